@@ -1,0 +1,64 @@
+// The paper's sound-to-friction conversion, equations (1) and (2):
+//   (1) a_mu[t] = (1/n) * sum_{i=0}^{n-1} |a[t-i]|,  n = round(sampleRate * window)
+//   (2) f[t] = mapping(20 log10(a_mu[t] / a_ref)), mapping clips to [loDb, hiDb] and maps
+//       linearly onto [loForce, hiForce].
+// The window may change while running, up to a maximum fixed at construction. The history
+// lives in memory the caller owns (RTAlloc in the plugin), so nothing here allocates.
+#pragma once
+
+#include <cstdint>
+
+namespace kf {
+
+struct FrictionMapping {
+  double loDb = -30.0;
+  double hiDb = 0.0;
+  double loForceN = 0.14;
+  double hiForceN = 0.5;
+  double ref = 1.0;  // a_ref: the mean |a| that reads 0 dB
+};
+
+// Equation (2) on one mean amplitude, in double: the reference the tests and benchmarks use.
+double frictionFromMeanAbs(double meanAbs, const FrictionMapping& mapping);
+
+// n = round(sampleRate * window), at least 1 and at most maxWindowSamples.
+int windowSamples(double sampleRateHz, double windowS, int maxWindowSamples);
+
+class LoudnessToFriction {
+ public:
+  // history: maxWindowSamples floats owned by the caller, for as long as this object lives.
+  LoudnessToFriction(float* history, int maxWindowSamples);
+
+  // Takes effect from the next sample; re-sums the window once when n changes.
+  void setWindowSamples(int n);
+  int windowSamples() const { return windowSamples_; }
+  void setMapping(const FrictionMapping& mapping);
+
+  // Force in N for each input sample. NaN/Inf input counts as silence.
+  void process(const float* in, float* forceN, int numSamples);
+  double meanAbs() const { return sum_ / windowSamples_; }
+  // The force process() would give for `a` as the next sample, without taking it in: the
+  // initial output a UGen shows before its first block.
+  float peekForce(float a) const;
+
+ private:
+  float mapMeanAbs(double meanAbs) const;
+  float sanitizedAbs(float a) const;
+  void resum();
+
+  float* history_;
+  int capacity_;
+  int windowSamples_ = 1;
+  int writeIndex_ = 0;  // where the next |a| goes; history_ is a ring of capacity_ samples
+  double sum_ = 0.0;    // sum of the latest windowSamples_ values of |a|
+
+  FrictionMapping mapping_;
+  // The mapping precomputed so that most samples need no logarithm: at or below loAbs_ the
+  // force is loForce, at or above hiAbs_ it is hiForce; in between, dB * forceSlope_ + offset.
+  double loAbs_ = 0.0, hiAbs_ = 0.0;
+  float forceAtLoAbs_ = 0.f, forceAtHiAbs_ = 0.f;
+  double forcePerDb_ = 0.0, forceOffset_ = 0.0, invRef_ = 1.0;
+  float maxAbs_ = 1e30f;  // |a| taken into the sum is clamped here (see setMapping)
+};
+
+}  // namespace kf

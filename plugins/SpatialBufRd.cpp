@@ -1,0 +1,80 @@
+// SpatialBufRd: plays a buffer laid out on the surface, read at the puck's position.
+// Inputs: bufnum, position (mm), samplesPerMm, origin (mm), interpolation (1, 2, 4).
+// samplesPerMm, origin and interpolation are read once per block.
+#include "PluginShared.hpp"
+#include "SpatialReader.hpp"
+
+namespace {
+
+enum Input { kBufnum, kPositionMm, kSamplesPerMm, kOriginMm, kInterpolation };
+
+// Why a block came out silent; posted once each time it changes.
+enum class BufferProblem { None, NotAllocated, ChannelMismatch };
+
+class SpatialBufRd : public SCUnit {
+ public:
+  SpatialBufRd() {
+    set_calc_function<SpatialBufRd, &SpatialBufRd::next>();
+    next(1);
+  }
+
+ private:
+  void next(int numSamples) {
+    const SndBuf* buf = lookupBuffer();
+    const int numChannels = static_cast<int>(mNumOutputs);
+    BufferProblem problem = BufferProblem::None;
+    if (buf == nullptr || buf->data == nullptr || buf->frames <= 0)
+      problem = BufferProblem::NotAllocated;
+    else if (buf->channels != numChannels)
+      problem = BufferProblem::ChannelMismatch;
+    report(problem, buf);
+    if (problem != BufferProblem::None) {
+      for (int c = 0; c < numChannels; ++c) std::fill_n(out(c), numSamples, 0.f);
+      return;
+    }
+
+    const kf::SignalView signal{buf->data, buf->frames, buf->channels};
+    const double samplesPerMm = in0(kSamplesPerMm);
+    const double originMm = in0(kOriginMm);
+    const auto interpolation = kf::interpolationFromCode(static_cast<int>(in0(kInterpolation)));
+    const float* positionMm = in(kPositionMm);
+    const bool positionIsAudio = isAudioRateIn(kPositionMm);
+    // Sample-major: an output buffer may share memory with the position input, so each
+    // position is read before any channel of that sample is written.
+    for (int i = 0; i < numSamples; ++i) {
+      const double index = kf::spatialIndex(positionMm[positionIsAudio ? i : 0], originMm, samplesPerMm);
+      for (int c = 0; c < numChannels; ++c) out(c)[i] = kf::readSpatial(signal, c, index, interpolation);
+    }
+  }
+
+  // The buffer for the bufnum input, global or local to the synth, or nullptr; looked up every
+  // block so that a freed or swapped buffer is seen at once.
+  const SndBuf* lookupBuffer() {
+    const float fbufnum = in0(kBufnum);
+    if (!(fbufnum >= 0.f)) return nullptr;
+    const auto bufnum = static_cast<uint32>(fbufnum);
+    mBufnum = static_cast<int>(bufnum);
+    if (bufnum < mWorld->mNumSndBufs) return mWorld->mSndBufs + bufnum;
+    const int localBufnum = static_cast<int>(bufnum - mWorld->mNumSndBufs);
+    if (localBufnum < mParent->localBufNum) return mParent->mLocalSndBufs + localBufnum;
+    return nullptr;
+  }
+
+  void report(BufferProblem problem, const SndBuf* buf) {
+    if (problem == mProblem) return;
+    mProblem = problem;
+    if (problem == BufferProblem::NotAllocated)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n",
+                         mBufnum);
+    else if (problem == BufferProblem::ChannelMismatch)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.\n",
+                         mBufnum, buf->channels, static_cast<int>(mNumOutputs));
+  }
+
+  BufferProblem mProblem = BufferProblem::None;
+  int mBufnum = -1;
+};
+
+}  // namespace
+
+void registerSpatialBufRd() { registerUnit<SpatialBufRd>(ft, "SpatialBufRd"); }

@@ -1,0 +1,35 @@
+// Plays a buffer laid out on the surface: the sample at index (position - origin) * samplesPerMm,
+// silent outside the signal. Positions in mm.
+SpatialBufRd : MultiOutUGen {
+	*ar { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4|
+		^this.multiNew('audio', numChannels, bufnum, position, samplesPerMm, origin, interpolation)
+	}
+
+	*kr { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4|
+		^this.multiNew('control', numChannels, bufnum, position, samplesPerMm, origin, interpolation)
+	}
+
+	init { |argNumChannels ... theInputs|
+		if(argNumChannels.isKindOf(Integer).not or: { argNumChannels < 1 }) {
+			Error("SpatialBufRd: numChannels must be an Integer of at least 1, got %".format(argNumChannels)).throw
+		};
+		inputs = theInputs;
+		^this.initOutputs(argNumChannels, rate)
+	}
+
+	argNamesInputsOffset { ^2 }
+
+	checkInputs {
+		var interpolation = inputs[4], samplesPerMm = inputs[2];
+		if(rate == 'audio' and: { inputs[1].rate != 'audio' }) {
+			^"position must be audio rate for SpatialBufRd.ar (got %); use K2A.ar or SpatialBufRd.kr".format(inputs[1].rate)
+		};
+		if(interpolation.isNumber and: { [1, 2, 4].includes(interpolation).not }) {
+			^"interpolation must be 1 (none), 2 (linear) or 4 (cubic), got %".format(interpolation)
+		};
+		if(samplesPerMm.isNumber and: { samplesPerMm.isNaN or: { samplesPerMm.abs == inf } }) {
+			^"samplesPerMm must be finite, got %".format(samplesPerMm)
+		};
+		^this.checkValidInputs
+	}
+}

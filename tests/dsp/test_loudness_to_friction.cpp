@@ -1,0 +1,242 @@
+// LoudnessToFriction against equations (1) and (2) recomputed in double, on the hard cases.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <vector>
+
+#include "LoudnessToFriction.hpp"
+
+using kf::FrictionMapping;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Owns the history a plugin would RTAlloc.
+struct Core {
+  std::vector<float> history;
+  kf::LoudnessToFriction core;
+  explicit Core(int maxWindow) : history(maxWindow), core(history.data(), maxWindow) {}
+};
+
+// Equations (1) and (2) straight from the paper, in double, with zeros before the start.
+struct Reference {
+  std::deque<double> window;
+  int n;
+  FrictionMapping mapping;
+  explicit Reference(int windowSamples, FrictionMapping m = {}) : window(windowSamples, 0.0), n(windowSamples), mapping(m) {}
+  double operator()(float a) {
+    double x = std::isfinite(a) ? std::fabs(double(a)) : (std::isnan(a) ? 0.0 : 1e30);
+    window.push_back(x);
+    window.pop_front();
+    double sum = 0;
+    for (double v : window) sum += v;
+    return kf::frictionFromMeanAbs(sum / n, mapping);
+  }
+};
+
+// Deterministic white noise in [-1, 1).
+struct Noise {
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  float operator()() {
+    state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+    return static_cast<float>((state >> 40) * (1.0 / 8388608.0) - 1.0);
+  }
+};
+
+std::vector<float> runCore(Core& c, const std::vector<float>& in) {
+  std::vector<float> out(in.size());
+  c.core.process(in.data(), out.data(), static_cast<int>(in.size()));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("reference mapping: the paper's end points and the full-scale sine") {
+  FrictionMapping m;
+  CHECK(kf::frictionFromMeanAbs(0.0, m) == 0.14);
+  CHECK(kf::frictionFromMeanAbs(1.0, m) == 0.5);
+  CHECK(kf::frictionFromMeanAbs(std::pow(10.0, -1.5), m) == Approx(0.14));
+  CHECK(kf::frictionFromMeanAbs(2.0 / kPi, m) == Approx(0.14 + 0.36 * (1 + 20 * std::log10(2 / kPi) / 30)));
+  CHECK(kf::frictionFromMeanAbs(2.0 / kPi, m) == Approx(0.4530).margin(1e-4));
+}
+
+TEST_CASE("window length is round(sr x window), clamped to [1, max]") {
+  CHECK(kf::windowSamples(192000, 0.001, 1000) == 192);
+  CHECK(kf::windowSamples(44100, 0.001, 1000) == 44);
+  CHECK(kf::windowSamples(48000, 0.001, 1000) == 48);
+  CHECK(kf::windowSamples(96000, 0.001, 1000) == 96);
+  CHECK(kf::windowSamples(48000, 1.0, 1000) == 1000);
+  CHECK(kf::windowSamples(48000, 0.0, 1000) == 1);
+  CHECK(kf::windowSamples(48000, -1.0, 1000) == 1);
+  CHECK(kf::windowSamples(48000, std::numeric_limits<double>::quiet_NaN(), 1000) == 1);
+  CHECK(kf::windowSamples(48000, std::numeric_limits<double>::infinity(), 1000) == 1000);
+}
+
+TEST_CASE("silence gives exactly loForce, from the first sample on") {
+  Core c(192);
+  c.core.setWindowSamples(192);
+  auto out = runCore(c, std::vector<float>(5000, 0.f));
+  for (float f : out) REQUIRE(f == 0.14f);
+}
+
+TEST_CASE("a full-scale square gives exactly hiForce once the window is full") {
+  Core c(192);
+  c.core.setWindowSamples(192);
+  std::vector<float> in(4000);
+  for (size_t i = 0; i < in.size(); ++i) in[i] = (i / 96) % 2 ? -1.f : 1.f;
+  auto out = runCore(c, in);
+  for (size_t i = 191; i < out.size(); ++i) REQUIRE(out[i] == 0.5f);
+}
+
+TEST_CASE("a full-scale sine gives 0.4530 N") {
+  // 1 kHz at 192 kHz: the 1 ms window holds whole periods, so the mean of |sin| is 2/pi up to
+  // the sampling of the period.
+  Core c(192);
+  c.core.setWindowSamples(192);
+  std::vector<float> in(19200);
+  for (size_t i = 0; i < in.size(); ++i) in[i] = static_cast<float>(std::sin(2 * kPi * 1000 * i / 192000.0));
+  auto out = runCore(c, in);
+  const double want = 0.14 + 0.36 * (1 + 20 * std::log10(2 / kPi) / 30);
+  for (size_t i = 192; i < out.size(); ++i) REQUIRE(out[i] == Approx(want).margin(2e-4));
+}
+
+TEST_CASE("per-sample agreement with equations (1) and (2) at 44.1 to 192 kHz") {
+  for (double sr : {44100.0, 48000.0, 96000.0, 192000.0}) {
+    const int n = kf::windowSamples(sr, 0.001, 400);
+    Core c(400);
+    c.core.setWindowSamples(n);
+    Reference ref(n);
+    Noise noise;
+    std::vector<float> in(3000);
+    // Noise whose level sweeps through the whole clip range and beyond.
+    for (size_t i = 0; i < in.size(); ++i) in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
+    auto out = runCore(c, in);
+    for (size_t i = 0; i < in.size(); ++i) REQUIRE(out[i] == Approx(ref(in[i])).margin(1e-6));
+  }
+}
+
+TEST_CASE("NaN and Inf input never reach the output") {
+  Core c(48);
+  c.core.setWindowSamples(48);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::vector<float> in(1000, 0.5f);
+  in[100] = nan, in[200] = inf, in[300] = -inf, in[301] = nan;
+  auto out = runCore(c, in);
+  Reference ref(48);
+  for (size_t i = 0; i < in.size(); ++i) {
+    REQUIRE(std::isfinite(out[i]));
+    REQUIRE(out[i] == Approx(ref(in[i])).margin(1e-6));
+  }
+  CHECK(out[210] == 0.5f);  // Inf is as loud as it gets
+  // ...and the running sum recovers once the Inf has left the window.
+  CHECK(out[999] == Approx(kf::frictionFromMeanAbs(0.5, FrictionMapping{})).margin(1e-6));
+}
+
+TEST_CASE("denormals and tiny levels read as loForce") {
+  Core c(192);
+  c.core.setWindowSamples(192);
+  std::vector<float> in(2000);
+  for (size_t i = 0; i < in.size(); ++i) in[i] = (i % 2 ? 1 : -1) * std::numeric_limits<float>::denorm_min() * (1 + i % 7);
+  for (float f : runCore(c, in)) REQUIRE(f == 0.14f);
+}
+
+TEST_CASE("full scale and above clip at hiForce") {
+  Core c(48);
+  c.core.setWindowSamples(48);
+  for (float level : {1.f, 10.f, 1e6f, 3e38f}) {
+    auto out = runCore(c, std::vector<float>(200, level));
+    REQUIRE(out.back() == 0.5f);
+  }
+}
+
+TEST_CASE("extreme and reversed mappings") {
+  SECTION("reversed dB bounds: louder means less friction") {
+    FrictionMapping m{0.0, -30.0, 0.14, 0.5, 1.0};
+    Core c(48);
+    c.core.setWindowSamples(48);
+    c.core.setMapping(m);
+    CHECK(runCore(c, std::vector<float>(100, 1.f)).back() == Approx(0.14f));
+    CHECK(runCore(c, std::vector<float>(100, 0.f)).back() == Approx(0.5f));
+  }
+  SECTION("loDb == hiDb is a threshold") {
+    FrictionMapping m{-6.0, -6.0, 0.2, 1.0, 1.0};
+    Core c(8);
+    c.core.setWindowSamples(8);
+    c.core.setMapping(m);
+    CHECK(runCore(c, std::vector<float>(16, 0.6f)).back() == 1.0f);
+    CHECK(runCore(c, std::vector<float>(16, 0.4f)).back() == 0.2f);
+  }
+  SECTION("bad ref and non-finite bounds fall back to the paper's values") {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Core c(8);
+    c.core.setWindowSamples(8);
+    c.core.setMapping(FrictionMapping{nan, nan, nan, nan, -1.0});
+    CHECK(runCore(c, std::vector<float>(16, 1.f)).back() == 0.5f);
+    CHECK(runCore(c, std::vector<float>(16, 0.f)).back() == 0.14f);
+  }
+  SECTION("a tiny ref moves 0 dB down") {
+    FrictionMapping m;
+    m.ref = 1e-6;
+    Core c(8);
+    c.core.setWindowSamples(8);
+    c.core.setMapping(m);
+    CHECK(runCore(c, std::vector<float>(16, 1e-6f)).back() == Approx(0.5f));
+  }
+}
+
+TEST_CASE("the window can change while running, up to the maximum") {
+  Core c(500);
+  c.core.setWindowSamples(48);
+  Noise noise;
+  std::vector<float> all;
+  std::vector<float> out;
+  int n = 48;
+  for (int block = 0; block < 60; ++block) {
+    if (block % 10 == 5) n = (n * 7) % 499 + 1;
+    if (block == 40) n = 10000;  // beyond the maximum: clamps
+    c.core.setWindowSamples(n);
+    std::vector<float> in(64);
+    for (float& x : in) x = noise() * 0.3f;
+    auto o = runCore(c, in);
+    const int used = c.core.windowSamples();
+    REQUIRE(used == std::min(n, 500));
+    for (int i = 0; i < 64; ++i) {
+      all.push_back(in[i]);
+      double sum = 0;
+      for (int k = 0; k < used && k < static_cast<int>(all.size()); ++k) sum += std::fabs(all[all.size() - 1 - k]);
+      REQUIRE(o[i] == Approx(kf::frictionFromMeanAbs(sum / used, FrictionMapping{})).margin(1e-6));
+    }
+  }
+}
+
+TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation", "[long]") {
+  const int n = 192;
+  Core c(n);
+  c.core.setWindowSamples(n);
+  Noise noise;
+  constexpr int kBlock = 4096;
+  std::vector<float> in(kBlock), out(kBlock);
+  const int64_t total = 1000000000;
+  int64_t done = 0;
+  double worstN = 0.0;
+  while (done < total) {
+    for (float& x : in) x = noise() * 0.25f;  // about -18 dB: inside the clip range
+    c.core.process(in.data(), out.data(), kBlock);
+    done += kBlock;
+    if (done % (kBlock * 24414) == 0 || done >= total) {
+      // Recompute the last n samples' mean in double and compare every 10^8 samples.
+      double sum = 0;
+      for (int k = 0; k < n; ++k) sum += std::fabs(double(in[kBlock - 1 - k]));
+      const double want = kf::frictionFromMeanAbs(sum / n, FrictionMapping{});
+      worstN = std::max(worstN, std::fabs(out[kBlock - 1] - want));
+      REQUIRE(out[kBlock - 1] == Approx(want).margin(1e-6));
+      REQUIRE(c.core.meanAbs() == Approx(sum / n).epsilon(1e-12));
+    }
+  }
+  INFO("worst |error| " << worstN << " N");
+  CHECK(worstN < 1e-6);
+}

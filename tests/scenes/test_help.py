@@ -1,0 +1,46 @@
+"""Every .schelp file parses with SCDoc, and every code example in it compiles."""
+from pathlib import Path
+
+import kfsc
+
+HELP_DIR = Path(__file__).resolve().parents[2] / "HelpSource"
+CLASS_DIR = Path(__file__).resolve().parents[2] / "sc-classes"
+
+
+def test_every_help_file_parses_and_its_examples_compile():
+    files = sorted(HELP_DIR.rglob("*.schelp"))
+    assert files, "no help files"
+    paths = ", ".join(f'"{p}"' for p in files)
+    out = kfsc.run_sclang(f"""
+        var failures = 0, codeBlocks = {{ |node|
+            if(node.id == \\CODEBLOCK) {{ [node.text] }} {{
+                (node.children ? []).collect(codeBlocks).flatten(1)
+            }}
+        }};
+        [{paths}].do {{ |path|
+            var doc = SCDoc.parseFileFull(path), blocks;
+            if(doc.isNil) {{ "HELP-PARSE-FAILED %".format(path).postln; failures = failures + 1 }} {{
+                blocks = codeBlocks.(doc);
+                blocks.do {{ |code, i|
+                    if(code.compile.isNil) {{
+                        "HELP-EXAMPLE-FAILED % block %".format(path, i).postln; failures = failures + 1
+                    }}
+                }};
+                "HELP-OK % (% examples)".format(path, blocks.size).postln;
+            }}
+        }};
+        if(failures > 0) {{ Error("% help problems".format(failures)).throw }};
+    """)
+    for f in files:
+        assert f"HELP-OK {f}" in out
+
+
+def test_every_class_has_a_help_file():
+    classes = []
+    for sc in CLASS_DIR.rglob("*.sc"):
+        for line in sc.read_text().splitlines():
+            if line and not line[0].isspace() and line[0].isupper() and "{" in line:
+                classes.append(line.split()[0])
+    assert classes
+    missing = [c for c in classes if not (HELP_DIR / "Classes" / f"{c}.schelp").exists()]
+    assert not missing, f"classes without a help file: {missing}"
