@@ -50,4 +50,7 @@ PluginLoad(KineticFriction) {
   ft = inTable;
   registerSpatialBufRd();
   registerLoudnessToFriction();
+  registerFrictionMouseIn();
+  registerFrictionOut();
+  registerDeviceCommands();
 }

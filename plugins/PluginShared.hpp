@@ -20,3 +20,6 @@ void clearUnitOnAllocFailure(Unit* unit, const char* ugenName);
 // Registration hooks, one per UGen file, called from PluginLoad.
 void registerSpatialBufRd();
 void registerLoudnessToFriction();
+void registerFrictionMouseIn();
+void registerFrictionOut();
+void registerDeviceCommands();

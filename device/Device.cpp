@@ -1,0 +1,134 @@
+#include "Device.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace kf {
+
+Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse,
+               std::shared_ptr<ForceBackend> force, bool lockstep, DeviceOptions options)
+    : spec_(spec),
+      lockstep_(lockstep),
+      options_(options),
+      mouse_(std::move(mouse)),
+      force_(std::move(force)),
+      reportQueue_(options.reportQueueCapacity),
+      frameQueue_(options.frameQueueCapacity),
+      safety_(spec) {
+  telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
+}
+
+Device::~Device() { close(); }
+
+void Device::start() {
+  if (lockstep_ || thread_.joinable() || isClosed()) return;
+  stopRequested_.store(false);
+  thread_ = std::thread([this] { threadMain(); });
+}
+
+void Device::threadMain() {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point openTime = Clock::now();
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(options_.pumpPeriodS));
+  Clock::time_point next = openTime;
+  while (!stopRequested_.load(std::memory_order_acquire)) {
+    next += period;
+    std::this_thread::sleep_until(next);
+    const Clock::time_point now = Clock::now();
+    // After a long stall, do not try to catch up with a burst of pumps.
+    if (now - next > 10 * period) next = now;
+    const double nowS = std::chrono::duration<double>(now - openTime).count();
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    pumpLocked(nowS);
+  }
+}
+
+void Device::pump(double nowS) {
+  if (!lockstep_ || isClosed()) return;
+  // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
+  std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;
+  pumpLocked(nowS);
+}
+
+void Device::pumpLocked(double nowS) {
+  if (!(nowS > lastPumpS_)) return;
+
+  ForceFrame frame;
+  while (frameQueue_.pop(frame)) {
+    const float commandedN = safety_.applyFrame(frame, nowS);
+    // Lockstep: device and audio time are one clock, so the frame takes effect at its own
+    // time (never before an earlier command, never in the future). Realtime: now.
+    double commandS = nowS;
+    if (lockstep_ && std::isfinite(frame.timeS))
+      commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
+    lastCommandS_ = commandS;
+    force_->commandForce(commandS, commandedN);
+    telemetry_.countFrame(commandedN);
+    recorder_.writeFrame(nowS, frame, commandedN);
+  }
+  if (safety_.checkWatchdog(nowS)) {
+    force_->driveOff();
+    telemetry_.countWatchdogTrip();
+    telemetry_.setCommandedForce(safety_.commandedForceN());
+    recorder_.writeOff(nowS);
+  }
+
+  int polled = 0;
+  do {
+    polled = mouse_->pollReports(nowS, pollBuffer_, kPollBatch);
+    for (int i = 0; i < polled; ++i) {
+      telemetry_.countReport(pollBuffer_[i].deviceTimeS);
+      recorder_.writeReport(nowS, pollBuffer_[i]);
+      reportQueue_.push(pollBuffer_[i]);  // a full queue counts the overflow
+    }
+  } while (polled == kPollBatch);
+
+  lastPumpS_ = nowS;
+  telemetry_.countPump();
+}
+
+void Device::close() {
+  if (closed_.exchange(true, std::memory_order_acq_rel)) return;
+  stopRequested_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  force_->driveOff();
+  safety_.resetToOff();
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  recorder_.writeOff(std::max(lastPumpS_, 0.0));
+  recorder_.close();
+}
+
+int Device::popReports(MouseReport* out, int capacity) {
+  int popped = 0;
+  while (popped < capacity && reportQueue_.pop(out[popped])) ++popped;
+  return popped;
+}
+
+bool Device::pushForceFrame(const ForceFrame& frame) { return frameQueue_.push(frame); }
+
+TelemetrySnapshot Device::telemetry() const {
+  TelemetrySnapshot snapshot = telemetry_.snapshot();
+  snapshot.reportQueueOverflows = reportQueue_.overflows();
+  snapshot.frameQueueOverflows = frameQueue_.overflows();
+  return snapshot;
+}
+
+bool Device::startRecording(const std::string& path, std::string& error) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  if (isClosed()) {
+    error = "the device is closed";
+    return false;
+  }
+  return recorder_.open(path, spec_, error);
+}
+
+void Device::stopRecording() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  recorder_.close();
+}
+
+}  // namespace kf

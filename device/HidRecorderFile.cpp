@@ -1,0 +1,118 @@
+#include "HidRecorderFile.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace kf {
+
+namespace {
+
+bool parseHexBytes(std::istringstream& fields, size_t count, std::vector<uint8_t>& out) {
+  out.clear();
+  std::string token;
+  while (fields >> token) {
+    if (token.size() != 2) return false;
+    char* end = nullptr;
+    const unsigned long value = std::strtoul(token.c_str(), &end, 16);
+    if (end != token.c_str() + 2) return false;
+    out.push_back(static_cast<uint8_t>(value));
+  }
+  return out.size() == count;
+}
+
+std::string lineError(const std::string& path, int lineNumber, const std::string& what) {
+  return path + ":" + std::to_string(lineNumber) + ": " + what;
+}
+
+std::string firstRecordTag(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    return line.substr(0, 2);
+  }
+  return {};
+}
+
+}  // namespace
+
+bool isHidRecorderFile(const std::string& path) {
+  const std::string tag = firstRecordTag(path);
+  return tag == "R:" || tag == "D:";
+}
+
+bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string& error) {
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot read " + path;
+    return false;
+  }
+  out = HidRecording{};
+  std::string line;
+  int lineNumber = 0;
+  int device = 0;
+  bool haveDescriptor = false;
+  while (std::getline(in, line)) {
+    ++lineNumber;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    if (line.size() < 2 || line[1] != ':') {
+      error = lineError(path, lineNumber, "not a hid-recorder record");
+      return false;
+    }
+    const char tag = line[0];
+    const std::string rest = line.size() > 2 ? line.substr(3) : std::string();
+    std::istringstream fields(rest);
+    fields.imbue(std::locale::classic());
+    if (tag == 'D') {
+      if (!(fields >> device)) {
+        error = lineError(path, lineNumber, "bad D: record");
+        return false;
+      }
+      continue;
+    }
+    if (device != 0) continue;  // only the first device
+    if (tag == 'R') {
+      size_t length = 0;
+      if (!(fields >> length) || !parseHexBytes(fields, length, out.descriptor)) {
+        error = lineError(path, lineNumber, "R: length does not match its bytes, or bad hex");
+        return false;
+      }
+      haveDescriptor = true;
+    } else if (tag == 'N') {
+      out.name = rest;
+    } else if (tag == 'P') {
+      out.physicalPath = rest;
+    } else if (tag == 'I') {
+      if (!(fields >> std::hex >> out.bus >> out.vendorId >> out.productId)) {
+        error = lineError(path, lineNumber, "bad I: record");
+        return false;
+      }
+    } else if (tag == 'E') {
+      HidRecordedEvent event;
+      size_t length = 0;
+      std::string timeToken;
+      if (!(fields >> timeToken >> length)) {
+        error = lineError(path, lineNumber, "bad E: record");
+        return false;
+      }
+      char* end = nullptr;
+      event.timeS = std::strtod(timeToken.c_str(), &end);
+      if (end != timeToken.c_str() + timeToken.size() ||
+          !parseHexBytes(fields, length, event.bytes)) {
+        error = lineError(path, lineNumber, "E: time, length or bytes malformed");
+        return false;
+      }
+      out.events.push_back(std::move(event));
+    }
+    // Other records (e.g. hid-tools' newer optional ones) are ignored.
+  }
+  if (!haveDescriptor) {
+    error = path + ": no R: report descriptor record";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace kf

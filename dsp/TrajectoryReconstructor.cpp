@@ -1,0 +1,137 @@
+#include "TrajectoryReconstructor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kf {
+
+namespace {
+
+// In update intervals T (see the header).
+constexpr double kExtrapolateT = 1.5;  // predictive: carry the motion on this long at most
+constexpr double kStaleT = 2.0;        // no report for this long: the puck has stopped
+constexpr double kFadeT = 1.0;         // then speed (and extrapolation) go to 0 over this
+
+constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/Report.hpp)
+
+}  // namespace
+
+TrajectoryMode trajectoryModeFromCode(int code) {
+  switch (code) {
+    case 0: return TrajectoryMode::Hold;
+    case 2: return TrajectoryMode::Predictive;
+    default: return TrajectoryMode::Linear;
+  }
+}
+
+TrajectoryReconstructor::TrajectoryReconstructor(double updateRateHz, TrajectoryMode mode)
+    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : 125.0)),
+      mode_(mode),
+      nextMode_(mode) {}
+
+void TrajectoryReconstructor::reset() {
+  axes_ = {};
+  hasAnchor_ = false;
+  hasRendered_ = false;
+  renderedMm_[0] = renderedMm_[1] = 0.0;
+  renderedSpeedMmPerS_[0] = renderedSpeedMmPerS_[1] = 0.0;
+  pendingHead_ = 0;
+  pendingCount_ = 0;
+  mode_ = nextMode_;
+}
+
+void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm,
+                                        uint32_t flags) {
+  if (flags & kAfterLossFlag) ++reportsAfterLoss_;
+  if (!std::isfinite(dxMm)) dxMm = 0.0;  // one bad report must not poison the position
+  if (!std::isfinite(dyMm)) dyMm = 0.0;
+  if (!std::isfinite(reportTimeS)) reportTimeS = pendingCount_ > 0 ? lastQueuedTimeS_ : lastRenderTimeS_;
+  if (pendingCount_ > 0) reportTimeS = std::max(reportTimeS, lastQueuedTimeS_);
+  if (pendingCount_ == kQueueCapacity) {
+    // Full: never drop distance; the newest report absorbs this one.
+    Pending& newest = queue_[(pendingHead_ + pendingCount_ - 1) % kQueueCapacity];
+    newest.dMm[0] += dxMm;
+    newest.dMm[1] += dyMm;
+    ++reportsMerged_;
+    return;
+  }
+  queue_[(pendingHead_ + pendingCount_) % kQueueCapacity] = Pending{reportTimeS, {dxMm, dyMm}};
+  ++pendingCount_;
+  lastQueuedTimeS_ = reportTimeS;
+}
+
+double TrajectoryReconstructor::positionAt(const Axis& axis, double sinceAnchorS) const {
+  const double s = sinceAnchorS / intervalS_;  // in intervals
+  double extrapolateT = 0.0;
+  double fade = 0.0;
+  if (mode_ == TrajectoryMode::Predictive) {
+    if (s < kExtrapolateT) extrapolateT = std::max(0.0, s);
+    else if (s < kStaleT) extrapolateT = kExtrapolateT;
+    else if (s < kStaleT + kFadeT) extrapolateT = kExtrapolateT * (1.0 - (s - kStaleT) / kFadeT);
+  }
+  if (mode_ != TrajectoryMode::Hold && s < 1.0) fade = 1.0 - std::max(0.0, s);
+  if (extrapolateT == 0.0 && fade == 0.0) return axis.anchorMm;  // exactly the reported sum
+  return axis.anchorMm + axis.speedMmPerS * (extrapolateT * intervalS_) + axis.correctionMm * fade;
+}
+
+double TrajectoryReconstructor::speedAt(const Axis& axis, double sinceAnchorS) const {
+  const double s = sinceAnchorS / intervalS_;
+  if (s < kStaleT) return axis.speedMmPerS;
+  if (s < kStaleT + kFadeT) return axis.speedMmPerS * (1.0 - (s - kStaleT) / kFadeT);
+  return 0.0;
+}
+
+void TrajectoryReconstructor::take(const Pending& report, double nowS) {
+  // Taken at its own time, or at the last rendered sample if that is already past it, so the
+  // position just before it is what was (or would have been) output.
+  double takeS = std::min(report.timeS, nowS);
+  if (hasRendered_) takeS = std::max(takeS, lastRenderTimeS_);
+  for (int a = 0; a < 2; ++a) {
+    Axis& axis = axes_[a];
+    const double beforeMm = hasAnchor_ ? positionAt(axis, takeS - anchorTimeS_) : axis.anchorMm;
+    axis.anchorMm += report.dMm[a];
+    axis.speedMmPerS = report.dMm[a] / intervalS_;
+    axis.correctionMm = beforeMm - axis.anchorMm;
+  }
+  mode_ = nextMode_;
+  if (mode_ == TrajectoryMode::Hold) axes_[0].correctionMm = axes_[1].correctionMm = 0.0;
+  anchorTimeS_ = takeS;
+  hasAnchor_ = true;
+  ++reportsTaken_;
+}
+
+void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples,
+                                     double originMm, float* xMm, float* yMm, float* vxMmPerS,
+                                     float* vyMmPerS) {
+  render(startTimeS, sampleDurS, numSamples, originMm, 0.0, xMm, yMm, vxMmPerS, vyMmPerS);
+}
+
+void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples,
+                                     double originXMm, double originYMm, float* xMm, float* yMm,
+                                     float* vxMmPerS, float* vyMmPerS) {
+  float* positionOut[2] = {xMm, yMm};
+  float* speedOut[2] = {vxMmPerS, vyMmPerS};
+  const double originMm[2] = {originXMm, originYMm};
+  for (int i = 0; i < numSamples; ++i) {
+    const double nowS = startTimeS + i * sampleDurS;
+    while (pendingCount_ > 0 && queue_[pendingHead_].timeS <= nowS) {
+      take(queue_[pendingHead_], nowS);
+      pendingHead_ = (pendingHead_ + 1) % kQueueCapacity;
+      --pendingCount_;
+    }
+    const double sinceS = nowS - anchorTimeS_;
+    for (int a = 0; a < 2; ++a) {
+      const Axis& axis = axes_[a];
+      const double pMm = hasAnchor_ ? positionAt(axis, sinceS) : axis.anchorMm;
+      const double vMmPerS = hasAnchor_ ? speedAt(axis, sinceS) : 0.0;
+      renderedMm_[a] = pMm;
+      renderedSpeedMmPerS_[a] = vMmPerS;
+      if (positionOut[a]) positionOut[a][i] = static_cast<float>(pMm - originMm[a]);
+      if (speedOut[a]) speedOut[a][i] = static_cast<float>(vMmPerS);
+    }
+    lastRenderTimeS_ = nowS;
+    hasRendered_ = true;
+  }
+}
+
+}  // namespace kf

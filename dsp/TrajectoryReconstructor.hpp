@@ -1,0 +1,118 @@
+// TrajectoryReconstructor: the puck's position and speed at audio rate, from displacement
+// reports that arrive every T = 1 / updateRate (8 ms at the paper's 125 Hz).
+//
+// Reports come in as (audio time, dx mm, dy mm) — the caller maps device time onto audio
+// time (DeviceClockMapper) and counts onto mm. The absolute position is summed in double;
+// after the last report has played out, every mode sits exactly on that sum.
+//
+// One rule covers the three modes. A report at time ta moves the anchor to the new reported
+// position A, and the output is
+//     p(t) = A + v * e(t - ta) + c * w(t - ta)
+// where c = (position just before the report) - A keeps p continuous and w fades it out.
+//   Hold:       w = 0, e = 0: p steps to each reported position.
+//   Linear:     w = 1 - s/T over one interval, e = 0: the paper's "linearly interpolating
+//               over the current update interval"; costs one interval (T) of lag.
+//   Predictive: as Linear, plus e(s) = s up to 1.5 T with v = dx / T of the latest report:
+//               the new position is reached at ta and the motion carried on. Extrapolation
+//               stops after 1.5 T (a late report, or a stop: mice send nothing when still),
+//               holds until 2 T and is taken back over the next T, so a stop overshoots by
+//               at most v * 1.5 T and then settles exactly on A.
+// Speed output (all modes): the latest report's dx / T — the paper's speed signal, in steps
+// of one count per interval — held for 2 T, then faded to 0 over T when no reports come.
+//
+// Reports wait in a fixed queue until rendering reaches their time, so several reports in one
+// block are taken in order at their own times. A report whose time has already been rendered
+// is taken at the next sample (p stays continuous; its lateness becomes lag). Nothing here
+// allocates.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace kf {
+
+enum class TrajectoryMode : int { Hold = 0, Linear = 1, Predictive = 2 };
+
+// 0 hold, 1 linear, 2 predictive; anything else reads linear (the paper's).
+TrajectoryMode trajectoryModeFromCode(int code);
+
+class TrajectoryReconstructor {
+ public:
+  explicit TrajectoryReconstructor(double updateRateHz = 125.0,
+                                   TrajectoryMode mode = TrajectoryMode::Linear);
+
+  // Takes effect at the next report, so the output never jumps because of it.
+  void setMode(TrajectoryMode mode) { nextMode_ = mode; }
+  TrajectoryMode mode() const { return nextMode_; }
+
+  // Back to position (0, 0), at rest, no pending reports.
+  void reset();
+
+  // Reports in order of time (an earlier time than the previous report's is taken as that
+  // one's). flags: ReportFlag bits (kAfterLoss counts a loss). If the queue is full the
+  // displacement is merged into the newest pending report, so no distance is lost.
+  void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0);
+
+  // Sample i is at startTimeS + i * sampleDurS; times should increase from call to call.
+  // originMm is subtracted from x in double before the float output (y is not shifted).
+  // Any output pointer may be null.
+  void render(double startTimeS, double sampleDurS, int numSamples, double originMm, float* xMm,
+              float* yMm, float* vxMmPerS, float* vyMmPerS);
+  // The same with an origin for each axis.
+  void render(double startTimeS, double sampleDurS, int numSamples, double originXMm,
+              double originYMm, float* xMm, float* yMm, float* vxMmPerS, float* vyMmPerS);
+
+  double updateIntervalS() const { return intervalS_; }
+  // Sum of the displacements of all reports taken so far (exact, double).
+  double reportedXMm() const { return axes_[0].anchorMm; }
+  double reportedYMm() const { return axes_[1].anchorMm; }
+  // Position and speed at the last rendered sample, in double, origin not subtracted.
+  double renderedXMm() const { return renderedMm_[0]; }
+  double renderedYMm() const { return renderedMm_[1]; }
+  double renderedSpeedXMmPerS() const { return renderedSpeedMmPerS_[0]; }
+  double renderedSpeedYMmPerS() const { return renderedSpeedMmPerS_[1]; }
+
+  int pendingReports() const { return pendingCount_; }
+  int64_t reportsTaken() const { return reportsTaken_; }
+  int64_t reportsAfterLoss() const { return reportsAfterLoss_; }
+  int64_t reportsMerged() const { return reportsMerged_; }
+
+ private:
+  static constexpr int kQueueCapacity = 64;  // 0.5 s of 125 Hz reports
+
+  struct Pending {
+    double timeS;
+    double dMm[2];
+  };
+  struct Axis {
+    double anchorMm = 0.0;      // reported position: the exact sum of displacements
+    double speedMmPerS = 0.0;   // dx / T of the latest report
+    double correctionMm = 0.0;  // c: position before the latest report minus the anchor
+  };
+
+  void take(const Pending& report, double nowS);
+  double positionAt(const Axis& axis, double sinceAnchorS) const;
+  double speedAt(const Axis& axis, double sinceAnchorS) const;
+
+  double intervalS_;
+  TrajectoryMode mode_;
+  TrajectoryMode nextMode_;
+  std::array<Axis, 2> axes_{};
+  double anchorTimeS_ = 0.0;
+  bool hasAnchor_ = false;
+  double lastRenderTimeS_ = 0.0;
+  bool hasRendered_ = false;
+  double renderedMm_[2] = {0.0, 0.0};
+  double renderedSpeedMmPerS_[2] = {0.0, 0.0};
+
+  std::array<Pending, kQueueCapacity> queue_{};
+  int pendingHead_ = 0;
+  int pendingCount_ = 0;
+  double lastQueuedTimeS_ = 0.0;
+
+  int64_t reportsTaken_ = 0;
+  int64_t reportsAfterLoss_ = 0;
+  int64_t reportsMerged_ = 0;
+};
+
+}  // namespace kf

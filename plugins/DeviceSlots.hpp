@@ -1,0 +1,45 @@
+// Device slots by index, shared by all UGens of a server. The NRT thread opens and closes
+// devices (asynchronous commands); the audio thread sees a slot's device through an atomic
+// pointer it loads once per block, and never keeps it across blocks.
+//
+// Reports are fanned out on the audio side: the first FrictionMouseIn of a block that asks a
+// slot pops its queue (single consumer) into a per-slot buffer that every FrictionMouseIn
+// of that block then reads, so several UGens may follow one device.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "Device.hpp"
+
+namespace kf::sc {
+
+constexpr int kNumDeviceSlots = 16;
+constexpr int kMaxReportsPerBlock = 256;
+
+struct SlotView {
+  Device* device = nullptr;     // null: closed or never opened
+  uint32_t generation = 0;      // changes whenever the slot's device does
+  const MouseReport* reports = nullptr;  // this block's reports, in order
+  int numReports = 0;
+};
+
+// Audio thread. Out-of-range indices give an empty view. `blockCounter` is World::mBufCounter;
+// `lockstepTimeS` is the end of the block in audio time, to which a lockstep device is
+// pumped before its reports are taken.
+SlotView viewSlot(int index, int64_t blockCounter, double lockstepTimeS);
+
+// Audio thread: the slot's device, pumped to lockstepTimeS if it runs in lockstep.
+Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation);
+
+// RT stage of the commands: publishes `device` (may be null) in the slot and returns the
+// previous one, for the NRT stage to close and delete.
+Device* exchangeSlot(int index, Device* device);
+
+// Any thread: the device for a status query (NRT stages only: the device stays alive because
+// it is only ever deleted in a later NRT stage).
+Device* peekSlot(int index);
+
+bool isValidSlot(int index);
+
+}  // namespace kf::sc

@@ -1,0 +1,75 @@
+// FrictionOut: sends an audio-rate force (N) to a device slot as 1 ms frames, each the mean
+// over its millisecond, clamped to the device's range, NaN/Inf as the minimum. Outputs the
+// force actually commanded, so it can be scoped and recorded.
+// Inputs: device (slot index), force (N).
+#include <new>
+
+#include "AudioClock.hpp"
+#include "DeviceSlots.hpp"
+#include "ForceFramer.hpp"
+#include "PluginShared.hpp"
+
+namespace {
+
+enum Input { kDevice, kForceN };
+
+class FrictionOut : public SCUnit {
+ public:
+  FrictionOut() {
+    // Not set_calc_function, which would run a block now and send a frame at the wrong time.
+    mCalcFunc = make_calc_function<FrictionOut, &FrictionOut::next>();
+    out0(0) = mMinForceN;
+  }
+
+ private:
+  void next(int numSamples) {
+    const int index = static_cast<int>(in0(kDevice));
+    const double startS = kf::sc::blockStartTimeS(mWorld);
+    uint32_t generation = 0;
+    kf::Device* device = kf::sc::deviceOfSlot(index, startS + kf::sc::blockDurationS(mWorld), &generation);
+    if (device == nullptr) {
+      warnClosed(index);
+      std::fill_n(out(0), numSamples, mMinForceN);  // no device: its magnet is off
+      return;
+    }
+    mWarnedClosed = false;
+    if (generation != mGeneration) attach(*device, generation);
+
+    struct PushFrames {
+      kf::Device* device;
+      void operator()(double frameTimeS, float forceN) { device->pushForceFrame(kf::ForceFrame{frameTimeS, forceN}); }
+    } sink{device};
+    const double sampleDurS = 1.0 / sampleRate();
+    if (isAudioRateIn(kForceN)) {
+      mFramer.process(startS, sampleDurS, in(kForceN), numSamples, out(0), sink);
+    } else {
+      // A control-rate force is held over the block.
+      const float heldN = in0(kForceN);
+      for (int i = 0; i < numSamples; ++i) mFramer.process(startS + i * sampleDurS, sampleDurS, &heldN, 1, out(0) + i, sink);
+    }
+  }
+
+  void attach(const kf::Device& device, uint32_t generation) {
+    mGeneration = generation;
+    const kf::DeviceSpec& spec = device.spec();
+    mMinForceN = static_cast<float>(spec.minForceN);
+    mFramer.~ForceFramer();
+    new (&mFramer) kf::ForceFramer(spec.forceFramePeriodS, spec.minForceN, spec.maxForceN);
+  }
+
+  void warnClosed(int index) {
+    if (mWarnedClosed) return;
+    mWarnedClosed = true;
+    mGeneration = 0;
+    kf::sc::postFromRt(mWorld, "FrictionOut: no device is open at index %d; no force is sent.\n", index);
+  }
+
+  kf::ForceFramer mFramer;
+  float mMinForceN = static_cast<float>(kf::DeviceSpec{}.minForceN);  // of the last device seen
+  uint32_t mGeneration = 0;
+  bool mWarnedClosed = false;
+};
+
+}  // namespace
+
+void registerFrictionOut() { registerUnit<FrictionOut>(ft, "FrictionOut"); }
