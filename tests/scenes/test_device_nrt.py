@@ -1,0 +1,152 @@
+"""The device layer in Score renders: a simulated device stepped in lockstep with audio time,
+record and replay, and closed slots."""
+import numpy as np
+
+import kfsc
+
+SR = 48000
+HID_FILE = kfsc.SHARED_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+
+
+def render_device(name, open_code, seconds, force="DC.ar(0.3)", extra_events="", interpolation=1):
+    """Renders FrictionMouseIn's four outputs and FrictionOut's commanded force."""
+    return kfsc.score_and_render(name, f"""
+        var dev = {open_code};
+        var def = SynthDef(\\{name}, {{
+            Out.ar(0, FrictionMouseIn.ar(0, 0, {interpolation}) ++ [FrictionOut.ar(0, {force})])
+        }});
+        score = Score([
+            [0.0, dev.openMsg],
+            [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\{name}, nil, 1000).newMsg],
+            {extra_events}
+            [{seconds}, dev.closeMsg],
+            [{seconds} + 0.05, ['/c_set', 0, 0]]]);
+    """, sample_rate=SR, channels=5)
+
+
+def read_session(path):
+    lines = [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
+    assert lines[0][0] == "kf-session"
+    reports = np.array([[float(v) for v in l[1:]] for l in lines[1:] if l[0] == "R"])
+    frames = np.array([[float(v) for v in l[1:]] for l in lines[1:] if l[0] == "F"])
+    offs = [float(l[1]) for l in lines[1:] if l[0] == "O"]
+    return reports, frames, offs
+
+
+def test_steady_100_mm_per_s_hand_reads_100_mm_per_s_within_one_speed_level():
+    data, _ = render_device("steady", "FrictionDevice.sim(nil, 0, FrictionHand.speeds([[100, 3]]))", 2.0)
+    t = np.arange(len(data)) / SR
+    steady = (t > 1.0) & (t < 1.9)  # after the hand has taken up its lag
+    speed = data[steady, 2]
+    assert abs(speed.mean() - 100) < 2.6
+    assert np.all(np.abs(speed - 100) <= 2.625 + 1e-3), "each reading is one of the two levels around 100"
+    levels = np.unique(np.round(speed / 2.625, 6))
+    assert np.allclose(levels, np.round(levels)), "speed comes in 2.625 mm/s levels"
+    position = data[steady, 0]
+    assert abs(np.polyfit(t[steady], position, 1)[0] - 100) < 1.0
+
+
+def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_path=kfsc.WORK_DIR):
+    rec = tmp_path / "frames.kfs"
+    data, _ = render_device("frames", "FrictionDevice.sim(nil, 0, FrictionHand.speeds([[60, 2]]))", 1.0,
+                            force="LFPulse.ar(50).range(0.2, 0.8)",
+                            extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
+    _, frames, offs = read_session(rec)
+    # Frames are the 1 ms means of the force: at 50 Hz each 10 ms half-period is 10 whole frames.
+    assert len(frames) > 950
+    commanded = frames[:, 3].astype(np.float32)  # written as floats
+    square = {np.float32(0.2), np.float32(0.8)}
+    assert set(np.unique(commanded)) <= square, "square frames pass unchanged (within range)"
+    assert np.sum(commanded == np.float32(0.8)) > 450
+    assert offs and abs(offs[-1] - 1.0) < 0.002, "magnet off when the slot closes"
+    # FrictionOut outputs what it commanded: the same frames, once complete.
+    out_force = data[:, 4]
+    assert set(np.unique(out_force[SR // 100: SR - 100])) <= square
+
+
+def test_friction_slows_the_puck_as_the_simulation_says():
+    slow, _ = render_device("heavy", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
+                            force="DC.ar(1.4)")
+    fast, _ = render_device("light", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
+                            force="DC.ar(0.14)")
+    i = int(0.6 * SR)
+    assert slow[i, 0] < fast[i, 0] - 5, f"{slow[i, 0]} mm with 1.4 N vs {fast[i, 0]} mm with 0.14 N"
+
+
+def test_out_of_range_force_is_clamped_and_nan_is_the_minimum():
+    data, _ = render_device("clamp", "FrictionDevice.sim(nil, 0)", 0.3,
+                            force="Select.ar(LFPulse.ar(10, 0, 0.5), [DC.ar(5), DC.ar(1e30) * 1e30 - (DC.ar(1e30) * 1e30)])")
+    force = data[: int(0.29 * SR), 4]
+    assert np.all(np.isfinite(force))
+    assert force.min() == np.float32(0.14) and force.max() == np.float32(1.4)
+    # Whole frames of 5 N read 1.4 N, whole frames of NaN 0.14 N (a frame that straddles LFPulse's
+    # switch mixes the two).
+    values, counts = np.unique(force, return_counts=True)
+    assert set(values[counts > 48 * 20]) == {np.float32(0.14), np.float32(1.4)}
+
+
+def test_record_then_replay_gives_identical_output():
+    rec = kfsc.WORK_DIR / "session.kfs"
+    recorded, _ = render_device(
+        "rec", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.5, 30], [1.0, 10], [1.5, 45]]), "
+        "(reportJitterS: 0.0005, dropProbability: 0.05, seed: 7))", 1.6,
+        extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
+    replayed, _ = render_device("replay", f"FrictionDevice.replay(nil, \"{rec}\")", 1.6)
+    reports, _, _ = read_session(rec)
+    assert len(reports) > 150
+    assert np.max(np.abs(recorded[:, 0])) > 25
+    np.testing.assert_array_equal(recorded[:, :4], replayed[:, :4])
+
+
+def test_hid_recorder_file_replays_through_the_ugens():
+    data, log = render_device("hid", f"FrictionDevice.replay(nil, \"{HID_FILE}\")", 9.0)
+    x, y = data[:, 0].astype(np.float64), data[:, 1].astype(np.float64)
+    # The recording's relative X and Y sum to -67 and -40 counts (decoded independently in the
+    # device tests); at 0.021 mm a count the puck ends there.
+    assert abs(x[-int(0.1 * SR)] - (-67 * 0.021)) < 1e-4, x[-int(0.1 * SR)]
+    assert abs(y[-int(0.1 * SR)] - (-40 * 0.021)) < 1e-4
+    assert np.all(np.isfinite(data))
+
+
+def test_closed_slot_gives_zero_position_minimum_force_and_one_warning_each():
+    data, log = kfsc.score_and_render("closed", """
+        var def = SynthDef(\\closed, { Out.ar(0, FrictionMouseIn.ar(3) ++ [FrictionOut.ar(3, DC.ar(0.9))]) });
+        score = Score([
+            [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\closed, nil, 1000).newMsg],
+            [0.2, ['/c_set', 0, 0]]]);
+    """, sample_rate=SR, channels=5)
+    assert np.all(data[:, :4] == 0.0)
+    assert np.all(data[:, 4] == np.float32(0.14))
+    assert log.count("FrictionMouseIn: no device is open at index 3") == 1
+    assert log.count("FrictionOut: no device is open at index 3") == 1
+
+
+def test_same_score_renders_the_same_file_sample_for_sample():
+    open_code = ("FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.4, 20], [0.8, 5]]), "
+                 "(reportJitterS: 0.001, dropProbability: 0.1))")
+    a, _ = render_device("det_a", open_code, 0.9, force="LoudnessToFriction.ar(SinOsc.ar(FrictionMouseIn.ar(0)[2].abs * 10))")
+    b, _ = render_device("det_b", open_code, 0.9, force="LoudnessToFriction.ar(SinOsc.ar(FrictionMouseIn.ar(0)[2].abs * 10))")
+    np.testing.assert_array_equal(a, b)
+
+
+def test_bad_device_arguments_give_clear_errors():
+    out = kfsc.run_sclang("""
+        var errors = List.new;
+        [
+            { FrictionHand.path([[0, 0], [-1, 3]]) },
+            { FrictionHand.speeds([[10, -1]]) },
+            { FrictionHand.path([]) },
+            { FrictionDevice.sim(nil, 16) },
+            { FrictionDevice.sim(nil, 0, 3) },
+            { FrictionDevice.sim(nil, 0, nil, (maxForceN: "x")) },
+            { SynthDef(\\x, { FrictionMouseIn.ar(0, 0, 5) }).add },
+            { SynthDef(\\y, { FrictionOut.ar(-1, 0.2) }).add }
+        ].do { |f| try { f.value } { |e| errors.add(e.errorString) } };
+        errors.do(_.postln);
+        if(errors.size != 8) { Error("expected 8 errors, got %".format(errors.size)).throw };
+    """)
+    for text in ["times must ascend", "durations must be >= 0", "non-empty array", "index must be an Integer from 0 to 15",
+                 "hand must be a FrictionHand", "must be a number", "interpolation must be 0", "device must be a slot index"]:
+        assert text in out, text
