@@ -15,7 +15,8 @@ Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse,
       force_(std::move(force)),
       reportQueue_(options.reportQueueCapacity),
       frameQueue_(options.frameQueueCapacity),
-      safety_(spec) {
+      safety_(spec),
+      startTime_(std::chrono::steady_clock::now()) {
   telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
 }
 
@@ -24,12 +25,13 @@ Device::~Device() { close(); }
 void Device::start() {
   if (lockstep_ || thread_.joinable() || isClosed()) return;
   stopRequested_.store(false);
+  startTime_ = std::chrono::steady_clock::now();
   thread_ = std::thread([this] { threadMain(); });
 }
 
 void Device::threadMain() {
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point openTime = Clock::now();
+  const Clock::time_point openTime = startTime_;
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(options_.pumpPeriodS));
   Clock::time_point next = openTime;
@@ -40,6 +42,7 @@ void Device::threadMain() {
     // After a long stall, do not try to catch up with a burst of pumps.
     if (now - next > 10 * period) next = now;
     const double nowS = std::chrono::duration<double>(now - openTime).count();
+    if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
     std::lock_guard<std::mutex> lock(stateMutex_);
     pumpLocked(nowS);
   }
@@ -59,6 +62,7 @@ void Device::pumpLocked(double nowS) {
   ForceFrame frame;
   while (frameQueue_.pop(frame)) {
     const float commandedN = safety_.applyFrame(frame, nowS);
+    if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
     // Lockstep: device and audio time are one clock, so the frame takes effect at its own
     // time (never before an earlier command, never in the future). Realtime: now.
     double commandS = nowS;
@@ -80,6 +84,7 @@ void Device::pumpLocked(double nowS) {
   do {
     polled = mouse_->pollReports(nowS, pollBuffer_, kPollBatch);
     for (int i = 0; i < polled; ++i) {
+      pollBuffer_[i].hostTimeS = nowS;
       telemetry_.countReport(pollBuffer_[i].deviceTimeS);
       recorder_.writeReport(nowS, pollBuffer_[i]);
       reportQueue_.push(pollBuffer_[i]);  // a full queue counts the overflow
@@ -87,6 +92,7 @@ void Device::pumpLocked(double nowS) {
   } while (polled == kPollBatch);
 
   lastPumpS_ = nowS;
+  lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
 }
 
@@ -105,7 +111,16 @@ void Device::close() {
 int Device::popReports(MouseReport* out, int capacity) {
   int popped = 0;
   while (popped < capacity && reportQueue_.pop(out[popped])) ++popped;
+  if (!lockstep_ && popped > 0) {
+    const double now = nowS();
+    for (int i = 0; i < popped; ++i) telemetry_.reportLatency.record(now - out[i].hostTimeS);
+  }
   return popped;
+}
+
+double Device::nowS() const {
+  if (lockstep_) return lastPumpAtomicS_.load(std::memory_order_relaxed);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - startTime_).count();
 }
 
 bool Device::pushForceFrame(const ForceFrame& frame) { return frameQueue_.push(frame); }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -50,8 +51,12 @@ class Device {
   void pump(double nowS);
 
   // Audio side (one consumer / one producer thread): never allocate, lock or wait.
+  // popReports also measures, in realtime, how long each report waited in the queue.
   int popReports(MouseReport* out, int capacity);
   bool pushForceFrame(const ForceFrame& frame);
+  // The device clock: seconds since start() in realtime (steady clock, any thread, no lock);
+  // in lockstep the last pumped time.
+  double nowS() const;
 
   const DeviceSpec& spec() const { return spec_; }
   bool isLockstep() const { return lockstep_; }
@@ -88,6 +93,8 @@ class Device {
   double lastCommandS_ = 0.0;
   MouseReport pollBuffer_[kPollBatch];
 
+  std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
+  std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads
   std::thread thread_;
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> closed_{false};

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 namespace kf {
 
@@ -18,12 +19,16 @@ struct MouseReport {
   int32_t dyCounts = 0;
   uint32_t buttons = 0;  // bit i = button i + 1
   uint32_t flags = 0;    // ReportFlag bits
+  double hostTimeS = 0.0;  // set by Device: its clock when the device thread took the report
 };
 
 // One 1 ms frame: the mean force requested over it.
 struct ForceFrame {
   double timeS = 0.0;
   float forceN = 0.0f;
+  // The device clock (Device::nowS) when the frame's millisecond ended, as the audio side
+  // estimates it; NaN when unknown. Measures the force latency in realtime.
+  double endedHostS = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace kf

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "LatencyHistogram.hpp"
+
 namespace kf {
 
 struct TelemetrySnapshot {
@@ -19,6 +21,9 @@ struct TelemetrySnapshot {
   uint64_t watchdogTrips = 0;
   float lastCommandedForceN = 0.0f;
   uint64_t pumps = 0;
+  LatencySummary pumpPeriod;     // realtime: the 1 kHz loop's period
+  LatencySummary reportLatency;  // realtime: device thread takes a report -> a UGen takes it
+  LatencySummary forceLatency;   // realtime: a frame's millisecond ends -> the magnet is told
 };
 
 class Telemetry {
@@ -31,6 +36,11 @@ class Telemetry {
   }
   void countWatchdogTrip() { watchdogTrips_.fetch_add(1, std::memory_order_relaxed); }
   void countPump() { pumps_.fetch_add(1, std::memory_order_relaxed); }
+
+  // Each written by one thread: the device thread, the audio thread, the device thread.
+  LatencyHistogram pumpPeriod;
+  LatencyHistogram reportLatency;
+  LatencyHistogram forceLatency;
 
   // Queue overflow counts live in the queues; Device fills them in.
   TelemetrySnapshot snapshot() const;
@@ -80,6 +90,9 @@ inline TelemetrySnapshot Telemetry::snapshot() const {
   s.watchdogTrips = watchdogTrips_.load(std::memory_order_relaxed);
   s.lastCommandedForceN = lastCommandedForceN_.load(std::memory_order_relaxed);
   s.pumps = pumps_.load(std::memory_order_relaxed);
+  s.pumpPeriod = LatencySummary::of(pumpPeriod);
+  s.reportLatency = LatencySummary::of(reportLatency);
+  s.forceLatency = LatencySummary::of(forceLatency);
   return s;
 }
 

@@ -219,6 +219,14 @@ bool statusStage(World*, void* raw) {  // NRT
         static_cast<unsigned long long>(t.frames), t.lastCommandedForceN,
         static_cast<unsigned long long>(t.watchdogTrips), static_cast<unsigned long long>(t.reportQueueOverflows),
         static_cast<unsigned long long>(t.frameQueueOverflows));
+  auto line = [&](const char* what, const kf::LatencySummary& l) {
+    if (l.count > 0)
+      Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu)\n", data->index, what, l.p50S * 1e3,
+            l.p99S * 1e3, l.maxS * 1e3, static_cast<unsigned long long>(l.count));
+  };
+  line("loop period", t.pumpPeriod);
+  line("report to UGen", t.reportLatency);
+  line("force to magnet", t.forceLatency);
   return true;
 }
 

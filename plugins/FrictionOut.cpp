@@ -35,10 +35,14 @@ class FrictionOut : public SCUnit {
     mWarnedClosed = false;
     if (generation != mGeneration) attach(*device, generation);
 
-    struct PushFrames {
-      kf::Device* device;
-      void operator()(double frameTimeS, float forceN) { device->pushForceFrame(kf::ForceFrame{frameTimeS, forceN}); }
-    } sink{device};
+    // Each frame is stamped with the device-clock time its millisecond ended: now, less the
+    // audio time between the frame's end and the end of this block.
+    const double blockEndS = startS + numSamples / sampleRate();
+    const double deviceNowS = device->nowS();
+    const double framePeriodS = device->spec().forceFramePeriodS;
+    auto sink = [&](double frameTimeS, float forceN) {
+      device->pushForceFrame(kf::ForceFrame{frameTimeS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
+    };
     const double sampleDurS = 1.0 / sampleRate();
     if (isAudioRateIn(kForceN)) {
       mFramer.process(startS, sampleDurS, in(kForceN), numSamples, out(0), sink);

@@ -108,15 +108,23 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
       // FrictionOut
       uint32_t generation = 0;
       kf::Device* d = kf::sc::deviceOfSlot(2, startS, &generation);
-      auto sink = [d](double timeS, float f) { d->pushForceFrame(kf::ForceFrame{timeS, f}); };
+      auto sink = [d](double timeS, float f) { d->pushForceFrame(kf::ForceFrame{timeS, f, d->nowS()}); };
       framer.process(startS, kSampleDurS, forceN.data(), kBlock, commandedN.data(), sink);
     }
     std::this_thread::sleep_for(std::chrono::microseconds(1333));  // a block of real time
   }
   kf::sc::exchangeSlot(2, nullptr);
+  const kf::TelemetrySnapshot telemetry = device->telemetry();
   device.reset();
 
   CHECK(reportsSeen > 20);  // the device thread really delivered while we watched
   CHECK(gAllocations == 0);
   CHECK(gLocks == 0);
+  // The latencies were measured on the way (generous bounds: a shared, loaded machine).
+  CHECK(telemetry.pumpPeriod.count > 200);
+  CHECK(telemetry.pumpPeriod.p50S == Approx(0.001).margin(0.0005));
+  CHECK(telemetry.reportLatency.count == static_cast<uint64_t>(reportsSeen));
+  CHECK(telemetry.reportLatency.p50S < 0.02);
+  CHECK(telemetry.forceLatency.count > 200);
+  CHECK(telemetry.forceLatency.p50S < 0.02);
 }
