@@ -63,8 +63,10 @@ void Device::pumpLocked(double nowS) {
   while (frameQueue_.pop(frame)) {
     const float commandedN = safety_.applyFrame(frame, nowS);
     if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
-    // Lockstep: device and audio time are one clock, so the frame takes effect at its own
-    // time (never before an earlier command, never in the future). Realtime: now.
+    // Lockstep: device and audio time are one clock, so the frame is stamped with its own time
+    // (never before an earlier command, never in the future); a backend that has already
+    // passed that time (the sim, one block on) applies it at once, as a realtime device would.
+    // Realtime: now.
     double commandS = nowS;
     if (lockstep_ && std::isfinite(frame.timeS))
       commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);

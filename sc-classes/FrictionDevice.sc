@@ -2,16 +2,28 @@
 // or (later) hardware. Every command has a ...Msg twin that returns the OSC message, so the
 // same device can be used in a Score (pass server nil to only describe it).
 FrictionDevice {
-	classvar <paperSpecs;
+	classvar <paperSpecs, <settingNames;
 	var <server, <index, <specs, <kind, <source, <overrides;
 
 	*initClass {
-		paperSpecs = (
-			countMm: 0.021, updateRateHz: 125, maxCountsPerReport: 127, maxSpeed: 0.021 * 127 * 125,
-			minForceN: 0.14, maxForceN: 1.4, audioLatencyS: 0.0014, tactileLatencyS: 0.0024,
-			forceFramePeriodS: 0.001, maxForceSlewNPerS: 2000, watchdogS: 0.05, magnetLagS: 0.0024
+		// DESIGN.md's names for the device's numbers, and the device library's setting names
+		// (with their units) that profiles use; either may be given in a profile.
+		settingNames = (
+			countMm: \countMm, updateRate: \updateRateHz, maxCountsPerReport: \maxCountsPerReport,
+			minForce: \minForceN, maxForce: \maxForceN, audioLatency: \audioLatencyS,
+			tactileLatency: \tactileLatencyS, forceFramePeriod: \forceFramePeriodS,
+			maxForceSlew: \maxForceSlewNPerS, watchdog: \watchdogS, magnetLag: \magnetLagS
 		);
+		paperSpecs = (
+			countMm: 0.021, updateRate: 125, maxCountsPerReport: 127, minForce: 0.14, maxForce: 1.4,
+			audioLatency: 0.0014, tactileLatency: 0.0024, forceFramePeriod: 0.001, maxForceSlew: 2000,
+			watchdog: 0.05, magnetLag: 0.0024
+		);
+		paperSpecs[\maxSpeed] = this.maxSpeedOf(paperSpecs);
 	}
+
+	// counts x count size x update rate: 333.375 mm/s for the paper's device (the paper says 334).
+	*maxSpeedOf { |specs| ^specs[\countMm] * specs[\maxCountsPerReport] * specs[\updateRate] }
 
 	// hand: a FrictionHand (nil: the puck stays put). profile: an Event of spec or simulation
 	// settings by name (e.g. (maxForceN: 1.0, puckMassKg: 0.2)); nil: the paper's numbers.
@@ -33,7 +45,7 @@ FrictionDevice {
 	}
 
 	// Audio is delayed by this much so that sound and touch arrive together (the paper: 1 ms).
-	audioDelay { ^specs[\tactileLatencyS] - specs[\audioLatencyS] }
+	audioDelay { ^specs[\tactileLatency] - specs[\audioLatency] }
 
 	openMsg {
 		^if(kind == \sim) {
@@ -69,12 +81,14 @@ FrictionDevice {
 		index = argIndex;
 		kind = argKind;
 		source = argSource;
-		overrides = profile ? ();
-		overrides.keysValuesDo { |key, value|
-			if(value.isNumber.not) { Error("FrictionDevice: setting % must be a number, got %".format(key, value)).throw }
+		overrides = ();
+		(profile ? ()).keysValuesDo { |key, value|
+			if(value.isNumber.not) { Error("FrictionDevice: setting % must be a number, got %".format(key, value)).throw };
+			overrides[settingNames[key] ? key] = value;  // DESIGN names become setting names
 		};
-		specs = paperSpecs.copy.putAll(overrides.select { |v, k| paperSpecs.includesKey(k) });
-		specs[\maxSpeed] = specs[\countMm] * specs[\maxCountsPerReport] * specs[\updateRateHz];
+		specs = paperSpecs.copy;
+		settingNames.keysValuesDo { |name, setting| overrides[setting] !? { |v| specs[name] = v } };
+		specs[\maxSpeed] = this.class.maxSpeedOf(specs);
 	}
 
 	prOpen { this.prSend(this.openMsg) }

@@ -150,3 +150,19 @@ def test_bad_device_arguments_give_clear_errors():
     for text in ["times must ascend", "durations must be >= 0", "non-empty array", "index must be an Integer from 0 to 15",
                  "hand must be a FrictionHand", "must be a number", "interpolation must be 0", "device must be a slot index"]:
         assert text in out, text
+
+
+def test_specs_use_the_design_names_and_audio_delay_is_one_ms():
+    out = kfsc.run_sclang("""
+        var d = FrictionDevice.sim(nil, 0), e = FrictionDevice.sim(nil, 1, nil, (maxForce: 1.0, tactileLatencyS: 0.003));
+        [\\countMm, \\updateRate, \\maxSpeed, \\minForce, \\maxForce, \\audioLatency, \\tactileLatency].do { |k|
+            "SPEC % %".format(k, d.specs[k]).postln };
+        "DELAY %".format(d.audioDelay.round(1e-9)).postln;
+        "E % %".format(e.specs[\\maxForce], e.audioDelay.round(1e-9)).postln;
+        "EMSG %".format(e.openMsg).postln;
+    """)
+    for line in ["SPEC countMm 0.021", "SPEC updateRate 125", "SPEC maxSpeed 333.375", "SPEC minForce 0.14",
+                 "SPEC maxForce 1.4", "SPEC audioLatency 0.0014", "SPEC tactileLatency 0.0024", "DELAY 0.001",
+                 "E 1.0 0.0016"]:
+        assert line in out, line
+    assert "maxForceN, 1.0" in out and "tactileLatencyS, 0.003" in out, "profile names reach the server by setting name"

@@ -1,0 +1,305 @@
+// The paper's pilot interaction (section 3, Table 1): a 1D signal laid out on the surface is
+// read by the puck's position (FrictionMouseIn -> SpatialBufRd), heard (delayed by the
+// device's audioDelay so sound and touch arrive together) and felt (LoudnessToFriction ->
+// FrictionOut), on one device slot. Positions in mm, times in s, forces in N.
+FrictionPilot {
+	classvar <mappings, <signalFrames = 24000, <cycleFrames = 100;
+	classvar <paperLoForceN = 0.14, <paperHiForceN = 0.5, <paperAudioDelayS = 0.001;
+	classvar <recordChannelNames;
+
+	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
+	var <buffer, <synth, <defName;
+
+	*initClass {
+		// Table 1: samples per mm of the three mappings.
+		mappings = (mapping1: 4000, mapping2: 500, mapping3: 8);
+		// What the recording outputs carry, in this order, from recordBus on.
+		recordChannelNames = [\positionMm, \speedMmPerS, \audio, \delayedAudio, \requestedForceN, \commandedForceN];
+	}
+
+	// ---- the pilot signal and the mappings ----
+
+	// The pilot signal: a sine of amplitude 1, 240 cycles of 100 samples (24000 samples).
+	*signal {
+		^Signal.fill(signalFrames, { |i| sin(2pi * i / cycleFrames) })
+	}
+
+	// Loads the pilot signal into a new Buffer on server (any server: sent as /b_setn).
+	*loadSignal { |server, action|
+		server = server ? Server.default;
+		if(server.isKindOf(Server).not) { Error("FrictionPilot.loadSignal: server must be a Server, got %".format(server)).throw };
+		if(server.serverRunning.not) { Error("FrictionPilot.loadSignal: server % is not running".format(server)).throw };
+		^Buffer.sendCollection(server, this.signal, 1, 0, action)
+	}
+
+	// The OSC messages that put a signal (default: the pilot signal) into buffer bufnum, for a Score.
+	*loadSignalMsgs { |bufnum = 0, signal|
+		var msgs, chunk = 1024;
+		signal = signal ? this.signal;
+		this.prCheckBufnum(bufnum, "loadSignalMsgs");
+		if(signal.isSequenceableCollection.not or: { signal.isEmpty } or: { signal.any { |v| v.isNumber.not } }) {
+			Error("FrictionPilot.loadSignalMsgs: signal must be a non-empty array of numbers").throw
+		};
+		msgs = [['/b_alloc', bufnum, signal.size, 1]];
+		(0, chunk .. signal.size - 1).do { |start|
+			var part = signal.copyRange(start, min(start + chunk, signal.size) - 1);
+			msgs = msgs.add(['/b_setn', bufnum, start, part.size] ++ part.asArray)
+		};
+		^msgs
+	}
+
+	// Samples per mm of a mapping: a name of Table 1 (\mapping1, \mapping2, \mapping3) or any
+	// positive finite number of samples per mm.
+	*samplesPerMmOf { |mapping|
+		case
+		{ mapping.isKindOf(Symbol) or: { mapping.isString } } {
+			^mappings[mapping.asSymbol] ?? {
+				Error("FrictionPilot: unknown mapping %; use one of % or a number of samples per mm".format(
+					mapping.asSymbol.cs, mappings.keys.asArray.sort.collect(_.cs).join(", "))).throw
+			}
+		}
+		{ mapping.isNumber } {
+			if(mapping.isNaN or: { mapping.abs == inf } or: { mapping <= 0 }) {
+				Error("FrictionPilot: samplesPerMm must be a positive finite number, got %".format(mapping)).throw
+			};
+			^mapping.asFloat
+		}
+		{ Error("FrictionPilot: mapping must be a Symbol (e.g. \\mapping1) or samples per mm, got %".format(mapping)).throw }
+	}
+
+	// Table 1 computed from samples per mm: cycle width and fragment width (mm), and the audio
+	// frequency range (Hz) at the device's slowest and fastest speed (mm/s).
+	*table { |mapping = \mapping1, minSpeed = 2.6, maxSpeed = 334|
+		var spm = this.samplesPerMmOf(mapping);
+		^(
+			samplesPerMm: spm,
+			cycleWidthMm: cycleFrames / spm,
+			fragmentWidthMm: signalFrames / spm,
+			loHz: this.frequencyAt(minSpeed, spm),
+			hiHz: this.frequencyAt(maxSpeed, spm)
+		)
+	}
+
+	// The audio frequency (Hz) when the pilot signal is crossed at speed (mm/s).
+	*frequencyAt { |speedMmPerS, mapping = \mapping1|
+		^speedMmPerS.abs * this.samplesPerMmOf(mapping) / cycleFrames
+	}
+
+	// ---- the ugen graph ----
+
+	// The mechanism as a ugen graph, for use inside any SynthDef. Returns an Event of audio-rate
+	// signals: position (mm), speed (mm/s), audio (as read), delayedAudio (what to play: audio *
+	// amp delayed by audioDelay), force (N, requested: loForceN + friction * (loudness mapping -
+	// loForceN)) and commandedForce (N, FrictionOut's output: the last completed 1 ms frame).
+	// friction 0 keeps the magnet at loForceN (use the device's minimum, 0.14 N for the paper).
+	// amp scales only what is heard; the force follows the signal as read (amplitude 1 = 0 dB).
+	*ar { |device = 0, bufnum = 0, samplesPerMm = 4000, origin = 0, friction = 1, amp = 1,
+		audioDelay = 0.001, loForceN = 0.14, hiForceN = 0.5, maxAudioDelay = 0.05|
+		var mouse, audio, loudness, force, commanded, delayed;
+		[\samplesPerMm, samplesPerMm, \origin, origin, \friction, friction, \amp, amp,
+			\loForceN, loForceN, \hiForceN, hiForceN].pairsDo { |name, value|
+			if(value.isNumber and: { value.isNaN or: { value.abs == inf } }) {
+				Error("FrictionPilot.ar: % must be finite, got %".format(name, value)).throw
+			}
+		};
+		if(samplesPerMm.isNumber and: { samplesPerMm <= 0 }) {
+			Error("FrictionPilot.ar: samplesPerMm must be > 0, got %".format(samplesPerMm)).throw
+		};
+		if(maxAudioDelay.isNumber.not or: { maxAudioDelay <= 0 }) {
+			Error("FrictionPilot.ar: maxAudioDelay is fixed at build time and must be a number > 0 s, got %".format(maxAudioDelay)).throw
+		};
+		if(audioDelay.isNumber and: { audioDelay < 0 or: { audioDelay > maxAudioDelay } }) {
+			Error("FrictionPilot.ar: audioDelay must be within [0, %] s, got %".format(maxAudioDelay, audioDelay)).throw
+		};
+		mouse = FrictionMouseIn.ar(device, 0, 1);
+		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4);
+		// Equations (1) and (2): 1 ms mean |a| -> dB -> [-30, 0] dB onto [lo, hi] N.
+		loudness = LoudnessToFriction.ar(audio, 0.001, -30, 0, loForceN, hiForceN, 1);
+		force = loForceN + (friction.clip(0, 1) * (loudness - loForceN));
+		commanded = FrictionOut.ar(device, force);
+		// Audio latency 1.4 ms, tactile 2.4 ms: audio waits the difference (1 ms).
+		delayed = DelayL.ar(audio * amp, maxAudioDelay, audioDelay);
+		^(position: mouse[0], speed: mouse[2], audio: audio, delayedAudio: delayed,
+			force: force, commandedForce: commanded)
+	}
+
+	// A SynthDef of the pilot for device (a FrictionDevice or a slot index). Controls: device,
+	// bufnum, samplesPerMm, origin (mm), friction (0 off .. 1 on), amp, out (stereo), audioDelay
+	// (s, default the device's), and with record: true, recordBus: 6 audio channels from there
+	// (see recordChannelNames).
+	*synthDef { |name = \frictionPilot, device = 0, record = false, loForceN, hiForceN|
+		var index = this.prDeviceIndex(device, "synthDef");
+		var delay = this.prAudioDelay(device);
+		var lo = loForceN ?? { this.prMinForce(device) };
+		var hi = hiForceN ? paperHiForceN;
+		if(name.isKindOf(Symbol).not and: { name.isString.not }) {
+			Error("FrictionPilot.synthDef: name must be a Symbol, got %".format(name)).throw
+		};
+		if(record != true and: { record != false }) {
+			Error("FrictionPilot.synthDef: record must be true or false, got %".format(record)).throw
+		};
+		[\loForceN, lo, \hiForceN, hi].pairsDo { |key, value|
+			if(value.isNumber.not or: { value.isNaN } or: { value.abs == inf }) {
+				Error("FrictionPilot.synthDef: % must be a finite number (N), got %".format(key, value)).throw
+			}
+		};
+		if(hi <= lo) { Error("FrictionPilot.synthDef: hiForceN (%) must be above loForceN (%)".format(hi, lo)).throw };
+		^SynthDef(name.asSymbol, {
+			var p = this.ar(\device.kr(index), \bufnum.kr(0), \samplesPerMm.kr(4000), \origin.kr(0),
+				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay));
+			Out.ar(\out.kr(0), p[\delayedAudio] ! 2);
+			if(record) {
+				Out.ar(\recordBus.kr(2), [\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
+			};
+		})
+	}
+
+	// ---- Scores (NRT) ----
+
+	// A Score that renders the pilot for device (a FrictionDevice, usually FrictionDevice.sim(nil,
+	// index, hand) or .replay(nil, path)): opens it, loads the signal, plays the pilot with
+	// mapping (a name of Table 1 or samples per mm) and friction (0 off, 1 on) for duration s,
+	// then closes the device. Output channels 0, 1: the delayed audio (times amp); with
+	// recordBus (e.g. 2), 6 more channels (recordChannelNames). recordPath: also write a
+	// kf-session recording of the device. duration nil: the hand script's duration + 0.5 s.
+	*score { |device, mapping = \mapping1, friction = 1, duration, origin = 0, amp = 1,
+		recordBus, recordPath, bufnum = 0, signal, nodeID = 1000|
+		var spm = this.samplesPerMmOf(mapping), def, msgs;
+		if(device.isKindOf(FrictionDevice).not) {
+			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.sim(nil, 0, hand)), got %".format(device)).throw
+		};
+		duration = duration ?? {
+			if(device.kind == \sim and: { device.source.notNil }) { device.source.duration + 0.5 } {
+				Error("FrictionPilot.score: give a duration (s) for %".format(device)).throw
+			}
+		};
+		if(duration.isNumber.not or: { duration.isNaN } or: { duration <= 0 } or: { duration == inf }) {
+			Error("FrictionPilot.score: duration must be a positive finite number (s), got %".format(duration)).throw
+		};
+		this.prCheckFriction(friction, "score");
+		this.prCheckFinite(origin, "origin", "score");
+		this.prCheckFinite(amp, "amp", "score");
+		if(recordBus.notNil and: { recordBus.isInteger.not or: { recordBus < 2 } }) {
+			Error("FrictionPilot.score: recordBus must be nil or an Integer >= 2 (0 and 1 carry the audio), got %".format(recordBus)).throw
+		};
+		if(recordPath.notNil and: { recordPath.isString.not }) {
+			Error("FrictionPilot.score: recordPath must be nil or a String, got %".format(recordPath)).throw
+		};
+		def = this.synthDef(\frictionPilot, device, recordBus.notNil);
+		msgs = [[0.0, device.openMsg]];
+		if(recordPath.notNil) { msgs = msgs.add([0.0, device.recordMsg(recordPath)]) };
+		msgs = msgs ++ this.loadSignalMsgs(bufnum, signal).collect { |m| [0.0, m] };
+		msgs = msgs.add([0.0, ['/d_recv', def.asBytes]]);
+		msgs = msgs.add([0.0, ['/s_new', \frictionPilot, nodeID, 0, 0,
+			\bufnum, bufnum, \samplesPerMm, spm, \origin, origin, \friction, friction, \amp, amp]
+			++ (recordBus !? { [\recordBus, recordBus] } ? [])]);
+		if(recordPath.notNil) { msgs = msgs.add([duration, device.stopRecordingMsg]) };
+		msgs = msgs.add([duration, ['/n_free', nodeID]]);
+		msgs = msgs.add([duration, device.closeMsg]);
+		^Score(msgs)
+	}
+
+	// Switching a running pilot: the OSC messages for a node (Score or realtime).
+	*setMappingMsg { |nodeID, mapping| ^['/n_set', nodeID, \samplesPerMm, this.samplesPerMmOf(mapping)] }
+	*setFrictionMsg { |nodeID, on| ^['/n_set', nodeID, \friction, this.prCheckFriction(on, "setFrictionMsg")] }
+
+	// ---- realtime ----
+
+	// A pilot on a running server: FrictionPilot(device).play; then .mapping_(\mapping2),
+	// .friction_(0), .free. device: a FrictionDevice (its server is used) or a slot index (on
+	// Server.default).
+	*new { |device, mapping = \mapping1, friction = 1, origin = 0, amp = 0.5, out = 0|
+		^super.new.prInit(device, mapping, friction, origin, amp, out)
+	}
+
+	server { ^if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default } }
+
+	play {
+		var server = this.server;
+		if(server.serverRunning.not) { Error("FrictionPilot.play: server % is not running".format(server)).throw };
+		if(synth.notNil) { ^this };
+		defName = ("frictionPilot" ++ this.class.prDeviceIndex(device, "play")).asSymbol;
+		forkIfNeeded {
+			buffer = buffer ?? { this.class.loadSignal(server) };
+			this.class.synthDef(defName, device).add;
+			server.sync;
+			synth = Synth(defName, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm, \origin, origin,
+				\friction, friction, \amp, amp, \out, out], server);
+		};
+	}
+
+	mapping_ { |newMapping|
+		samplesPerMm = this.class.samplesPerMmOf(newMapping);
+		mapping = newMapping;
+		synth !? { synth.set(\samplesPerMm, samplesPerMm) }
+	}
+
+	friction_ { |on|
+		friction = this.class.prCheckFriction(on, "friction_");
+		synth !? { synth.set(\friction, friction) }
+	}
+
+	origin_ { |mm| origin = this.class.prCheckFinite(mm, "origin", "origin_"); synth !? { synth.set(\origin, origin) } }
+	amp_ { |value| amp = this.class.prCheckFinite(value, "amp", "amp_"); synth !? { synth.set(\amp, amp) } }
+
+	free {
+		synth !? { synth.free };
+		synth = nil;
+		buffer !? { buffer.free };
+		buffer = nil;
+	}
+
+	printOn { |stream| stream << this.class.name << "(" << device << ", " << mapping.cs << ", friction: " << friction << ")" }
+
+	prInit { |argDevice, argMapping, argFriction, argOrigin, argAmp, argOut|
+		this.class.prDeviceIndex(argDevice, "new");
+		device = argDevice;
+		samplesPerMm = this.class.samplesPerMmOf(argMapping);
+		mapping = argMapping;
+		friction = this.class.prCheckFriction(argFriction, "new");
+		origin = this.class.prCheckFinite(argOrigin, "origin", "new");
+		amp = this.class.prCheckFinite(argAmp, "amp", "new");
+		if(argOut.isInteger.not or: { argOut < 0 }) { Error("FrictionPilot.new: out must be a bus index (Integer >= 0), got %".format(argOut)).throw };
+		out = argOut;
+	}
+
+	// ---- checks ----
+
+	*prDeviceIndex { |device, method|
+		^case
+		{ device.isKindOf(FrictionDevice) } { device.index }
+		{ device.isInteger and: { device >= 0 } } { device }
+		{ Error("FrictionPilot.%: device must be a FrictionDevice or a slot index (Integer >= 0), got %".format(method, device)).throw }
+	}
+
+	*prAudioDelay { |device|
+		^if(device.isKindOf(FrictionDevice)) { device.audioDelay } { paperAudioDelayS }
+	}
+
+	*prMinForce { |device|
+		^if(device.isKindOf(FrictionDevice)) { device.specs[\minForce] } { paperLoForceN }
+	}
+
+	*prCheckFriction { |on, method|
+		if(on == true) { ^1 };
+		if(on == false) { ^0 };
+		if(on.isNumber.not or: { on.isNaN } or: { on < 0 } or: { on > 1 }) {
+			Error("FrictionPilot.%: friction must be 0 (off), 1 (on), a Boolean or a number in between, got %".format(method, on)).throw
+		};
+		^on
+	}
+
+	*prCheckFinite { |value, name, method|
+		if(value.isNumber.not or: { value.isNaN } or: { value.abs == inf }) {
+			Error("FrictionPilot.%: % must be a finite number, got %".format(method, name, value)).throw
+		};
+		^value
+	}
+
+	*prCheckBufnum { |bufnum, method|
+		if(bufnum.isInteger.not or: { bufnum < 0 }) {
+			Error("FrictionPilot.%: bufnum must be an Integer >= 0, got %".format(method, bufnum)).throw
+		};
+		^bufnum
+	}
+}
