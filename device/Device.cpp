@@ -93,6 +93,7 @@ void Device::pumpLocked(double nowS) {
     }
   } while (polled == kPollBatch);
 
+  recorder_.flush();
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();

@@ -92,6 +92,10 @@ void Recorder::writeOff(double hostTimeS) {
   std::fprintf(file_, "O %.17g\n", hostTimeS);
 }
 
+void Recorder::flush() {
+  if (file_) std::fflush(file_);
+}
+
 void Recorder::close() {
   if (file_) std::fclose(file_);
   file_ = nullptr;

@@ -45,6 +45,9 @@ class Recorder {
   void writeReport(double hostTimeS, const MouseReport& report);
   void writeFrame(double hostTimeS, const ForceFrame& frame, float commandedForceN);
   void writeOff(double hostTimeS);
+  // Hands what was written to the OS, so that a reader opening the file now (a replay of a
+  // session still being recorded) sees every record up to here.
+  void flush();
   void close();
   bool isOpen() const { return file_ != nullptr; }
 

@@ -178,6 +178,22 @@ void openReplayCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 
 // --- kfRecord, kfStatus --------------------------------------------------------------------
 
+// Commands that act on the device a slot holds look it up in an RT stage that follows an NRT
+// stage: an open sent just before has published its device by then (stages run in order).
+bool nrtHop(World*, void*) { return true; }
+
+bool lookUpDeviceStage(World*, void* raw) {  // RT
+  auto* data = static_cast<CommandData*>(raw);
+  data->device = kf::sc::peekSlot(data->index);
+  return true;
+}
+
+bool unpublishStage(World*, void* raw) {  // RT
+  auto* data = static_cast<CommandData*>(raw);
+  data->previous = kf::sc::exchangeSlot(data->index, nullptr);
+  return true;
+}
+
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (data->device == nullptr) {
@@ -201,8 +217,7 @@ void recordCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   if (data == nullptr) return;
   copyString(data->path, args->gets(""), kMaxPathChars);
   if (!checkSlot(world, data)) return freeCommand(world, data);
-  data->device = kf::sc::peekSlot(data->index);
-  run(world, replyAddr, data, recordStage, nullptr, nullptr);
+  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, recordStage);
 }
 
 bool statusStage(World*, void* raw) {  // NRT
@@ -234,8 +249,7 @@ void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   CommandData* data = newCommand(world, "kfStatus", args);
   if (data == nullptr) return;
   if (!checkSlot(world, data)) return freeCommand(world, data);
-  data->device = kf::sc::peekSlot(data->index);
-  run(world, replyAddr, data, statusStage, nullptr, nullptr);
+  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, statusStage);
 }
 
 // --- kfClose -------------------------------------------------------------------------------
@@ -244,9 +258,9 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   CommandData* data = newCommand(world, "kfClose", args);
   if (data == nullptr) return;
   if (!checkSlot(world, data)) return freeCommand(world, data);
-  // Unpublished here, in the RT thread between blocks: no UGen sees it from the next block on.
-  data->previous = kf::sc::exchangeSlot(data->index, nullptr);
-  run(world, replyAddr, data, deletePreviousStage, nullptr, nullptr);
+  // Unpublished in the RT stage, between blocks (no UGen sees it from the next block on), after
+  // an NRT hop so that an open sent just before is closed too; deleted in the last NRT stage.
+  run(world, replyAddr, data, nrtHop, unpublishStage, deletePreviousStage);
 }
 
 }  // namespace

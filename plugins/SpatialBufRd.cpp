@@ -37,14 +37,10 @@ class SpatialBufRd : public SCUnit {
     const double samplesPerMm = in0(kSamplesPerMm);
     const double originMm = in0(kOriginMm);
     const auto interpolation = kf::interpolationFromCode(static_cast<int>(in0(kInterpolation)));
-    const float* positionMm = in(kPositionMm);
-    const bool positionIsAudio = isAudioRateIn(kPositionMm);
-    // Sample-major: an output buffer may share memory with the position input, so each
-    // position is read before any channel of that sample is written.
-    for (int i = 0; i < numSamples; ++i) {
-      const double index = kf::spatialIndex(positionMm[positionIsAudio ? i : 0], originMm, samplesPerMm);
-      for (int c = 0; c < numChannels; ++c) out(c)[i] = kf::readSpatial(signal, c, index, interpolation);
-    }
+    // One call per block: indices for the whole block first, then the taps (see
+    // readSpatialBlock), so an output buffer may share memory with the position input.
+    kf::readSpatialBlock(signal, in(kPositionMm), isAudioRateIn(kPositionMm) ? 1 : 0, originMm, samplesPerMm,
+                         interpolation, mOutBuf, numSamples);
   }
 
   // The buffer for the bufnum input, global or local to the synth, or nullptr; looked up every

@@ -1,0 +1,250 @@
+"""Realtime scenes: sclang boots scsynth against jackd -d dummy, opens a device on the device
+thread (realtime, not lockstep) and sees the puck move and the force arrive.
+
+The simulated device runs on the wall clock, so the bounds are loose; the recording (the device
+thread's own clock) carries the exact numbers.
+"""
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rt
+
+HID_FILE = rt.SHARED_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+COUNT_MM = 0.021
+FORCE_N = 0.4
+
+# Posts "KF-POS t x y speedX speedY" 50 times a second; t: seconds since `~t0`.
+POS_LISTENER = r"""
+~t0 = Main.elapsedTime;
+~posLog = List.new;
+OSCdef(\kfPos, { |msg| ~posLog.add([Main.elapsedTime - ~t0] ++ msg[3..6]) }, '/kfPos');
+SynthDef(\kfPos, { |device = 0|
+	SendReply.kr(Impulse.kr(50), '/kfPos', FrictionMouseIn.kr(device));
+}).add;
+SynthDef(\kfForce, { |device = 0, force = 0.4|
+	var commanded = FrictionOut.ar(device, DC.ar(force));
+	SendReply.kr(Impulse.kr(20), '/kfForce', A2K.kr(commanded));
+}).add;
+~forceLog = List.new;
+OSCdef(\kfForce, { |msg| ~forceLog.add([Main.elapsedTime - ~t0, msg[3]]) }, '/kfForce');
+s.sync;
+"""
+
+POS_DUMP = r"""
+~posLog.do { |row| ("KF-POS " ++ row.collect { |v| v.asStringPrec(10) }.join(" ")).postln };
+~forceLog.do { |row| ("KF-FORCE " ++ row.collect { |v| v.asStringPrec(10) }.join(" ")).postln };
+"""
+
+
+def positions(run):
+    rows = np.array([[float(v) for v in r] for r in run.lines("KF-POS ")])
+    assert rows.ndim == 2 and rows.shape[1] == 5, f"no position replies:\n{run.output[-3000:]}"
+    return rows
+
+
+@pytest.fixture
+def jack():
+    with rt.JackServer() as server:
+        yield server
+
+
+def test_sim_device_moves_the_puck_and_receives_the_force(jack):
+    record = rt.WORK_DIR / "sim-session.txt"
+    record.unlink(missing_ok=True)
+    run = rt.require_ok(rt.run_sclang("var dev, pos, force;\n" + POS_LISTENER + f"""
+        pos = Synth(\\kfPos, [\\device, 0]);
+        force = Synth(\\kfForce, [\\device, 0, \\force, {FORCE_N}]);
+        s.sync;
+        ~t0 = Main.elapsedTime;
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[50, 1.5]]));
+        s.sync;  // kfRecord right after kfOpenSim does not find the device yet (see below)
+        dev.record({rt.sc_string(record)});
+        s.sync;
+        "KF-OPENED %".format(Main.elapsedTime - ~t0).postln;
+        2.5.wait;
+        // Frames stop: the watchdog must drive the magnet off ~50 ms later.
+        "KF-FREE-FORCE %".format(Main.elapsedTime - ~t0).postln;
+        force.free;
+        0.5.wait;
+        dev.status;
+        s.sync;
+        "KF-CLOSING %".format(Main.elapsedTime - ~t0).postln;
+        dev.close;
+        s.sync;
+        0.2.wait;
+        pos.free;
+        {POS_DUMP}
+    """, jack, name="sim"))
+
+    # --- what sclang saw on the control buses
+    rows = positions(run)
+    freed_t = float(run.lines("KF-FREE-FORCE ")[0][0])
+    closed_t = float(run.lines("KF-CLOSING ")[0][0])
+    rows = rows[rows[:, 0] < closed_t - 0.05]  # a closed slot reads 0
+    t, x, y, speed_x = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
+    during = (t > 0.6) & (t < 1.4)
+    assert during.sum() >= 10, f"too few position replies during the push: {during.sum()}"
+    # The target moves at 50 mm/s; the puck follows it (speed quantized to 2.625 mm/s steps).
+    assert 40 <= np.median(speed_x[during]) <= 60, f"speed {np.median(speed_x[during])} mm/s"
+    slope = np.polyfit(t[during], x[during], 1)[0]
+    assert 35 <= slope <= 65, f"x grows at {slope} mm/s"
+    # The script ends at 75 mm (1.5 s). The hand is a spring of 20 N/m: with 0.4 N of friction
+    # the puck comes to rest up to 20 mm short of the target...
+    held = (t > 2.0) & (t < freed_t)
+    assert held.sum() >= 5
+    rest_x = np.median(x[held])
+    assert 53 <= rest_x <= 75, f"rest x {rest_x} mm with {FORCE_N} N"
+    assert np.all(np.abs(speed_x[held]) < 3), "the puck should rest after the script"
+    # ... and when the frames stop, the watchdog turns the magnet off (0.14 N): the spring pulls
+    # the puck on, to within 7 mm of the target. So the force really arrived at the puck.
+    final_x = x[-1]
+    assert 67 <= final_x <= 75 and final_x > rest_x + 3, f"x {rest_x} -> {final_x} mm after magnet off"
+    assert np.all(np.diff(x) > -0.05), "x went backwards"
+    assert np.all(np.abs(y) < 1e-6), "y moved"
+
+    forces = np.array([[float(v) for v in r] for r in run.lines("KF-FORCE ")])
+    assert len(forces) >= 10
+    settled = forces[(forces[:, 0] > 0.5) & (forces[:, 0] < 2.4), 1]
+    assert len(settled) >= 10 and np.allclose(settled, FORCE_N, atol=1e-6), settled
+
+    # --- the recording: reports, frames at the commanded force, magnet off after the frames stop
+    header, records = rt.read_session(record)
+    assert float(header["countMm"]) == pytest.approx(COUNT_MM)
+    reports = [f for tag, f in records if tag == "R"]
+    frames = [f for tag, f in records if tag == "F"]
+    offs = [f[0] for tag, f in records if tag == "O"]
+    assert len(reports) >= 100, f"{len(reports)} reports recorded"
+    assert len(frames) >= 1000, f"{len(frames)} force frames recorded"
+    requested = np.array([f[2] for f in frames])
+    commanded = np.array([f[3] for f in frames])
+    assert np.allclose(requested, FORCE_N, atol=1e-6)
+    assert np.allclose(commanded, FORCE_N, atol=1e-6), "commanded force differs from 0.4 N"
+
+    # The reports come at 125 Hz (device thread clock) and add up to the position sclang saw.
+    report_t = np.array([r[0] for r in reports])
+    interval = np.median(np.diff(report_t))
+    assert interval == pytest.approx(0.008, abs=0.001), f"report interval {interval}"
+    dx_mm = np.cumsum([r[2] for r in reports]) * COUNT_MM
+    in_push = (report_t > 0.5) & (report_t < 1.3)
+    record_slope = np.polyfit(report_t[in_push], dx_mm[in_push], 1)[0]
+    assert record_slope == pytest.approx(50, abs=5), f"recorded speed {record_slope} mm/s"
+    # The recording started a moment after the open, so it misses the first reports at most.
+    assert 0 <= x[-1] - dx_mm[-1] < 3, f"bus x {x[-1]} vs recorded {dx_mm[-1]}"
+    assert max(r[2] for r in reports) <= 127 and all(r[5] == 0 for r in reports)
+
+    # Watchdog: after the last frame, the magnet goes off 50 ms later (device clock), before
+    # the close. On a loaded machine the device thread may wake late: allow 200 ms.
+    last_frame_t = frames[-1][0]
+    later_offs = [o for o in offs if o > last_frame_t]
+    assert len(later_offs) >= 2, f"expected a watchdog O line and a close O line, got {offs}"
+    watchdog_delay = later_offs[0] - last_frame_t
+    assert 0.049 <= watchdog_delay <= 0.2, f"watchdog tripped {watchdog_delay * 1e3:.1f} ms after the last frame"
+    # ... and the close writes the last line, an O.
+    assert records[-1][0] == "O"
+    status = [line for line in run.output.splitlines() if line.startswith("kfStatus 0:")]
+    assert status and "realtime" in status[0], run.output[-3000:]
+    trips = int(status[0].split("watchdog trips ")[1].split()[0].rstrip(","))
+    assert trips >= 1
+
+
+def hid_track():
+    """(times, x mm, y mm) after each report of the hid file, computed independently."""
+    times, xs, ys = [], [], []
+    x = y = 0
+    for line in HID_FILE.read_text().splitlines():
+        if not line.startswith("E:"):
+            continue
+        fields = line.split()
+        report = bytes(int(h, 16) for h in fields[3:])
+        if report[0] != 1:
+            continue
+        dx, dy = struct.unpack("<hh", report[2:6])
+        x += dx
+        y += dy
+        times.append(float(fields[1]))
+        xs.append(x * COUNT_MM)
+        ys.append(y * COUNT_MM)
+    return np.array(times), np.array(xs), np.array(ys)
+
+
+@pytest.mark.skipif(not HID_FILE.exists(), reason=f"no recorded mouse at {HID_FILE} (set KF_SHARED_DATA_DIR)")
+def test_replay_of_a_hid_recording_moves_the_puck(jack):
+    track_t, track_x, track_y = hid_track()
+    duration = track_t[-1]
+    run = rt.require_ok(rt.run_sclang("var dev, pos;\n" + POS_LISTENER + f"""
+        pos = Synth(\\kfPos, [\\device, 2]);
+        s.sync;
+        ~t0 = Main.elapsedTime;
+        dev = FrictionDevice.replay(s, {rt.sc_string(HID_FILE)}, 2);
+        s.sync;
+        {duration + 1.0}.wait;
+        dev.close;
+        s.sync;
+        pos.free;
+        {POS_DUMP}
+    """, jack, name="replay", timeout=150))
+    rows = positions(run)
+    x, y = rows[:, 1], rows[:, 2]
+    # The whole file was replayed: the final position is the sum of its counts.
+    assert x[-1] == pytest.approx(track_x[-1], abs=1e-4)
+    assert y[-1] == pytest.approx(track_y[-1], abs=1e-4)
+    # ... and the puck moved on the way: at 50 Hz sampling, most of the file's excursion shows.
+    assert np.ptp(x) >= 0.7 * np.ptp(track_x), (np.ptp(x), np.ptp(track_x))
+    assert np.ptp(y) >= 0.7 * np.ptp(track_y), (np.ptp(y), np.ptp(track_y))
+    assert len(np.unique(np.round(x, 4))) >= 10, "x barely changed"
+    # Realtime: the file plays on the wall clock, not all at once. Half-way through, the
+    # position is the file's position near that time (sampled values, a generous window).
+    t = rows[:, 0]
+    mid = np.argmin(np.abs(t - duration / 2))
+    near = (track_t > t[mid] - 1.0) & (track_t < t[mid] + 1.0)
+    assert track_x[near].min() - 0.05 <= x[mid] <= track_x[near].max() + 0.05, (t[mid], x[mid])
+
+
+def test_quitting_the_server_turns_the_magnet_off(jack):
+    record = rt.WORK_DIR / "quit-session.txt"
+    record.unlink(missing_ok=True)
+    run = rt.require_ok(rt.run_sclang(f"""
+        var dev;
+        SynthDef(\\kfForceOnly, {{ FrictionOut.ar(3, DC.ar({FORCE_N})) }}).add;
+        s.sync;
+        dev = FrictionDevice.sim(s, 3, FrictionHand.speeds([[20, 5]]));
+        s.sync;
+        dev.record({rt.sc_string(record)});
+        s.sync;
+        Synth(\\kfForceOnly);
+        s.sync;
+        1.0.wait;
+        "KF-QUITTING".postln;
+        // The device stays open; quitting the server must close it.
+        s.quit;
+        50.do {{ if(s.serverRunning) {{ 0.1.wait }} }};
+    """, jack, name="quit"))
+    assert "exited with exit code 0" in run.output, run.output[-3000:]
+    assert run.scsynth_pid and rt.wait_pid_gone(run.scsynth_pid, 5)
+    header, records = rt.read_session(record)
+    frames = [f for tag, f in records if tag == "F"]
+    assert len(frames) >= 300, f"{len(frames)} frames before the quit"
+    assert np.allclose([f[3] for f in frames], FORCE_N, atol=1e-6)
+    assert records[-1][0] == "O", f"the last record is {records[-1]}, not the magnet off"
+    assert records[-1][1][0] >= frames[-1][0]
+
+
+def test_record_right_after_open(jack):
+    """`FrictionDevice.sim(s, ...).record(path)` in one go, as a user writes it."""
+    record = rt.WORK_DIR / "open-then-record.txt"
+    record.unlink(missing_ok=True)
+    run = rt.require_ok(rt.run_sclang(f"""
+        var dev = FrictionDevice.sim(s, 4, FrictionHand.speeds([[50, 1]]));
+        dev.record({rt.sc_string(record)});
+        dev.status;
+        0.5.wait;
+        dev.close;
+        s.sync;
+    """, jack, name="open-record"))
+    assert "kfRecord: no device is open" not in run.output
+    assert "kfStatus 4: closed" not in run.output
+    header, records = rt.read_session(record)
+    assert any(tag == "R" for tag, _ in records)
