@@ -10,7 +10,7 @@
 #include <cmath>
 #include <ctime>
 
-static InterfaceTable* ft;
+InterfaceTable* ft;
 
 namespace {
 

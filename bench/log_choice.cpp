@@ -62,10 +62,12 @@ inline float fastLog2Poly(float x) {
   const float t = m - 1.f;
   float p;
   if constexpr (Degree == 5)
-    p = 1.44270180f + t * (-0.72120847f + t * (0.47979388f + t * (-0.36641326f + t * (0.31840712f + t * -0.20685812f))));
+    p = 1.44270180f +
+        t * (-0.72120847f + t * (0.47979388f + t * (-0.36641326f + t * (0.31840712f + t * -0.20685812f))));
   else
     p = 1.44269643f +
-        t * (-0.72136404f + t * (0.48062915f + t * (-0.35935065f + t * (0.29563360f + t * (-0.26950627f + t * 0.17212873f)))));
+        t * (-0.72136404f +
+             t * (0.48062915f + t * (-0.35935065f + t * (0.29563360f + t * (-0.26950627f + t * 0.17212873f)))));
   return e + t * p;
 }
 
@@ -166,11 +168,12 @@ int main() {
   std::vector<float> coreOut(samples);
 
   std::printf("%-38s %12s %12s %14s %14s\n", "log variant", "map ns/value", "core ns/samp", "worst err N", "rms err N");
-  const int coreRepeats = 7;
+  const int coreRepeats = 15;
   auto coreTime = [&](auto& core) {
-    return bestSecondsOf(coreRepeats, [&] {
-             for (int i = 0; i < samples; i += 64) core.process(input.data() + i, coreOut.data() + i, 64);
-           }) /
+    return bestSecondsOf(coreRepeats,
+                         [&] {
+                           for (int i = 0; i < samples; i += 64) core.process(input.data() + i, coreOut.data() + i, 64);
+                         }) /
            samples * 1e9;
   };
   auto run = [&](const char* name, auto force, auto core) {
@@ -181,20 +184,24 @@ int main() {
       sq += err * err;
     }
     const double rms = std::sqrt(sq / sweep);
-    const double mapNs = bestSecondsOf(5, [&] {
-                           for (int p = 0; p < passes; ++p) {
-                             for (int i = 0; i < block; ++i) blockOut[i] = force(blockAbs[i]);
-                             gSink = blockOut[p % block];
-                           }
-                         }) /
+    const double mapNs = bestSecondsOf(9,
+                                       [&] {
+                                         for (int p = 0; p < passes; ++p) {
+                                           for (int i = 0; i < block; ++i) blockOut[i] = force(blockAbs[i]);
+                                           gSink = blockOut[p % block];
+                                         }
+                                       }) /
                          (double(block) * passes) * 1e9;
     const double coreNs = coreTime(core);
     std::printf("%-38s %12.2f %12.2f %14.3g %14.3g\n", name, mapNs, coreNs, worst, rms);
-    std::printf("RESULT name=\"%s\" map_ns=%.4f core_ns=%.4f worst_n=%.6g rms_n=%.6g\n", name, mapNs, coreNs, worst, rms);
+    std::printf("RESULT name=\"%s\" map_ns=%.4f core_ns=%.4f worst_n=%.6g rms_n=%.6g\n", name, mapNs, coreNs, worst,
+                rms);
   };
-#define KF_VARIANT(NAME, F) run(NAME, [](double a) { return F(a); }, CoreCopy<F>(capacity, window))
-  KF_VARIANT("std::log10 (double, current)", forceLog10);
-  KF_VARIANT("std::log (double) * log10(e)", forceLn);
+#define KF_VARIANT(NAME, F) \
+  run(                      \
+      NAME, [](double a) { return F(a); }, CoreCopy<F>(capacity, window))
+  KF_VARIANT("std::log10 (double)", forceLog10);
+  KF_VARIANT("std::log (double) * log10(e), the exact path", forceLn);
   KF_VARIANT("std::log2 (double) * log10(2)", forceLog2);
   KF_VARIANT("log10f (float)", forceLog10f);
   KF_VARIANT("log2f (float) * log10(2)", forceLog2f);
@@ -208,9 +215,11 @@ int main() {
   std::vector<float> history(capacity);
   kf::LoudnessToFriction real(history.data(), capacity);
   real.setWindowSamples(window);
-  const double realNs = bestSecondsOf(coreRepeats, [&] {
-                          for (int i = 0; i < samples; i += 64) real.process(input.data() + i, coreOut.data() + i, 64);
-                        }) /
+  const double realNs = bestSecondsOf(coreRepeats,
+                                      [&] {
+                                        for (int i = 0; i < samples; i += 64)
+                                          real.process(input.data() + i, coreOut.data() + i, 64);
+                                      }) /
                         samples * 1e9;
   std::printf("%-38s %12s %12.2f\n", "kf::LoudnessToFriction::process", "", realNs);
   std::printf("RESULT name=\"kf::LoudnessToFriction::process\" core_ns=%.4f\n", realNs);

@@ -2,12 +2,46 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace kf {
 
 namespace {
 
 inline bool isUsable(double v) { return std::isfinite(v); }
+
+constexpr double kLog10OfE = 0.43429448190325182765;
+constexpr double kLog10Of2 = 0.30102999566398119521;
+
+// log2 of a positive normal float: the exponent from the bits, the mantissa folded into
+// [sqrt(1/2), sqrt(2)), log2(1 + t) = t P(t) with P of degree 6 fitted (minimax, float
+// coefficients) on t in [-0.293, 0.415]. Worst error of the float evaluation, measured over the
+// whole range: 3.7e-7 (kFastLog2Error, with margin). Branch-free; the SSE2 version below does
+// the same operations four at a time.
+constexpr double kFastLog2Error = 4e-7;
+constexpr float kP0 = 1.4426996708f, kP1 = -0.7213758826f, kP2 = 0.4804650247f, kP3 = -0.3589618504f,
+                kP4 = 0.2972626686f, kP5 = -0.2726978362f, kP6 = 0.1706340909f;
+constexpr int32_t kSqrt2Bits = 0x3fb504f3;
+
+inline float fastLog2(float x) {
+  int32_t bits;
+  std::memcpy(&bits, &x, 4);
+  int32_t ex = (bits >> 23) - 127;
+  int32_t mbits = (bits & 0x007fffff) | 0x3f800000;
+  const int32_t big = mbits > kSqrt2Bits ? 1 : 0;  // mantissa above sqrt(2): halve it
+  mbits -= big << 23;
+  ex += big;
+  float m;
+  std::memcpy(&m, &mbits, 4);
+  const float t = m - 1.f;
+  const float p = kP0 + t * (kP1 + t * (kP2 + t * (kP3 + t * (kP4 + t * (kP5 + t * kP6)))));
+  return static_cast<float>(ex) + t * p;
+}
 
 }  // namespace
 
@@ -38,14 +72,31 @@ void LoudnessToFriction::setWindowSamples(int n) {
   resum();
 }
 
-void LoudnessToFriction::resum() {
-  double sum = 0.0;
-  int k = writeIndex_;
-  for (int i = 0; i < windowSamples_; ++i) {
-    k = (k == 0 ? capacity_ : k) - 1;
-    sum += history_[k];
+namespace {
+
+// Sum of count floats in double, in four independent chains (the adds pipeline).
+double sumOf(const float* x, int count) {
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    s0 += x[i];
+    s1 += x[i + 1];
+    s2 += x[i + 2];
+    s3 += x[i + 3];
   }
-  sum_ = sum;
+  for (; i < count; ++i) s0 += x[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
+}  // namespace
+
+void LoudnessToFriction::resum() {
+  // The window is the n values before writeIndex_: one run, or two where it wraps.
+  const int n = windowSamples_, w = writeIndex_;
+  if (n <= w)
+    sum_ = sumOf(history_ + w - n, n);
+  else
+    sum_ = sumOf(history_ + capacity_ - (n - w), n - w) + sumOf(history_, w);
 }
 
 void LoudnessToFriction::setMapping(const FrictionMapping& wanted) {
@@ -77,6 +128,24 @@ void LoudnessToFriction::setMapping(const FrictionMapping& wanted) {
     forcePerDb_ = (m.hiForceN - m.loForceN) / (m.hiDb - m.loDb);
     forceOffset_ = m.loForceN - m.loDb * forcePerDb_;
   }
+
+  // The fast path, on level = mean / ref: force = 20 log10(level) * forcePerDb + offset
+  // = log2(level) * (20 log10(2) forcePerDb) + offset. Taken only where a bound on its error
+  // (logarithm, float level and float arithmetic) stays within kMaxFastLogErrorN; a threshold
+  // (loDb == hiDb) or a steep or far-offset mapping keeps the exact path.
+  const double loLevel = std::pow(10.0, lowDb / 20.0), hiLevel = std::pow(10.0, highDb / 20.0);
+  const double forcePerLog2 = 20.0 * kLog10Of2 * forcePerDb_;
+  const double maxLog2 = std::max({1.0, std::fabs(std::log2(loLevel)), std::fabs(std::log2(hiLevel))});
+  const double maxForce = std::max({std::fabs(m.loForceN), std::fabs(m.hiForceN), std::fabs(forceOffset_)});
+  // log2 error: the polynomial, the float level (2^-24 relative), the float sum e + t P
+  // (half an ulp of maxLog2); then the float product and sum (an ulp of maxForce each).
+  const double log2Error = kFastLog2Error + 1.5 * 0x1p-24 + maxLog2 * 0x1p-23;
+  const double boundN = std::fabs(forcePerLog2) * log2Error + 2.0 * maxForce * 0x1p-23;
+  fastLog_ = m.hiDb != m.loDb && loLevel >= 1e-30 && hiLevel <= 1e30 && boundN <= kMaxFastLogErrorN;
+  loLevel_ = static_cast<float>(loLevel);
+  hiLevel_ = static_cast<float>(hiLevel);
+  forcePerLog2_ = static_cast<float>(forcePerLog2);
+  forceAtLog2Zero_ = static_cast<float>(forceOffset_);
 }
 
 inline float LoudnessToFriction::sanitizedAbs(float a) const {
@@ -90,7 +159,8 @@ inline float LoudnessToFriction::mapMeanAbs(double meanAbs) const {
   if (meanAbs >= hiAbs_) return forceAtHiAbs_;
   if (meanAbs <= loAbs_) return forceAtLoAbs_;
   // Equation (2) inside the clip range: 20 log10(mean / ref) mapped linearly.
-  const double db = 20.0 * std::log10(meanAbs * invRef_);
+  // 20 log10(x) as 20 log10(e) ln(x): the same error, and glibc's log is much faster than log10.
+  const double db = (20.0 * kLog10OfE) * std::log(meanAbs * invRef_);
   return static_cast<float>(db * forcePerDb_ + forceOffset_);
 }
 
@@ -102,30 +172,164 @@ float LoudnessToFriction::peekForce(float a) const {
 }
 
 void LoudnessToFriction::process(const float* in, float* forceN, int numSamples) {
-  const int n = windowSamples_;
-  const double invN = 1.0 / n;
-  double sum = sum_;
-  int w = writeIndex_;
-  for (int i = 0; i < numSamples; ++i) {
-    // Equation (1) as a running sum: add the newest |a|, drop the one n samples back.
-    const float x = sanitizedAbs(in[i]);
-    int oldest = w - n;
-    if (oldest < 0) oldest += capacity_;
-    sum += static_cast<double>(x) - history_[oldest];
-    history_[w] = x;
-    if (++w == capacity_) {
-      w = 0;
-      writeIndex_ = 0;
-      sum_ = sum;
-      // Re-sum once per lap of the ring, so rounding cannot accumulate: the sum never carries
-      // more than capacity_ additions' worth of error, however long it runs.
-      resum();
-      sum = sum_;
+  for (int done = 0; done < numSamples; done += kPiece) {
+    const int count = std::min(kPiece, numSamples - done);
+    if (fastLog_) {
+      alignas(16) float levels[kPiece];
+      runningMeans(in + done, levels, invRef_ / windowSamples_, count);
+      mapFast(levels, forceN + done, count);
+    } else {
+      alignas(16) double means[kPiece];
+      runningMeans(in + done, means, 1.0 / windowSamples_, count);
+      mapExact(means, forceN + done, count);
     }
-    forceN[i] = mapMeanAbs(std::max(sum, 0.0) * invN);
+  }
+}
+
+// Equation (1) for a piece: the window's running sum, in double. The serial dependency is one
+// add per four samples: the differences (newest in, oldest out) are formed first, then summed
+// in groups of four whose prefix sums hang off the running sum. The ring is read and written
+// in contiguous runs, without a wrap test per sample.
+template <typename Mean>
+void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale, int count) {
+  const int n = windowSamples_, cap = capacity_;
+  float a[kPiece];
+  double diff[kPiece];
+#if defined(__SSE2__)
+  {
+    const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
+    int i = 0;
+    for (; i + 4 <= count; i += 4) {
+      const __m128 x = _mm_and_ps(_mm_loadu_ps(in + i), absMask);
+      // NaN -> 0 (an unordered compare is all zeros), then the clamp: Inf -> maxAbs.
+      _mm_storeu_ps(a + i, _mm_min_ps(_mm_and_ps(x, _mm_cmpord_ps(x, x)), maxAbs));
+    }
+    for (; i < count; ++i) a[i] = sanitizedAbs(in[i]);
+  }
+#else
+  for (int i = 0; i < count; ++i) a[i] = sanitizedAbs(in[i]);
+#endif
+
+  // The values leaving the window: from the ring for the first min(n, count) samples, from this
+  // piece after that.
+  const int fromRing = std::min(n, count);
+  int oldest = writeIndex_ - n;
+  if (oldest < 0) oldest += cap;
+  for (int i = 0; i < fromRing;) {
+    const int run = std::min(fromRing - i, cap - oldest);
+    const float* old = history_ + oldest;
+    for (int k = 0; k < run; ++k) diff[i + k] = static_cast<double>(a[i + k]) - old[k];
+    i += run;
+    oldest += run;
+    if (oldest == cap) oldest = 0;
+  }
+  for (int i = fromRing; i < count; ++i) diff[i] = static_cast<double>(a[i]) - a[i - n];
+
+  // Into the ring: only the last cap values matter when the piece is longer than the ring.
+  const int keep = std::min(count, cap);
+  int w = (writeIndex_ + (count - keep)) % cap;
+  for (int i = count - keep; i < count;) {
+    const int run = std::min(count - i, cap - w);
+    std::memcpy(history_ + w, a + i, sizeof(float) * run);
+    i += run;
+    w += run;
+    if (w == cap) w = 0;
+  }
+  writeIndex_ = w;
+
+  double sum = sum_;
+  int i = 0;
+#if defined(__SSE2__)
+  {
+    // Four at a time: prefix sums of the four differences in two double pairs, each added to the
+    // running sum, which then moves on by the group's total.
+    const __m128d zero = _mm_setzero_pd(), vScale = _mm_set1_pd(scale);
+    __m128d s = _mm_set1_pd(sum);
+    for (; i + 4 <= count; i += 4) {
+      __m128d d01 = _mm_loadu_pd(diff + i), d23 = _mm_loadu_pd(diff + i + 2);
+      d01 = _mm_add_pd(d01, _mm_unpacklo_pd(zero, d01));  // (d0, d0 + d1)
+      d23 = _mm_add_pd(d23, _mm_unpacklo_pd(zero, d23));  // (d2, d2 + d3)
+      d23 = _mm_add_pd(d23, _mm_unpackhi_pd(d01, d01));   // (d0 + d1 + d2, d0 + .. + d3)
+      const __m128d m01 = _mm_mul_pd(_mm_max_pd(_mm_add_pd(s, d01), zero), vScale);
+      const __m128d m23 = _mm_mul_pd(_mm_max_pd(_mm_add_pd(s, d23), zero), vScale);
+      s = _mm_add_pd(s, _mm_unpackhi_pd(d23, d23));
+      if constexpr (std::is_same_v<Mean, float>) {
+        _mm_storeu_ps(means + i, _mm_movelh_ps(_mm_cvtpd_ps(m01), _mm_cvtpd_ps(m23)));
+      } else {
+        _mm_storeu_pd(means + i, m01);
+        _mm_storeu_pd(means + i + 2, m23);
+      }
+    }
+    sum = _mm_cvtsd_f64(s);
+  }
+#endif
+  for (; i < count; ++i) {
+    sum += diff[i];
+    means[i] = static_cast<Mean>(std::max(sum, 0.0) * scale);
   }
   sum_ = sum;
-  writeIndex_ = w;
+
+  // Re-sum once per lap of the ring, so rounding cannot accumulate: the sum never carries more
+  // than capacity_ + kPiece additions' worth of error, however long it runs.
+  sinceResum_ += count;
+  if (sinceResum_ >= cap) {
+    sinceResum_ = 0;
+    resum();
+  }
+}
+
+// Equation (2) on the fast logarithm, branch-free: clip in the linear domain, log2 by bits and
+// polynomial, the linear map, then the clip values where the level is at or beyond a bound.
+void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) const {
+  int i = 0;
+#if defined(__SSE2__)
+  {
+    const __m128 lo = _mm_set1_ps(loLevel_), hi = _mm_set1_ps(hiLevel_);
+    const __m128 fLo = _mm_set1_ps(forceAtLoAbs_), fHi = _mm_set1_ps(forceAtHiAbs_);
+    const __m128 a = _mm_set1_ps(forcePerLog2_), b = _mm_set1_ps(forceAtLog2Zero_);
+    const __m128i mantMask = _mm_set1_epi32(0x007fffff), one = _mm_set1_epi32(0x3f800000);
+    const __m128i sqrt2 = _mm_set1_epi32(kSqrt2Bits), bias = _mm_set1_epi32(127);
+    const __m128i halfBit = _mm_set1_epi32(1 << 23);
+    for (; i + 4 <= count; i += 4) {
+      const __m128 level = _mm_loadu_ps(levels + i);
+      const __m128 atLo = _mm_cmple_ps(level, lo), atHi = _mm_cmpge_ps(level, hi);
+      const int clipped = _mm_movemask_ps(_mm_or_ps(atLo, atHi));
+      if (clipped == 0xf) {  // all four clipped (silence, or loud): no logarithm
+        _mm_storeu_ps(forceN + i, _mm_or_ps(_mm_and_ps(atHi, fHi), _mm_andnot_ps(atHi, fLo)));
+        continue;
+      }
+      const __m128 m = _mm_min_ps(_mm_max_ps(level, lo), hi);
+      const __m128i bits = _mm_castps_si128(m);
+      __m128i ex = _mm_sub_epi32(_mm_srli_epi32(bits, 23), bias);
+      __m128i mbits = _mm_or_si128(_mm_and_si128(bits, mantMask), one);
+      const __m128i big = _mm_cmpgt_epi32(mbits, sqrt2);  // all ones where the mantissa > sqrt(2)
+      mbits = _mm_sub_epi32(mbits, _mm_and_si128(big, halfBit));
+      ex = _mm_sub_epi32(ex, big);
+      const __m128 t = _mm_sub_ps(_mm_castsi128_ps(mbits), _mm_set1_ps(1.f));
+      __m128 p = _mm_add_ps(_mm_set1_ps(kP5), _mm_mul_ps(t, _mm_set1_ps(kP6)));
+      p = _mm_add_ps(_mm_set1_ps(kP4), _mm_mul_ps(t, p));
+      p = _mm_add_ps(_mm_set1_ps(kP3), _mm_mul_ps(t, p));
+      p = _mm_add_ps(_mm_set1_ps(kP2), _mm_mul_ps(t, p));
+      p = _mm_add_ps(_mm_set1_ps(kP1), _mm_mul_ps(t, p));
+      p = _mm_add_ps(_mm_set1_ps(kP0), _mm_mul_ps(t, p));
+      const __m128 log2 = _mm_add_ps(_mm_cvtepi32_ps(ex), _mm_mul_ps(t, p));
+      __m128 f = _mm_add_ps(_mm_mul_ps(log2, a), b);
+      f = _mm_or_ps(_mm_and_ps(atLo, fLo), _mm_andnot_ps(atLo, f));
+      f = _mm_or_ps(_mm_and_ps(atHi, fHi), _mm_andnot_ps(atHi, f));  // hi wins, as in mapMeanAbs
+      _mm_storeu_ps(forceN + i, f);
+    }
+  }
+#endif
+  for (; i < count; ++i) {  // the same operations, one at a time
+    const float level = levels[i];
+    const float m = std::min(std::max(level, loLevel_), hiLevel_);
+    const float f = fastLog2(m) * forcePerLog2_ + forceAtLog2Zero_;
+    forceN[i] = level >= hiLevel_ ? forceAtHiAbs_ : (level <= loLevel_ ? forceAtLoAbs_ : f);
+  }
+}
+
+void LoudnessToFriction::mapExact(const double* means, float* forceN, int count) const {
+  for (int i = 0; i < count; ++i) forceN[i] = mapMeanAbs(means[i]);
 }
 
 }  // namespace kf

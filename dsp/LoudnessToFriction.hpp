@@ -34,22 +34,39 @@ class LoudnessToFriction {
   int windowSamples() const { return windowSamples_; }
   void setMapping(const FrictionMapping& mapping);
 
-  // Force in N for each input sample. NaN/Inf input counts as silence.
+  // Force in N for each input sample. NaN/Inf input counts as silence. in and forceN may be
+  // the same array.
   void process(const float* in, float* forceN, int numSamples);
   double meanAbs() const { return sum_ / windowSamples_; }
   // The force process() would give for `a` as the next sample, without taking it in: the
   // initial output a UGen shows before its first block.
   float peekForce(float a) const;
+  // Whether equation (2) runs on the fast logarithm (the mapping's worst error with it is
+  // within kMaxFastLogErrorN) or on the exact one.
+  bool usesFastLog() const { return fastLog_; }
+  // Worst force error the fast logarithm may add, by the bound setMapping() evaluates.
+  static constexpr double kMaxFastLogErrorN = 5e-7;
+
+  // Samples per two-pass piece of process(); longer blocks are processed in pieces.
+  static constexpr int kPiece = 128;
 
  private:
   float mapMeanAbs(double meanAbs) const;
   float sanitizedAbs(float a) const;
   void resum();
+  // The pieces of process(): equation (1) into means[], then equation (2) from them.
+  // Mean is double (the means, for the exact path) or float (the levels mean / ref, for the
+  // fast path); scale is 1 / n, or 1 / (n ref).
+  template <typename Mean>
+  void runningMeans(const float* in, Mean* means, double scale, int count);
+  void mapFast(const float* levels, float* forceN, int count) const;
+  void mapExact(const double* means, float* forceN, int count) const;
 
   float* history_;
   int capacity_;
   int windowSamples_ = 1;
   int writeIndex_ = 0;  // where the next |a| goes; history_ is a ring of capacity_ samples
+  int sinceResum_ = 0;  // samples taken in since the last re-sum
   double sum_ = 0.0;    // sum of the latest windowSamples_ values of |a|
 
   FrictionMapping mapping_;
@@ -59,6 +76,10 @@ class LoudnessToFriction {
   float forceAtLoAbs_ = 0.f, forceAtHiAbs_ = 0.f;
   double forcePerDb_ = 0.0, forceOffset_ = 0.0, invRef_ = 1.0;
   float maxAbs_ = 1e30f;  // |a| taken into the sum is clamped here (see setMapping)
+  // The fast path of equation (2), on the level mean / ref in float: clip in the linear domain
+  // to [loLevel_, hiLevel_], then force = log2(level) * forcePerLog2_ + forceAtLog2Zero_.
+  bool fastLog_ = false;
+  float loLevel_ = 0.f, hiLevel_ = 1.f, forcePerLog2_ = 0.f, forceAtLog2Zero_ = 0.f;
 };
 
 }  // namespace kf

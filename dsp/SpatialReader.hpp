@@ -46,19 +46,26 @@ inline float sampleAt(const SignalView& s, int channel, int64_t k) {
   return s.data[k * s.channels + channel];
 }
 
+// floor(x) for x > -1 (callers have range-checked x), without a libm call: the default x86-64
+// target has no SSE4.1 round, so std::floor(double) is a call per sample.
+inline int64_t floorAboveMinusOne(double x) {
+  const int64_t t = static_cast<int64_t>(x);  // truncates toward zero
+  return t - (static_cast<double>(t) > x);
+}
+
 }  // namespace detail
 
 // Reads channel `channel` at fractional `index`. Returns 0 for a NaN/Inf index, an empty
 // signal, or an index at or beyond one sample outside the signal. Inline: it runs per sample.
+// The UGen reads whole blocks with readSpatialBlock(), which gives the same values.
 inline float readSpatial(const SignalView& s, int channel, double index, Interpolation interpolation) {
   if (s.data == nullptr || s.frames <= 0) return 0.f;
   // Outside (-1, frames) every tap is a padded zero; this also rejects NaN and +-Inf, and keeps
   // the integer conversion below in range.
   if (!(index > -1.0 && index < static_cast<double>(s.frames))) return 0.f;
 
-  const double floorIndex = std::floor(index);
-  const int64_t i = static_cast<int64_t>(floorIndex);
-  const float frac = static_cast<float>(index - floorIndex);
+  const int64_t i = detail::floorAboveMinusOne(index);
+  const float frac = static_cast<float>(index - static_cast<double>(i));
   const float* p = s.data + channel;
   const int64_t stride = s.channels;
 
@@ -80,5 +87,17 @@ inline float readSpatial(const SignalView& s, int channel, double index, Interpo
                           detail::sampleAt(s, channel, i + 1), detail::sampleAt(s, channel, i + 2));
   }
 }
+
+// A block of positions read at once, every channel of the signal: out[c][i] is
+// readSpatial(s, c, spatialIndex(positionMm[i * positionStride], originMm, samplesPerMm),
+// interpolation), bit for bit. positionStride is 1 for an audio-rate position, 0 for one
+// position held over the block. Every position of a piece is read before its outputs are
+// written, so an output may share memory with positionMm. out holds s.channels pointers.
+//
+// Two passes per piece of up to 64 samples: the indices in double -> whole part and float
+// fraction (branch-free, vectorized), then the taps, with no padding checks where the whole
+// piece lies inside the signal (one check per piece, not per sample).
+void readSpatialBlock(const SignalView& s, const float* positionMm, int positionStride, double originMm,
+                      double samplesPerMm, Interpolation interpolation, float* const* out, int numSamples);
 
 }  // namespace kf

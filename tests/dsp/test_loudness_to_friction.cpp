@@ -1,6 +1,7 @@
 // LoudnessToFriction against equations (1) and (2) recomputed in double, on the hard cases.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <deque>
@@ -239,4 +240,73 @@ TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation"
   }
   INFO("worst |error| " << worstN << " N");
   CHECK(worstN < 1e-6);
+}
+
+// The fast logarithm of equation (2): where it is used, its worst error over the whole clip
+// range is within 1e-6 N; where a bound says it could not be, the exact path is taken.
+TEST_CASE("fast logarithm: worst error over the clip range, and when it is not used") {
+  SECTION("the paper's mapping uses it, within 1e-6 N at every level across the clip range") {
+    Core c(1);
+    c.core.setWindowSamples(1);  // the output is the mapping of |a| itself
+    REQUIRE(c.core.usesFastLog());
+    const int count = 1 << 20;
+    std::vector<float> in(count), out(count);
+    // Log-spaced levels from -31 to +1 dB, plus the exact bounds and their float neighbours.
+    for (int i = 0; i < count; ++i) in[i] = static_cast<float>(std::pow(10.0, (-31.0 + 32.0 * i / (count - 1)) / 20.0));
+    const float lo = static_cast<float>(std::pow(10.0, -1.5));
+    for (float x : {lo, std::nextafter(lo, 0.f), std::nextafter(lo, 1.f), 1.f, std::nextafter(1.f, 0.f), std::nextafter(1.f, 2.f)})
+      in.push_back(x), out.push_back(0.f);
+    c.core.process(in.data(), out.data(), static_cast<int>(in.size()));
+    double worst = 0;
+    for (size_t i = 0; i < in.size(); ++i)
+      worst = std::max(worst, std::fabs(out[i] - kf::frictionFromMeanAbs(in[i], FrictionMapping{})));
+    INFO("worst |error| " << worst << " N");
+    CHECK(worst <= 1e-6);
+  }
+  SECTION("a steep mapping takes the exact path and stays within 1e-6 N") {
+    const FrictionMapping steep{-3.0, -2.0, 0.0, 1000.0, 1.0};  // 1000 N per dB
+    Core c(1);
+    c.core.setWindowSamples(1);
+    c.core.setMapping(steep);
+    CHECK_FALSE(c.core.usesFastLog());
+    std::vector<float> in(4096), out(4096);
+    for (size_t i = 0; i < in.size(); ++i) in[i] = static_cast<float>(std::pow(10.0, (-3.1 + 1.2 * i / 4095) / 20.0));
+    c.core.process(in.data(), out.data(), 4096);
+    for (size_t i = 0; i < in.size(); ++i) {
+      const double want = kf::frictionFromMeanAbs(in[i], steep);
+      REQUIRE(out[i] == Approx(want).margin(std::max(1e-6, want * 1e-7)));  // float output
+    }
+  }
+  SECTION("a threshold (loDb == hiDb) takes the exact path") {
+    Core c(8);
+    c.core.setMapping(FrictionMapping{-6.0, -6.0, 0.2, 1.0, 1.0});
+    CHECK_FALSE(c.core.usesFastLog());
+  }
+}
+
+TEST_CASE("block sizes, in-place processing and tiny rings give the same forces") {
+  Noise noise;
+  std::vector<float> in(5000);
+  for (size_t i = 0; i < in.size(); ++i) in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
+  for (int maxWindow : {1, 3, 48, 200, 1000}) {
+    const int n = std::max(1, maxWindow * 2 / 3);
+    std::vector<float> whole;
+    {
+      Core c(maxWindow);
+      c.core.setWindowSamples(n);
+      whole = runCore(c, in);
+      Reference ref(n);
+      for (size_t i = 0; i < in.size(); ++i) REQUIRE(whole[i] == Approx(ref(in[i])).margin(1e-6));
+    }
+    for (int block : {1, 7, 64, 127, 128, 129, 1024}) {
+      Core c(maxWindow);
+      c.core.setWindowSamples(n);
+      std::vector<float> buf(in);  // processed in place
+      for (size_t done = 0; done < buf.size(); done += block) {
+        const int len = static_cast<int>(std::min<size_t>(block, buf.size() - done));
+        c.core.process(buf.data() + done, buf.data() + done, len);
+      }
+      for (size_t i = 0; i < in.size(); ++i) REQUIRE(buf[i] == Approx(whole[i]).margin(2e-7));
+    }
+  }
 }

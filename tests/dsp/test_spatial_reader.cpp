@@ -1,7 +1,9 @@
 // SpatialReader: index arithmetic, the three interpolators, and what they read at the borders.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -153,4 +155,88 @@ TEST_CASE("a position far from the origin keeps its index exact in double") {
   const float bigFloatPhase = static_cast<float>(1e7 + 0.25);
   CHECK(static_cast<double>(bigFloatPhase) != 1e7 + 0.25);  // what BufRd's float phase loses
   CHECK(kf::spatialIndex(2500.0f + 0.25, 0.0, 4000.0) == 1e7 + 1000.0);
+}
+
+// The UGen's path: readSpatialBlock must give readSpatial's values bit for bit, whatever the
+// mode, channel count, position rate, block length, and wherever the positions fall.
+TEST_CASE("the block reader equals the per-sample reader bit for bit") {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (int channels : {1, 2, 3}) {
+    const int frames = 37;
+    std::vector<float> v(frames * channels);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(std::sin(0.7 * i) + 0.01 * i);
+    SignalView s{v.data(), frames, channels};
+    // Positions (mm, origin 2, 4 samples/mm): inside, at and across both borders, far outside,
+    // non-finite, in runs long enough for whole inside pieces and mixed pieces.
+    std::vector<float> pos;
+    for (int i = 0; i < 300; ++i) pos.push_back(static_cast<float>(2.0 + 0.03 * i));         // inside
+    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(1.5 + 0.0137 * i));       // index -2 .. 9
+    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(2.0 + 8.6 + 0.0071 * i)); // 34.4 .. 40
+    for (float x : {nan, inf, -inf, 1e30, -1e30, 2.0 - 0.25, 2.0 - 0.2499, 2.0 + 9.25, 2.0 + 9.2499})
+      pos.push_back(static_cast<float>(x));
+    for (int i = 0; i < 100; ++i) pos.push_back(static_cast<float>(2.0 + 0.09 * i));
+    for (auto mode : kAll) {
+      for (int blockLen : {1, 3, 64, 65, 128, 1000}) {
+        std::vector<std::vector<float>> out(channels, std::vector<float>(pos.size(), -99.f));
+        std::vector<float*> outs;
+        for (auto& o : out) outs.push_back(o.data());
+        for (size_t done = 0; done < pos.size(); done += blockLen) {
+          const int len = static_cast<int>(std::min<size_t>(blockLen, pos.size() - done));
+          std::vector<float*> at;
+          for (float* o : outs) at.push_back(o + done);
+          kf::readSpatialBlock(s, pos.data() + done, 1, 2.0, 4.0, mode, at.data(), len);
+        }
+        for (int c = 0; c < channels; ++c)
+          for (size_t i = 0; i < pos.size(); ++i) {
+            const float want = readSpatial(s, c, kf::spatialIndex(pos[i], 2.0, 4.0), mode);
+            INFO("channels " << channels << " mode " << int(mode) << " block " << blockLen << " i " << i);
+            REQUIRE(std::memcmp(&out[c][i], &want, sizeof(float)) == 0);
+          }
+      }
+      // A position held over the block (control rate): every output is the one read.
+      for (float p : {2.0f + 3.3f, 1.8f, 2.0f + 9.2f, 100.f}) {
+        std::vector<std::vector<float>> out(channels, std::vector<float>(70, -99.f));
+        std::vector<float*> outs;
+        for (auto& o : out) outs.push_back(o.data());
+        kf::readSpatialBlock(s, &p, 0, 2.0, 4.0, mode, outs.data(), 70);
+        for (int c = 0; c < channels; ++c)
+          for (float o : out[c]) REQUIRE(o == readSpatial(s, c, kf::spatialIndex(p, 2.0, 4.0), mode));
+      }
+    }
+  }
+}
+
+TEST_CASE("the block reader may write over its position input") {
+  std::vector<float> v(100);
+  for (int i = 0; i < 100; ++i) v[i] = static_cast<float>(i % 9) - 4.f;
+  SignalView s{v.data(), 100, 1};
+  for (auto mode : kAll) {
+    std::vector<float> pos(200);
+    for (int i = 0; i < 200; ++i) pos[i] = static_cast<float>(-1.0 + 0.55 * i);
+    std::vector<float> want(200);
+    for (int i = 0; i < 200; ++i) want[i] = readSpatial(s, 0, kf::spatialIndex(pos[i], 0.0, 1.0), mode);
+    float* out[1] = {pos.data()};
+    kf::readSpatialBlock(s, pos.data(), 1, 0.0, 1.0, mode, out, 200);
+    for (int i = 0; i < 200; ++i) REQUIRE(pos[i] == want[i]);
+  }
+}
+
+TEST_CASE("the block reader: empty signals are silent, indices at 1e7 stay exact") {
+  std::vector<float> pos(10, 1.f), o(10, -1.f);
+  float* out[1] = {o.data()};
+  for (auto mode : kAll) {
+    kf::readSpatialBlock(SignalView{nullptr, 8, 1}, pos.data(), 1, 0.0, 1.0, mode, out, 10);
+    for (float x : o) REQUIRE(x == 0.f);
+  }
+  // A ramp of 1e7 + 64 samples read at index 1e7 + 0.25: linear gives the exact value there.
+  std::vector<float> big(10000064);
+  for (size_t i = 0; i < big.size(); ++i) big[i] = static_cast<float>(i % 16);
+  SignalView s{big.data(), static_cast<int64_t>(big.size()), 1};
+  const float p = 2500.0f;  // 2500 mm x 4000 samples/mm = 1e7 exactly
+  float q[1] = {p};
+  kf::readSpatialBlock(s, q, 1, 0.0, 4000.0, Interpolation::Linear, out, 1);
+  CHECK(o[0] == static_cast<float>(10000000 % 16));
+  q[0] = p;
+  kf::readSpatialBlock(s, q, 1, -0.0000625, 4000.0, Interpolation::Linear, out, 1);  // + 0.25 sample
+  CHECK(o[0] == Approx(10000000 % 16 + 0.25).margin(1e-6));
 }
