@@ -6,8 +6,8 @@
 
 namespace kf {
 
-Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse,
-               std::shared_ptr<ForceBackend> force, bool lockstep, DeviceOptions options)
+Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std::shared_ptr<ForceBackend> force,
+               bool lockstep, DeviceOptions options)
     : spec_(spec),
       lockstep_(lockstep),
       options_(options),
@@ -32,8 +32,7 @@ void Device::start() {
 void Device::threadMain() {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point openTime = startTime_;
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(options_.pumpPeriodS));
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.pumpPeriodS));
   Clock::time_point next = openTime;
   while (!stopRequested_.load(std::memory_order_acquire)) {
     next += period;

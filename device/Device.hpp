@@ -31,8 +31,8 @@ struct DeviceOptions {
 class Device {
  public:
   // The mouse and force backends may be one object (SimDevice) or two.
-  Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse,
-         std::shared_ptr<ForceBackend> force, bool lockstep, DeviceOptions options = {});
+  Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std::shared_ptr<ForceBackend> force,
+         bool lockstep, DeviceOptions options = {});
   // Closes: stops and joins the thread, drives the magnet off.
   ~Device();
   Device(const Device&) = delete;

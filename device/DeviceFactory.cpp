@@ -5,25 +5,23 @@
 
 namespace kf {
 
-std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& simParams,
-                                      const HandScript& handScript, bool lockstep,
-                                      std::string* error, DeviceOptions options) {
+std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& simParams, const HandScript& handScript,
+                                      bool lockstep, std::string* error, DeviceOptions options) {
   auto fail = [error](const char* message) {
     if (error) *error = message;
     return std::unique_ptr<Device>();
   };
   if (!spec.isValid()) return fail("invalid device spec");
   if (!handScript.isValid()) return fail("invalid hand script (times must ascend, durations >= 0)");
-  if (!(simParams.puckMassKg > 0.0) || !(simParams.stepS > 0.0))
-    return fail("invalid sim parameters");
+  if (!(simParams.puckMassKg > 0.0) || !(simParams.stepS > 0.0)) return fail("invalid sim parameters");
   auto sim = std::make_shared<SimDevice>(spec, simParams, handScript);
   auto device = std::make_unique<Device>(spec, sim, sim, lockstep, options);
   device->start();
   return device;
 }
 
-std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec,
-                                         bool lockstep, std::string& error, DeviceOptions options) {
+std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
+                                         std::string& error, DeviceOptions options) {
   DeviceSpec replaySpec = spec;
   std::vector<TimedReport> reports;
   if (!loadReplayReports(path, replaySpec, reports, error)) return nullptr;

@@ -14,14 +14,12 @@ namespace kf {
 
 // A SimDevice as both backends. Null (with a message in *error if given) when the spec or
 // hand script is unusable.
-std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& simParams,
-                                      const HandScript& handScript, bool lockstep,
-                                      std::string* error = nullptr, DeviceOptions options = {});
+std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& simParams, const HandScript& handScript,
+                                      bool lockstep, std::string* error = nullptr, DeviceOptions options = {});
 
 // A ReplayBackend of a kf-session or hid-recorder file, with a CountingForceSink as the force
 // side. For kf-session files the spec of the file's header wins over `spec`.
-std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec,
-                                         bool lockstep, std::string& error,
-                                         DeviceOptions options = {});
+std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
+                                         std::string& error, DeviceOptions options = {});
 
 }  // namespace kf

@@ -44,11 +44,10 @@ bool DeviceSpec::applyOverride(std::string_view key, double value) {
 }
 
 bool DeviceSpec::isValid() const {
-  return isPositive(countMm) && isPositive(updateRateHz) && maxCountsPerReport >= 1 &&
-         isNonNegative(minForceN) && isNonNegative(maxForceN) && minForceN <= maxForceN &&
-         isNonNegative(audioLatencyS) && isNonNegative(tactileLatencyS) &&
-         isPositive(forceFramePeriodS) && isPositive(maxForceSlewNPerS) && isPositive(watchdogS) &&
-         isNonNegative(magnetLagS);
+  return isPositive(countMm) && isPositive(updateRateHz) && maxCountsPerReport >= 1 && isNonNegative(minForceN) &&
+         isNonNegative(maxForceN) && minForceN <= maxForceN && isNonNegative(audioLatencyS) &&
+         isNonNegative(tactileLatencyS) && isPositive(forceFramePeriodS) && isPositive(maxForceSlewNPerS) &&
+         isPositive(watchdogS) && isNonNegative(magnetLagS);
 }
 
 }  // namespace kf

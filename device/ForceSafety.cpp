@@ -5,8 +5,7 @@
 
 namespace kf {
 
-ForceSafety::ForceSafety(const DeviceSpec& spec)
-    : spec_(spec), commandedForceN_(static_cast<float>(spec.minForceN)) {}
+ForceSafety::ForceSafety(const DeviceSpec& spec) : spec_(spec), commandedForceN_(static_cast<float>(spec.minForceN)) {}
 
 float ForceSafety::applyFrame(const ForceFrame& frame, double arrivalS) {
   const double minN = spec_.minForceN;
@@ -22,8 +21,7 @@ float ForceSafety::applyFrame(const ForceFrame& frame, double arrivalS) {
   const double previousN = commandedForceN_;
   targetN = std::clamp(targetN, previousN - maxStepN, previousN + maxStepN);
   // The float rounding of a clamped value must not leave the range.
-  commandedForceN_ =
-      std::clamp(static_cast<float>(targetN), static_cast<float>(minN), static_cast<float>(maxN));
+  commandedForceN_ = std::clamp(static_cast<float>(targetN), static_cast<float>(minN), static_cast<float>(maxN));
 
   if (std::isfinite(frame.timeS)) lastFrameTimeS_ = frame.timeS;
   lastArrivalS_ = arrivalS;

@@ -36,8 +36,7 @@ bool HandScript::isValid() const {
   return true;
 }
 
-HandTrajectory::HandTrajectory(const HandScript& script)
-    : kind_(script.kind), constantForceN_(script.constantForceN) {
+HandTrajectory::HandTrajectory(const HandScript& script) : kind_(script.kind), constantForceN_(script.constantForceN) {
   if (kind_ == HandScript::Kind::kPath) {
     pathMm_ = script.points;
   } else if (kind_ == HandScript::Kind::kSpeeds) {

@@ -5,8 +5,7 @@
 namespace kf {
 
 void HidMouseDecoder::noteExtent(Layout& layout, const Element& element) {
-  layout.minBytes =
-      std::max<size_t>(layout.minBytes, (element.bitOffset + element.bitSize + 7) / 8);
+  layout.minBytes = std::max<size_t>(layout.minBytes, (element.bitOffset + element.bitSize + 7) / 8);
 }
 
 bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& error) {
@@ -38,15 +37,14 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
           layout.y = element;
           layout.haveY = true;
           noteExtent(layout, element);
-        } else if (usage >> 16 == kHidPageButton && (usage & 0xFFFF) >= 1 &&
-                   (usage & 0xFFFF) <= 32) {
+        } else if (usage >> 16 == kHidPageButton && (usage & 0xFFFF) >= 1 && (usage & 0xFFFF) <= 32) {
           layout.buttonBits.emplace_back(element, usage & 0xFFFF);
           noteExtent(layout, element);
         }
       }
     } else {
-      const bool anyButton = std::any_of(field.usages.begin(), field.usages.end(),
-                                         [](HidUsage u) { return u >> 16 == kHidPageButton; });
+      const bool anyButton =
+          std::any_of(field.usages.begin(), field.usages.end(), [](HidUsage u) { return u >> 16 == kHidPageButton; });
       if (!anyButton) continue;
       for (uint32_t i = 0; i < field.count; ++i) {
         ButtonArray array;
@@ -59,8 +57,7 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
     }
   }
   // Only reports with motion are mouse reports.
-  layouts_.erase(std::remove_if(layouts_.begin(), layouts_.end(),
-                                [](const Layout& l) { return !l.haveX && !l.haveY; }),
+  layouts_.erase(std::remove_if(layouts_.begin(), layouts_.end(), [](const Layout& l) { return !l.haveX && !l.haveY; }),
                  layouts_.end());
   if (layouts_.empty()) {
     error = "the HID report descriptor has no relative Generic Desktop X or Y input";
@@ -91,25 +88,21 @@ bool HidMouseDecoder::decode(const uint8_t* bytes, size_t size, HidMouseDelta& o
   out = HidMouseDelta{};
   out.reportId = reportId;
   int64_t value = 0;
-  if (layout->haveX && extractHidBits(bytes, size, layout->x.bitOffset, layout->x.bitSize,
-                                      layout->x.isSigned, value))
+  if (layout->haveX && extractHidBits(bytes, size, layout->x.bitOffset, layout->x.bitSize, layout->x.isSigned, value))
     out.dxCounts = static_cast<int32_t>(value);
-  if (layout->haveY && extractHidBits(bytes, size, layout->y.bitOffset, layout->y.bitSize,
-                                      layout->y.isSigned, value))
+  if (layout->haveY && extractHidBits(bytes, size, layout->y.bitOffset, layout->y.bitSize, layout->y.isSigned, value))
     out.dyCounts = static_cast<int32_t>(value);
   for (const auto& [element, button] : layout->buttonBits)
     if (extractHidBits(bytes, size, element.bitOffset, element.bitSize, false, value) && value != 0)
       out.buttons |= 1u << (button - 1);
   for (const ButtonArray& array : layout->buttonArrays) {
-    if (!extractHidBits(bytes, size, array.element.bitOffset, array.element.bitSize,
-                        array.element.isSigned, value))
+    if (!extractHidBits(bytes, size, array.element.bitOffset, array.element.bitSize, array.element.isSigned, value))
       continue;
     const int64_t index = value - array.logicalMin;
     if (index < 0 || index >= static_cast<int64_t>(array.usages.size())) continue;  // none pressed
     const HidUsage usage = array.usages[static_cast<size_t>(index)];
     const uint32_t button = usage & 0xFFFF;
-    if (usage >> 16 == kHidPageButton && button >= 1 && button <= 32)
-      out.buttons |= 1u << (button - 1);
+    if (usage >> 16 == kHidPageButton && button >= 1 && button <= 32) out.buttons |= 1u << (button - 1);
   }
   return true;
 }

@@ -99,8 +99,7 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
       }
       char* end = nullptr;
       event.timeS = std::strtod(timeToken.c_str(), &end);
-      if (end != timeToken.c_str() + timeToken.size() ||
-          !parseHexBytes(fields, length, event.bytes)) {
+      if (end != timeToken.c_str() + timeToken.size() || !parseHexBytes(fields, length, event.bytes)) {
         error = lineError(path, lineNumber, "E: time, length or bytes malformed");
         return false;
       }

@@ -65,8 +65,7 @@ size_t HidReportDescriptor::inputReportBytes(uint8_t reportId) const {
   return static_cast<size_t>((bits + 7) / 8) + (usesReportIds ? 1 : 0);
 }
 
-bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out,
-                              std::string& error) {
+bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out, std::string& error) {
   out = HidReportDescriptor{};
   GlobalState global;
   std::vector<GlobalState> pushed;
@@ -99,8 +98,7 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
     if (size - pos < static_cast<size_t>(dataBytes)) {
       static const char digits[] = "0123456789abcdef";
       const std::string hex{digits[prefix >> 4], digits[prefix & 15]};
-      error = at(itemStart, "truncated item (prefix 0x" + hex + " needs " +
-                                std::to_string(dataBytes) + " data bytes)");
+      error = at(itemStart, "truncated item (prefix 0x" + hex + " needs " + std::to_string(dataBytes) + " data bytes)");
       return false;
     }
     uint32_t data = 0;
@@ -133,11 +131,9 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
           field.flags = data;
           field.logicalMin = signExtend(global.logicalMinRaw, global.logicalMinBytes);
           // A maximum is signed only when the minimum is negative (as the Linux parser does).
-          field.logicalMax = field.logicalMin < 0
-                                 ? signExtend(global.logicalMaxRaw, global.logicalMaxBytes)
-                                 : int64_t(global.logicalMaxRaw);
-          for (const LocalUsage& usage : local.usages)
-            field.usages.push_back(fullUsage(usage, global.usagePage));
+          field.logicalMax = field.logicalMin < 0 ? signExtend(global.logicalMaxRaw, global.logicalMaxBytes)
+                                                  : int64_t(global.logicalMaxRaw);
+          for (const LocalUsage& usage : local.usages) field.usages.push_back(fullUsage(usage, global.usagePage));
           if (local.haveMin && local.haveMax) {
             const HidUsage first = fullUsage(local.usageMin, global.usagePage);
             const HidUsage last = fullUsage(local.usageMax, global.usagePage);
@@ -154,8 +150,7 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
       } else if (tag == 0xA) {  // collection
         HidCollection collection;
         collection.type = static_cast<uint8_t>(data);
-        if (!local.usages.empty())
-          collection.usage = fullUsage(local.usages.front(), global.usagePage);
+        if (!local.usages.empty()) collection.usage = fullUsage(local.usages.front(), global.usagePage);
         collection.parent = openCollections.empty() ? -1 : openCollections.back();
         out.collections.push_back(collection);
         openCollections.push_back(static_cast<int>(out.collections.size()) - 1);
@@ -243,15 +238,14 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
     }
   }
   if (!openCollections.empty()) {
-    error = "HID report descriptor: " + std::to_string(openCollections.size()) +
-            " collection(s) not closed at the end";
+    error = "HID report descriptor: " + std::to_string(openCollections.size()) + " collection(s) not closed at the end";
     return false;
   }
   return true;
 }
 
-bool extractHidBits(const uint8_t* data, size_t sizeBytes, uint32_t bitOffset, uint32_t bitSize,
-                    bool isSigned, int64_t& value) {
+bool extractHidBits(const uint8_t* data, size_t sizeBytes, uint32_t bitOffset, uint32_t bitSize, bool isSigned,
+                    int64_t& value) {
   if (bitSize == 0 || bitSize > 32) return false;
   if (uint64_t(bitOffset) + bitSize > uint64_t(sizeBytes) * 8) return false;
   uint64_t raw = 0;

@@ -59,12 +59,11 @@ struct HidReportDescriptor {
 // Parses `size` bytes. On malformed input (truncated item, unbalanced collections or
 // push/pop, unknown main or global item, absurd sizes) returns false with a message naming
 // the byte offset; never reads past the end.
-bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out,
-                              std::string& error);
+bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out, std::string& error);
 
 // The little-endian bit field [bitOffset, bitOffset + bitSize) of `data` (bitSize 1..32),
 // sign-extended if `isSigned`. False if it does not lie within `sizeBytes`.
-bool extractHidBits(const uint8_t* data, size_t sizeBytes, uint32_t bitOffset, uint32_t bitSize,
-                    bool isSigned, int64_t& value);
+bool extractHidBits(const uint8_t* data, size_t sizeBytes, uint32_t bitOffset, uint32_t bitSize, bool isSigned,
+                    int64_t& value);
 
 }  // namespace kf

@@ -9,9 +9,7 @@ namespace kf {
 class MagnetModel {
  public:
   MagnetModel(double lagS, double stepS, double offForceN)
-      : blend_(lagS > 0.0 ? 1.0 - std::exp(-stepS / lagS) : 1.0),
-        commandedN_(offForceN),
-        forceN_(offForceN) {}
+      : blend_(lagS > 0.0 ? 1.0 - std::exp(-stepS / lagS) : 1.0), commandedN_(offForceN), forceN_(offForceN) {}
 
   void command(double forceN) { commandedN_ = forceN; }
   void step() { forceN_ += (commandedN_ - forceN_) * blend_; }

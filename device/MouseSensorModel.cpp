@@ -5,8 +5,7 @@
 
 namespace kf {
 
-MouseSensorModel::MouseSensorModel(const DeviceSpec& spec, const SimParams& params,
-                                   double initialPositionMm)
+MouseSensorModel::MouseSensorModel(const DeviceSpec& spec, const SimParams& params, double initialPositionMm)
     : spec_(spec),
       params_(params),
       random_(params.seed),

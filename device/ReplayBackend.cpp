@@ -21,8 +21,8 @@ void CountingForceSink::commandForce(double timeS, float forceN) {
 
 void CountingForceSink::driveOff() { driveOffs_.fetch_add(1, std::memory_order_relaxed); }
 
-bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out,
-                       std::string& error, size_t* skippedEvents) {
+bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out, std::string& error,
+                       size_t* skippedEvents) {
   out.clear();
   if (skippedEvents) *skippedEvents = 0;
   if (isSessionFile(path)) {
@@ -39,8 +39,7 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
   HidRecording recording;
   if (!readHidRecorderFile(path, recording, error)) return false;
   HidReportDescriptor descriptor;
-  if (!parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(),
-                                descriptor, error))
+  if (!parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(), descriptor, error))
     return false;
   HidMouseDecoder decoder;
   if (!decoder.build(descriptor, error)) return false;

@@ -51,7 +51,7 @@ class CountingForceSink : public ForceBackend {
 // The reports of a file, kf-session or hid-recorder (told apart by their first line).
 // `spec` becomes the session file's header spec for kf-session files and stays as given
 // for hid-recorder files. `skippedEvents` counts hid events that are not mouse reports.
-bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out,
-                       std::string& error, size_t* skippedEvents = nullptr);
+bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out, std::string& error,
+                       size_t* skippedEvents = nullptr);
 
 }  // namespace kf

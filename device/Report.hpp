@@ -17,8 +17,8 @@ struct MouseReport {
   double deviceTimeS = 0.0;  // the device's clock, not audio time
   int32_t dxCounts = 0;
   int32_t dyCounts = 0;
-  uint32_t buttons = 0;  // bit i = button i + 1
-  uint32_t flags = 0;    // ReportFlag bits
+  uint32_t buttons = 0;    // bit i = button i + 1
+  uint32_t flags = 0;      // ReportFlag bits
   double hostTimeS = 0.0;  // set by Device: its clock when the device thread took the report
 };
 

@@ -68,8 +68,7 @@ bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string
     return false;
   }
   std::fprintf(file_, "%s %d", kSessionFormatName, kSessionFormatVersion);
-  for (const SpecField& field : kSpecFields)
-    std::fprintf(file_, " %s=%.17g", field.name, field.get(spec));
+  for (const SpecField& field : kSpecFields) std::fprintf(file_, " %s=%.17g", field.name, field.get(spec));
   std::fprintf(file_, "\n");
   return true;
 }
@@ -77,14 +76,14 @@ bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string
 void Recorder::writeReport(double hostTimeS, const MouseReport& r) {
   if (!file_) return;
   // %.17g: doubles read back bit for bit.
-  std::fprintf(file_, "R %.17g %.17g %d %d %u %u\n", hostTimeS, r.deviceTimeS, r.dxCounts,
-               r.dyCounts, r.buttons, r.flags);
+  std::fprintf(file_, "R %.17g %.17g %d %d %u %u\n", hostTimeS, r.deviceTimeS, r.dxCounts, r.dyCounts, r.buttons,
+               r.flags);
 }
 
 void Recorder::writeFrame(double hostTimeS, const ForceFrame& frame, float commandedForceN) {
   if (!file_) return;
-  std::fprintf(file_, "F %.17g %.17g %.9g %.9g\n", hostTimeS, frame.timeS,
-               static_cast<double>(frame.forceN), static_cast<double>(commandedForceN));
+  std::fprintf(file_, "F %.17g %.17g %.9g %.9g\n", hostTimeS, frame.timeS, static_cast<double>(frame.forceN),
+               static_cast<double>(commandedForceN));
 }
 
 void Recorder::writeOff(double hostTimeS) {
@@ -107,8 +106,7 @@ bool isSessionFile(const std::string& path) {
   return static_cast<bool>(in >> word) && word == kSessionFormatName;
 }
 
-bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out,
-                     std::string& error) {
+bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out, std::string& error) {
   std::ifstream in(path);
   if (!in) {
     error = "cannot read " + path;
@@ -133,8 +131,7 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
         return false;
       }
       if (version != kSessionFormatVersion) {
-        error = lineError(path, lineNumber,
-                          "unsupported kf-session version " + std::to_string(version));
+        error = lineError(path, lineNumber, "unsupported kf-session version " + std::to_string(version));
         return false;
       }
       std::string pair;
@@ -162,16 +159,14 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
     if (tag == "R") {
       TimedReport timed;
       MouseReport& r = timed.report;
-      ok = tokens.size() == 6 && parseDouble(tokens[0], timed.hostTimeS) &&
-           parseDouble(tokens[1], r.deviceTimeS) && parseInteger(tokens[2], r.dxCounts) &&
-           parseInteger(tokens[3], r.dyCounts) && parseInteger(tokens[4], r.buttons) &&
-           parseInteger(tokens[5], r.flags);
+      ok = tokens.size() == 6 && parseDouble(tokens[0], timed.hostTimeS) && parseDouble(tokens[1], r.deviceTimeS) &&
+           parseInteger(tokens[2], r.dxCounts) && parseInteger(tokens[3], r.dyCounts) &&
+           parseInteger(tokens[4], r.buttons) && parseInteger(tokens[5], r.flags);
       if (ok) out.reports.push_back(timed);
     } else if (tag == "F") {
       RecordedFrame recorded;
       ok = tokens.size() == 4 && parseDouble(tokens[0], recorded.hostTimeS) &&
-           parseDouble(tokens[1], recorded.frame.timeS) &&
-           parseFloat(tokens[2], recorded.frame.forceN) &&
+           parseDouble(tokens[1], recorded.frame.timeS) && parseFloat(tokens[2], recorded.frame.forceN) &&
            parseFloat(tokens[3], recorded.commandedForceN);
       if (ok) out.frames.push_back(recorded);
     } else if (tag == "O") {

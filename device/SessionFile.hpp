@@ -58,7 +58,6 @@ class Recorder {
 // True if the file starts with the kf-session header line.
 bool isSessionFile(const std::string& path);
 // Reads a whole kf-session file; the header's fields override those of `spec` in out.spec.
-bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out,
-                     std::string& error);
+bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out, std::string& error);
 
 }  // namespace kf

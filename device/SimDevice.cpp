@@ -21,8 +21,7 @@ double SimDevice::handPushN(double timeS) const {
   const HandTarget target = hand_.at(timeS);
   const double errorM = (target.positionMm - positionMm()) * 1e-3;
   const double speedErrorMPerS = (target.speedMmPerS - speedMmPerS()) * 1e-3;
-  const double pushN =
-      params_.handStiffnessNPerM * errorM + params_.handDampingNSPerM * speedErrorMPerS;
+  const double pushN = params_.handStiffnessNPerM * errorM + params_.handDampingNSPerM * speedErrorMPerS;
   return std::clamp(pushN, -params_.handMaxForceN, params_.handMaxForceN);
 }
 

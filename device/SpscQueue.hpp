@@ -14,8 +14,7 @@ template <typename T>
 class SpscQueue {
  public:
   // Allocates once, here; holds up to `capacity` items.
-  explicit SpscQueue(size_t capacity)
-      : slotCount_(capacity + 1), slots_(std::make_unique<T[]>(capacity + 1)) {}
+  explicit SpscQueue(size_t capacity) : slotCount_(capacity + 1), slots_(std::make_unique<T[]>(capacity + 1)) {}
 
   SpscQueue(const SpscQueue&) = delete;
   SpscQueue& operator=(const SpscQueue&) = delete;

@@ -31,9 +31,7 @@ class Telemetry {
   // Device thread: one report with this deviceTimeS arrived.
   void countReport(double deviceTimeS);
   void countFrame(float commandedForceN);
-  void setCommandedForce(float forceN) {
-    lastCommandedForceN_.store(forceN, std::memory_order_relaxed);
-  }
+  void setCommandedForce(float forceN) { lastCommandedForceN_.store(forceN, std::memory_order_relaxed); }
   void countWatchdogTrip() { watchdogTrips_.fetch_add(1, std::memory_order_relaxed); }
   void countPump() { pumps_.fetch_add(1, std::memory_order_relaxed); }
 
@@ -70,8 +68,7 @@ inline void Telemetry::countReport(double deviceTimeS) {
     intervalMeanS_ += delta / intervalCount_;
     intervalM2_ += delta * (intervalS - intervalMeanS_);
     reportIntervalMeanS_.store(intervalMeanS_, std::memory_order_relaxed);
-    reportIntervalJitterS_.store(std::sqrt(intervalM2_ / intervalCount_),
-                                 std::memory_order_relaxed);
+    reportIntervalJitterS_.store(std::sqrt(intervalM2_ / intervalCount_), std::memory_order_relaxed);
   }
   lastReportTimeS_ = deviceTimeS;
 }

@@ -28,13 +28,13 @@ namespace kf {
 class DeviceClockMapper {
  public:
   struct Config {
-    double horizonS = 2.0;            // how long one low observation holds the floor down
-    double maxDriftPpm = 200.0;       // the floor may rise 25% faster; drift clamped to this
-    double loopTimeS = 3.0;           // 1 / natural frequency of the smoothing loop
-    double snapS = 0.004;             // floor this far from the mapping: take it at once
-    double resetJumpS = 0.1;          // d this far below the estimate: a new device clock
-    double minAdvanceRatio = 0.5;     // mapped time advances >= this * device time advance
-    double extraLatencyS = 0.0;       // added to every mapped time (headroom for jitter)
+    double horizonS = 2.0;         // how long one low observation holds the floor down
+    double maxDriftPpm = 200.0;    // the floor may rise 25% faster; drift clamped to this
+    double loopTimeS = 3.0;        // 1 / natural frequency of the smoothing loop
+    double snapS = 0.004;          // floor this far from the mapping: take it at once
+    double resetJumpS = 0.1;       // d this far below the estimate: a new device clock
+    double minAdvanceRatio = 0.5;  // mapped time advances >= this * device time advance
+    double extraLatencyS = 0.0;    // added to every mapped time (headroom for jitter)
   };
 
   DeviceClockMapper();

@@ -78,8 +78,8 @@ bool ForceFramer::closeFrame(FrameSink sink, void* context) {
   return emit;
 }
 
-int ForceFramer::process(double blockStartTimeS, double sampleDurS, const float* forceN,
-                         int numSamples, float* commandedN, FrameSink sink, void* context) {
+int ForceFramer::process(double blockStartTimeS, double sampleDurS, const float* forceN, int numSamples,
+                         float* commandedN, FrameSink sink, void* context) {
   if (numSamples <= 0 || !(sampleDurS > 0.0)) return 0;
   int frames = 0;
   if (started_ && std::fabs(blockStartTimeS - nextBlockStartS_) > 0.5 * sampleDurS) {
@@ -89,8 +89,7 @@ int ForceFramer::process(double blockStartTimeS, double sampleDurS, const float*
   }
   if (!started_) {
     // The frame holding the block's first sample (a start on a boundary opens the next one).
-    frameIndex_ = static_cast<int64_t>(
-        std::floor((blockStartTimeS + kSnapSamples * sampleDurS) / framePeriodS_));
+    frameIndex_ = static_cast<int64_t>(std::floor((blockStartTimeS + kSnapSamples * sampleDurS) / framePeriodS_));
     weightedSum_ = 0.0;
     weight_ = 0.0;
     started_ = true;
@@ -115,8 +114,10 @@ int ForceFramer::process(double blockStartTimeS, double sampleDurS, const float*
       const float now = lastCommandedN_;
       if (commandedN) {
         for (; filled < completing; ++filled) commandedN[filled] = before;
-        if (filled == completing) commandedN[filled++] = now;
-        else commandedN[completing] = now;  // several frames in one sample: the newest wins
+        if (filled == completing)
+          commandedN[filled++] = now;
+        else
+          commandedN[completing] = now;  // several frames in one sample: the newest wins
       }
     }
   }

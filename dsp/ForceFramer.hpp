@@ -31,15 +31,14 @@ class ForceFramer {
   // receives per sample the last completed frame's value as known after that sample. Returns
   // the number of frames completed. A block that does not start where the previous one ended
   // (more than half a sample off) first closes the frame in progress with what it has.
-  int process(double blockStartTimeS, double sampleDurS, const float* forceN, int numSamples,
-              float* commandedN, FrameSink sink, void* context);
+  int process(double blockStartTimeS, double sampleDurS, const float* forceN, int numSamples, float* commandedN,
+              FrameSink sink, void* context);
 
   // The same with any callable sink(double frameTimeS, float forceN).
   template <class Sink>
-  int process(double blockStartTimeS, double sampleDurS, const float* forceN, int numSamples,
-              float* commandedN, Sink& sink) {
-    return process(blockStartTimeS, sampleDurS, forceN, numSamples, commandedN,
-                   &ForceFramer::callSink<Sink>, &sink);
+  int process(double blockStartTimeS, double sampleDurS, const float* forceN, int numSamples, float* commandedN,
+              Sink& sink) {
+    return process(blockStartTimeS, sampleDurS, forceN, numSamples, commandedN, &ForceFramer::callSink<Sink>, &sink);
   }
 
   double framePeriodS() const { return framePeriodS_; }

@@ -39,15 +39,15 @@ inline void split(double x, double framesD, int32_t& whole, float& frac) {
   const bool inside = x > -1.0 && x < framesD;  // false for NaN and +-Inf
   x = inside ? x : double(kOutside);
   double t = static_cast<double>(static_cast<int32_t>(x));  // truncation; |x| < 2^31 here
-  t -= t > x ? 1.0 : 0.0;                                    // floor, as x > -1 or x == -3
+  t -= t > x ? 1.0 : 0.0;                                   // floor, as x > -1 or x == -3
   whole = static_cast<int32_t>(t);
   frac = static_cast<float>(x - t);
 }
 
 // Pass 1. Returns whether every tap of the piece lies inside the signal.
 template <Interpolation I>
-bool splitIndices(const float* positionMm, int positionStride, double originMm, double samplesPerMm,
-                  int64_t frames, int n, Piece& p) {
+bool splitIndices(const float* positionMm, int positionStride, double originMm, double samplesPerMm, int64_t frames,
+                  int n, Piece& p) {
   const double framesD = static_cast<double>(frames);
   if (positionStride == 0) {
     int32_t w;
@@ -73,10 +73,9 @@ bool splitIndices(const float* positionMm, int positionStride, double originMm, 
     const __m128i low = _mm_set1_epi32(kTapsLeft<I>), high = _mm_set1_epi32(lastWhole);
     __m128i anyBorder = _mm_setzero_si128();
     auto pair = [&](const float* pos, __m128i& whole, __m128& frac) {
-      __m128d x = _mm_mul_pd(_mm_sub_pd(_mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(
-                                                        reinterpret_cast<const __m128i*>(pos)))),
-                                        origin),
-                             spm);
+      __m128d x = _mm_mul_pd(
+          _mm_sub_pd(_mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(pos)))), origin),
+          spm);
       const __m128d inside = _mm_and_pd(_mm_cmpgt_pd(x, minusOne), _mm_cmplt_pd(x, end));
       x = _mm_or_pd(_mm_and_pd(inside, x), _mm_andnot_pd(inside, outside));
       const __m128d r = _mm_add_pd(x, magic);
@@ -85,8 +84,8 @@ bool splitIndices(const float* positionMm, int positionStride, double originMm, 
       const __m128d floorX = _mm_sub_pd(rounded, _mm_and_pd(above, one));
       frac = _mm_cvtpd_ps(_mm_sub_pd(x, floorX));  // in the low two lanes
       // low 32 bits of r, plus the mask (-1) where rounded > x, in the low two int lanes
-      whole = _mm_add_epi32(_mm_shuffle_epi32(_mm_castpd_si128(r), 0x08),
-                            _mm_shuffle_epi32(_mm_castpd_si128(above), 0x08));
+      whole =
+          _mm_add_epi32(_mm_shuffle_epi32(_mm_castpd_si128(r), 0x08), _mm_shuffle_epi32(_mm_castpd_si128(above), 0x08));
     };
     for (; i + 4 <= n; i += 4) {
       __m128i w0, w1;
@@ -140,10 +139,11 @@ void readInside(const float* channelData, int64_t stride, const Piece& p, float*
       const __m128 frac = _mm_loadu_ps(p.frac + i);
       const __m128 half = _mm_set1_ps(0.5f);
       const __m128 c1 = _mm_mul_ps(half, _mm_sub_ps(y2, y0));
-      const __m128 c2 = _mm_sub_ps(_mm_add_ps(_mm_sub_ps(y0, _mm_mul_ps(_mm_set1_ps(2.5f), y1)),
-                                              _mm_mul_ps(_mm_set1_ps(2.f), y2)),
-                                   _mm_mul_ps(half, y3));
-      const __m128 c3 = _mm_add_ps(_mm_mul_ps(half, _mm_sub_ps(y3, y0)), _mm_mul_ps(_mm_set1_ps(1.5f), _mm_sub_ps(y1, y2)));
+      const __m128 c2 =
+          _mm_sub_ps(_mm_add_ps(_mm_sub_ps(y0, _mm_mul_ps(_mm_set1_ps(2.5f), y1)), _mm_mul_ps(_mm_set1_ps(2.f), y2)),
+                     _mm_mul_ps(half, y3));
+      const __m128 c3 =
+          _mm_add_ps(_mm_mul_ps(half, _mm_sub_ps(y3, y0)), _mm_mul_ps(_mm_set1_ps(1.5f), _mm_sub_ps(y1, y2)));
       __m128 r = _mm_add_ps(_mm_mul_ps(c3, frac), c2);
       r = _mm_add_ps(_mm_mul_ps(r, frac), c1);
       r = _mm_add_ps(_mm_mul_ps(r, frac), y1);
@@ -153,7 +153,8 @@ void readInside(const float* channelData, int64_t stride, const Piece& p, float*
     return;
   }
 #endif
-  for (int i = 0; i < n; ++i) out[i] = kernel<I>(channelData + static_cast<int64_t>(p.whole[i]) * stride, stride, p.frac[i]);
+  for (int i = 0; i < n; ++i)
+    out[i] = kernel<I>(channelData + static_cast<int64_t>(p.whole[i]) * stride, stride, p.frac[i]);
 }
 
 // Pass 2 of a piece that touches a border or the outside: padded taps per sample.
@@ -181,8 +182,8 @@ void readPadded(const SignalView& s, int channel, const Piece& p, float* out, in
 }
 
 template <Interpolation I>
-void readBlock(const SignalView& s, const float* positionMm, int positionStride, double originMm,
-               double samplesPerMm, float* const* out, int numSamples) {
+void readBlock(const SignalView& s, const float* positionMm, int positionStride, double originMm, double samplesPerMm,
+               float* const* out, int numSamples) {
   Piece p;
   for (int done = 0; done < numSamples; done += kPiece) {
     const int n = std::min(kPiece, numSamples - done);

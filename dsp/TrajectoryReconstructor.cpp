@@ -18,16 +18,17 @@ constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/Report
 
 TrajectoryMode trajectoryModeFromCode(int code) {
   switch (code) {
-    case 0: return TrajectoryMode::Hold;
-    case 2: return TrajectoryMode::Predictive;
-    default: return TrajectoryMode::Linear;
+    case 0:
+      return TrajectoryMode::Hold;
+    case 2:
+      return TrajectoryMode::Predictive;
+    default:
+      return TrajectoryMode::Linear;
   }
 }
 
 TrajectoryReconstructor::TrajectoryReconstructor(double updateRateHz, TrajectoryMode mode)
-    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : 125.0)),
-      mode_(mode),
-      nextMode_(mode) {}
+    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : 125.0)), mode_(mode), nextMode_(mode) {}
 
 void TrajectoryReconstructor::reset() {
   axes_ = {};
@@ -40,8 +41,7 @@ void TrajectoryReconstructor::reset() {
   mode_ = nextMode_;
 }
 
-void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm,
-                                        uint32_t flags) {
+void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags) {
   if (flags & kAfterLossFlag) ++reportsAfterLoss_;
   if (!std::isfinite(dxMm)) dxMm = 0.0;  // one bad report must not poison the position
   if (!std::isfinite(dyMm)) dyMm = 0.0;
@@ -65,9 +65,12 @@ double TrajectoryReconstructor::positionAt(const Axis& axis, double sinceAnchorS
   double extrapolateT = 0.0;
   double fade = 0.0;
   if (mode_ == TrajectoryMode::Predictive) {
-    if (s < kExtrapolateT) extrapolateT = std::max(0.0, s);
-    else if (s < kStaleT) extrapolateT = kExtrapolateT;
-    else if (s < kStaleT + kFadeT) extrapolateT = kExtrapolateT * (1.0 - (s - kStaleT) / kFadeT);
+    if (s < kExtrapolateT)
+      extrapolateT = std::max(0.0, s);
+    else if (s < kStaleT)
+      extrapolateT = kExtrapolateT;
+    else if (s < kStaleT + kFadeT)
+      extrapolateT = kExtrapolateT * (1.0 - (s - kStaleT) / kFadeT);
   }
   if (mode_ != TrajectoryMode::Hold && s < 1.0) fade = 1.0 - std::max(0.0, s);
   if (extrapolateT == 0.0 && fade == 0.0) return axis.anchorMm;  // exactly the reported sum
@@ -100,15 +103,13 @@ void TrajectoryReconstructor::take(const Pending& report, double nowS) {
   ++reportsTaken_;
 }
 
-void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples,
-                                     double originMm, float* xMm, float* yMm, float* vxMmPerS,
-                                     float* vyMmPerS) {
+void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples, double originMm, float* xMm,
+                                     float* yMm, float* vxMmPerS, float* vyMmPerS) {
   render(startTimeS, sampleDurS, numSamples, originMm, 0.0, xMm, yMm, vxMmPerS, vyMmPerS);
 }
 
-void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples,
-                                     double originXMm, double originYMm, float* xMm, float* yMm,
-                                     float* vxMmPerS, float* vyMmPerS) {
+void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples, double originXMm,
+                                     double originYMm, float* xMm, float* yMm, float* vxMmPerS, float* vyMmPerS) {
   float* positionOut[2] = {xMm, yMm};
   float* speedOut[2] = {vxMmPerS, vyMmPerS};
   const double originMm[2] = {originXMm, originYMm};

@@ -38,8 +38,7 @@ TrajectoryMode trajectoryModeFromCode(int code);
 
 class TrajectoryReconstructor {
  public:
-  explicit TrajectoryReconstructor(double updateRateHz = 125.0,
-                                   TrajectoryMode mode = TrajectoryMode::Linear);
+  explicit TrajectoryReconstructor(double updateRateHz = 125.0, TrajectoryMode mode = TrajectoryMode::Linear);
 
   // Takes effect at the next report, so the output never jumps because of it.
   void setMode(TrajectoryMode mode) { nextMode_ = mode; }
@@ -56,11 +55,11 @@ class TrajectoryReconstructor {
   // Sample i is at startTimeS + i * sampleDurS; times should increase from call to call.
   // originMm is subtracted from x in double before the float output (y is not shifted).
   // Any output pointer may be null.
-  void render(double startTimeS, double sampleDurS, int numSamples, double originMm, float* xMm,
-              float* yMm, float* vxMmPerS, float* vyMmPerS);
+  void render(double startTimeS, double sampleDurS, int numSamples, double originMm, float* xMm, float* yMm,
+              float* vxMmPerS, float* vyMmPerS);
   // The same with an origin for each axis.
-  void render(double startTimeS, double sampleDurS, int numSamples, double originXMm,
-              double originYMm, float* xMm, float* yMm, float* vxMmPerS, float* vyMmPerS);
+  void render(double startTimeS, double sampleDurS, int numSamples, double originXMm, double originYMm, float* xMm,
+              float* yMm, float* vxMmPerS, float* vyMmPerS);
 
   double updateIntervalS() const { return intervalS_; }
   // Sum of the displacements of all reports taken so far (exact, double).

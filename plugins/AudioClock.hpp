@@ -10,8 +10,6 @@ inline double blockStartTimeS(const World* world) {
   return static_cast<double>(world->mBufCounter) * world->mFullRate.mBufLength * world->mFullRate.mSampleDur;
 }
 
-inline double blockDurationS(const World* world) {
-  return world->mFullRate.mBufLength * world->mFullRate.mSampleDur;
-}
+inline double blockDurationS(const World* world) { return world->mFullRate.mBufLength * world->mFullRate.mSampleDur; }
 
 }  // namespace kf::sc

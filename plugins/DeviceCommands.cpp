@@ -102,10 +102,14 @@ kf::HandScript handScriptOf(const CommandData* data) {
   std::vector<std::pair<double, double>> pairs;
   for (int i = 0; i + 1 < data->numValues; i += 2) pairs.emplace_back(data->values[i], data->values[i + 1]);
   switch (data->kind) {
-    case 0: return kf::HandScript::path(std::move(pairs));
-    case 1: return kf::HandScript::speeds(std::move(pairs));
-    case 2: return kf::HandScript::constantForce(data->numValues > 0 ? data->values[0] : 0.0);
-    default: return kf::HandScript::none();
+    case 0:
+      return kf::HandScript::path(std::move(pairs));
+    case 1:
+      return kf::HandScript::speeds(std::move(pairs));
+    case 2:
+      return kf::HandScript::constantForce(data->numValues > 0 ? data->values[0] : 0.0);
+    default:
+      return kf::HandScript::none();
   }
 }
 
@@ -227,13 +231,13 @@ bool statusStage(World*, void* raw) {  // NRT
     return true;
   }
   const kf::TelemetrySnapshot t = data->device->telemetry();
-  Print("kfStatus %d: %s, reports %llu (interval %.3f ms, jitter %.3f ms), frames %llu, "
-        "last force %.4f N, watchdog trips %llu, queue overflows %llu/%llu\n",
-        data->index, data->device->isLockstep() ? "lockstep" : "realtime",
-        static_cast<unsigned long long>(t.reports), t.reportIntervalMeanS * 1e3, t.reportIntervalJitterS * 1e3,
-        static_cast<unsigned long long>(t.frames), t.lastCommandedForceN,
-        static_cast<unsigned long long>(t.watchdogTrips), static_cast<unsigned long long>(t.reportQueueOverflows),
-        static_cast<unsigned long long>(t.frameQueueOverflows));
+  Print(
+      "kfStatus %d: %s, reports %llu (interval %.3f ms, jitter %.3f ms), frames %llu, "
+      "last force %.4f N, watchdog trips %llu, queue overflows %llu/%llu\n",
+      data->index, data->device->isLockstep() ? "lockstep" : "realtime", static_cast<unsigned long long>(t.reports),
+      t.reportIntervalMeanS * 1e3, t.reportIntervalJitterS * 1e3, static_cast<unsigned long long>(t.frames),
+      t.lastCommandedForceN, static_cast<unsigned long long>(t.watchdogTrips),
+      static_cast<unsigned long long>(t.reportQueueOverflows), static_cast<unsigned long long>(t.frameQueueOverflows));
   auto line = [&](const char* what, const kf::LatencySummary& l) {
     if (l.count > 0)
       Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu)\n", data->index, what, l.p50S * 1e3,

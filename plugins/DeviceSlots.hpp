@@ -18,8 +18,8 @@ constexpr int kNumDeviceSlots = 16;
 constexpr int kMaxReportsPerBlock = 256;
 
 struct SlotView {
-  Device* device = nullptr;     // null: closed or never opened
-  uint32_t generation = 0;      // changes whenever the slot's device does
+  Device* device = nullptr;              // null: closed or never opened
+  uint32_t generation = 0;               // changes whenever the slot's device does
   const MouseReport* reports = nullptr;  // this block's reports, in order
   int numReports = 0;
 };

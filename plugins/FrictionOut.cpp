@@ -41,7 +41,8 @@ class FrictionOut : public SCUnit {
     const double deviceNowS = device->nowS();
     const double framePeriodS = device->spec().forceFramePeriodS;
     auto sink = [&](double frameTimeS, float forceN) {
-      device->pushForceFrame(kf::ForceFrame{frameTimeS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
+      device->pushForceFrame(
+          kf::ForceFrame{frameTimeS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
     };
     const double sampleDurS = 1.0 / sampleRate();
     if (isAudioRateIn(kForceN)) {
@@ -49,7 +50,8 @@ class FrictionOut : public SCUnit {
     } else {
       // A control-rate force is held over the block.
       const float heldN = in0(kForceN);
-      for (int i = 0; i < numSamples; ++i) mFramer.process(startS + i * sampleDurS, sampleDurS, &heldN, 1, out(0) + i, sink);
+      for (int i = 0; i < numSamples; ++i)
+        mFramer.process(startS + i * sampleDurS, sampleDurS, &heldN, 1, out(0) + i, sink);
     }
   }
 

@@ -37,8 +37,10 @@ void postFromRt(World* world, const char* format, ...) {
 }
 
 void clearUnitOnAllocFailure(Unit* unit, const char* ugenName) {
-  postFromRt(unit->mWorld, "%s: RT memory allocation failed; the UGen outputs silence. "
-                           "Raise ServerOptions.memSize.\n", ugenName);
+  postFromRt(unit->mWorld,
+             "%s: RT memory allocation failed; the UGen outputs silence. "
+             "Raise ServerOptions.memSize.\n",
+             ugenName);
   unit->mCalcFunc = reinterpret_cast<UnitCalcFunc>(ft->fClearUnitOutputs);
   ft->fClearUnitOutputs(unit, 1);
   unit->mDone = true;

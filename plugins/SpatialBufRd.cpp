@@ -60,8 +60,7 @@ class SpatialBufRd : public SCUnit {
     if (problem == mProblem) return;
     mProblem = problem;
     if (problem == BufferProblem::NotAllocated)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n",
-                         mBufnum);
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n", mBufnum);
     else if (problem == BufferProblem::ChannelMismatch)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.\n",
                          mBufnum, buf->channels, static_cast<int>(mNumOutputs));

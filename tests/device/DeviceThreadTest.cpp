@@ -12,8 +12,7 @@
 using namespace kf;
 using namespace std::chrono_literals;
 
-TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, telemetry",
-          "[thread]") {
+TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, telemetry", "[thread]") {
   const DeviceSpec spec;
   auto sim = std::make_shared<SimDevice>(spec, SimParams{}, HandScript::speeds({{100.0, 5.0}}));
   auto sink = std::make_shared<CountingForceSink>();
@@ -112,7 +111,6 @@ TEST_CASE("factory rejects unusable specs and scripts", "[thread]") {
   std::string error;
   CHECK_FALSE(openSimDevice(spec, SimParams{}, HandScript::none(), true, &error));
   CHECK(error.find("spec") != std::string::npos);
-  CHECK_FALSE(openSimDevice(DeviceSpec{}, SimParams{}, HandScript::path({{1.0, 0.0}, {0.5, 3.0}}),
-                            true, &error));
+  CHECK_FALSE(openSimDevice(DeviceSpec{}, SimParams{}, HandScript::path({{1.0, 0.0}, {0.5, 3.0}}), true, &error));
   CHECK(error.find("hand") != std::string::npos);
 }

@@ -55,8 +55,7 @@ TEST_CASE("hid-recorder file of a real mouse: header and descriptor", "[hid]") {
   CHECK(recording.events[1].timeS == Approx(0.025885));
 
   HidReportDescriptor descriptor;
-  REQUIRE(parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(),
-                                   descriptor, error));
+  REQUIRE(parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(), descriptor, error));
   CHECK(descriptor.usesReportIds);
   CHECK(descriptor.inputReportBytes(1) == 8);
   HidMouseDecoder decoder;
@@ -69,8 +68,7 @@ TEST_CASE("hid-recorder reports decode to hand-decoded counts", "[hid]") {
   std::string error;
   REQUIRE(readHidRecorderFile(KF_HID_RECORDING, recording, error));
   HidReportDescriptor descriptor;
-  REQUIRE(parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(),
-                                   descriptor, error));
+  REQUIRE(parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(), descriptor, error));
   HidMouseDecoder decoder;
   REQUIRE(decoder.build(descriptor, error));
 

@@ -39,8 +39,8 @@ inline ReconstructionResult reconstructAgainstSim(const HandScript& hand, double
     }
     const int n = sim.pollReports(startS + blockSize * dt, reports, 256);
     for (int i = 0; i < n; ++i)
-      trajectory.addReport(reports[i].deviceTimeS, reports[i].dxCounts * spec.countMm, reports[i].dyCounts * spec.countMm,
-                           reports[i].flags);
+      trajectory.addReport(reports[i].deviceTimeS, reports[i].dxCounts * spec.countMm,
+                           reports[i].dyCounts * spec.countMm, reports[i].flags);
     trajectory.render(startS, dt, blockSize, 0.0, x.data(), nullptr, nullptr, nullptr);
     rendered.insert(rendered.end(), x.begin(), x.end());
   }

@@ -19,7 +19,8 @@ std::vector<Movement> movements() {
   return {
       {"slow, 10 mm/s", HandScript::speeds({{10.0, 3.0}}), 3.0},
       {"fast, 250 mm/s", HandScript::speeds({{250.0, 1.0}}), 1.0},
-      {"reversing, +-30 mm at 1 Hz", HandScript::path({{0, 0}, {0.5, 30}, {1.0, 0}, {1.5, 30}, {2.0, 0}, {2.5, 30}}), 2.5},
+      {"reversing, +-30 mm at 1 Hz", HandScript::path({{0, 0}, {0.5, 30}, {1.0, 0}, {1.5, 30}, {2.0, 0}, {2.5, 30}}),
+       2.5},
   };
 }
 

@@ -28,8 +28,7 @@ std::vector<MouseReport> runLockstep(Device& device, double endS) {
     device.pushForceFrame({timeS - 0.001, 0.14f + 0.3f * static_cast<float>((ms / 100) % 2)});
     device.pump(timeS);
     int n = 0;
-    while ((n = device.popReports(buffer, 16)) > 0)
-      reports.insert(reports.end(), buffer, buffer + n);
+    while ((n = device.popReports(buffer, 16)) > 0) reports.insert(reports.end(), buffer, buffer + n);
   }
   return reports;
 }
@@ -44,8 +43,7 @@ TEST_CASE("record then replay gives identical reports", "[record]") {
   params.dropProbability = 0.05;
   params.clockDriftPpm = -30.0;
   std::string error;
-  auto recorded =
-      openSimDevice(spec, params, HandScript::speeds({{120.0, 0.6}, {-400.0, 0.4}}), true, &error);
+  auto recorded = openSimDevice(spec, params, HandScript::speeds({{120.0, 0.6}, {-400.0, 0.4}}), true, &error);
   REQUIRE(recorded);
   REQUIRE(recorded->startRecording(path, error));
   const auto original = runLockstep(*recorded, 1.0);

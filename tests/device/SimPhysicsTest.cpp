@@ -16,8 +16,7 @@ TEST_CASE("constant push above friction accelerates at (F - f) / m", "[sim]") {
   const double accelerationMPerS2 = (pushN - direction * spec.minForceN) / params.puckMassKg;
   for (double timeS : {0.1, 0.25, 0.5}) {
     sim.advanceTo(timeS);
-    CHECK(sim.positionMm() ==
-          Approx(0.5 * accelerationMPerS2 * timeS * timeS * 1000.0).epsilon(1e-6));
+    CHECK(sim.positionMm() == Approx(0.5 * accelerationMPerS2 * timeS * timeS * 1000.0).epsilon(1e-6));
     CHECK(sim.speedMmPerS() == Approx(accelerationMPerS2 * timeS * 1000.0).epsilon(1e-6));
   }
 }
@@ -116,8 +115,7 @@ TEST_CASE("stick/slip settles without chattering", "[sim]") {
   sim.advanceTo(1.0);
   const double restMm = sim.positionMm();
   CHECK(sim.speedMmPerS() == 0.0);
-  CHECK(std::fabs(20.0 - restMm) <=
-        spec.minForceN / SimParams{}.handStiffnessNPerM * 1000.0 + 1e-9);
+  CHECK(std::fabs(20.0 - restMm) <= spec.minForceN / SimParams{}.handStiffnessNPerM * 1000.0 + 1e-9);
   int signChanges = 0;
   double lastSpeed = 0.0;
   for (int i = 1; i <= 1000; ++i) {
@@ -151,7 +149,6 @@ TEST_CASE("the simulator is deterministic bit for bit", "[sim]") {
   const auto second = run();
   REQUIRE(first.first.size() == second.first.size());
   REQUIRE(!first.first.empty());
-  CHECK(std::memcmp(first.first.data(), second.first.data(),
-                    first.first.size() * sizeof(MouseReport)) == 0);
+  CHECK(std::memcmp(first.first.data(), second.first.data(), first.first.size() * sizeof(MouseReport)) == 0);
   CHECK(std::memcmp(&first.second, &second.second, sizeof(double)) == 0);
 }

@@ -40,9 +40,8 @@ TEST_CASE("device thread with producer, consumer, telemetry reader and recording
       std::this_thread::sleep_for(5ms);
     }
   });
-  const std::string path =
-      std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/kf-tsan-" +
-      std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".kfsession";
+  const std::string path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") + "/kf-tsan-" +
+                           std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".kfsession";
   std::string error;
   std::this_thread::sleep_for(100ms);
   REQUIRE(device->startRecording(path, error));

@@ -2,8 +2,8 @@
 // of +-200 ppm, gaps, restarts, and mapped time never going backward.
 #include <catch2/catch.hpp>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -13,9 +13,9 @@ using kf::DeviceClockMapper;
 
 namespace {
 
-constexpr double kReportS = 0.008;              // 125 Hz
-constexpr double kBlockS = 64.0 / 48000.0;      // arrivals are seen at audio block starts
-constexpr double kLatencyS = 0.003;             // true latency: device -> earliest arrival
+constexpr double kReportS = 0.008;          // 125 Hz
+constexpr double kBlockS = 64.0 / 48000.0;  // arrivals are seen at audio block starts
+constexpr double kLatencyS = 0.003;         // true latency: device -> earliest arrival
 
 // A device clock against the audio clock: audio = device * (1 + ppm) + offset.
 struct Link {
@@ -96,9 +96,8 @@ TEST_CASE("DeviceClockMapper: follows the floor under jitter and +-200 ppm drift
   // blocks repeats the same phase, so the floor itself is seen only as drift walks the phase.
   for (double ppm : {-200.0, -100.0, -20.0, 0.0, 5.0, 20.0, 100.0, 200.0}) {
     const Stats st = run(ppm, 600.0);
-    INFO("ppm " << ppm << ": error " << st.lowestS * 1e3 << " .. " << st.highestS * 1e3
-                << " ms, largest step " << st.largestStepS * 1e3 << " ms, largest 1 s spread "
-                << st.largestSpreadS * 1e3 << " ms");
+    INFO("ppm " << ppm << ": error " << st.lowestS * 1e3 << " .. " << st.highestS * 1e3 << " ms, largest step "
+                << st.largestStepS * 1e3 << " ms, largest 1 s spread " << st.largestSpreadS * 1e3 << " ms");
     CHECK(st.increasing);
     // Never much before the floor, never later than the jitter (1.73 ms) allows.
     CHECK(st.lowestS > -1e-4);
@@ -156,8 +155,7 @@ TEST_CASE("DeviceClockMapper: a device clock jumping forward resets it", "[clock
   link.offsetS -= 30.0;  // device time 30 s ahead of where it was: arrival - device drops 30 s
   for (int k = 0; k < 500; ++k) {
     const double deviceS = 44.0 + k * kReportS;
-    const double errorS = mapper.map(deviceS, link.arrivalS(deviceS)) -
-                          (link.trueAudioS(deviceS) + kLatencyS);
+    const double errorS = mapper.map(deviceS, link.arrivalS(deviceS)) - (link.trueAudioS(deviceS) + kLatencyS);
     CHECK(errorS > -1e-4);
     CHECK(errorS < 1.8e-3);
   }

@@ -36,8 +36,8 @@ const Rate kRates[] = {{44100, 441, 10}, {48000, 48, 1}, {96000, 96, 1}, {192000
 // Runs `signal(sampleIndex)` through a framer in blocks of `blockSize`, block start times
 // computed from the integer sample count (as the plugin does).
 template <class Signal>
-std::vector<Frame> runFramer(ForceFramer& framer, int64_t sampleRateHz, int64_t numSamples,
-                             int blockSize, Signal signal, std::vector<float>* commanded = nullptr) {
+std::vector<Frame> runFramer(ForceFramer& framer, int64_t sampleRateHz, int64_t numSamples, int blockSize,
+                             Signal signal, std::vector<float>* commanded = nullptr) {
   std::vector<Frame> frames;
   Collect sink{&frames};
   std::vector<float> block(blockSize), out(blockSize);
@@ -45,8 +45,8 @@ std::vector<Frame> runFramer(ForceFramer& framer, int64_t sampleRateHz, int64_t 
   for (int64_t start = 0; start < numSamples; start += blockSize) {
     const int n = static_cast<int>(std::min<int64_t>(blockSize, numSamples - start));
     for (int i = 0; i < n; ++i) block[i] = signal(start + i);
-    framer.process(static_cast<double>(start) / static_cast<double>(sampleRateHz), durS,
-                   block.data(), n, out.data(), sink);
+    framer.process(static_cast<double>(start) / static_cast<double>(sampleRateHz), durS, block.data(), n, out.data(),
+                   sink);
     if (commanded) commanded->insert(commanded->end(), out.begin(), out.begin() + n);
   }
   return frames;
@@ -147,8 +147,7 @@ TEST_CASE("ForceFramer: each frame's mean is clamped to the device range", "[fra
   CHECK(frames[3].forceN == Approx(1.0).epsilon(1e-6));
 }
 
-TEST_CASE("ForceFramer: commanded output is the last completed frame, from its last sample",
-          "[framer]") {
+TEST_CASE("ForceFramer: commanded output is the last completed frame, from its last sample", "[framer]") {
   for (int blockSize : {1, 10, 64, 1024}) {
     ForceFramer framer(0.001, 0.14, 1.4);
     std::vector<float> commanded;
@@ -190,13 +189,11 @@ TEST_CASE("ForceFramer: block sizes 1..1024 give the same frames", "[framer]") {
   std::uniform_int_distribution<int> sizes(1, 1024);
   for (size_t start = 0; start < noise.size();) {
     const int n = static_cast<int>(std::min<size_t>(sizes(rng), noise.size() - start));
-    framer.process(static_cast<double>(start) / 44100.0, 1.0 / 44100.0, noise.data() + start, n,
-                   nullptr, sink);
+    framer.process(static_cast<double>(start) / 44100.0, 1.0 / 44100.0, noise.data() + start, n, nullptr, sink);
     start += n;
   }
   REQUIRE(frames.size() == expected.size());
-  for (size_t k = 0; k < frames.size(); ++k)
-    CHECK(frames[k].forceN == Approx(expected[k].forceN).margin(1e-6));
+  for (size_t k = 0; k < frames.size(); ++k) CHECK(frames[k].forceN == Approx(expected[k].forceN).margin(1e-6));
 }
 
 TEST_CASE("ForceFramer: no drift over 10^7 frames", "[framer][long]") {
@@ -226,8 +223,7 @@ TEST_CASE("ForceFramer: no drift over 10^7 frames", "[framer][long]") {
   for (int64_t start = 0; start < numSamples; start += 1024) {
     const int n = static_cast<int>(std::min<int64_t>(1024, numSamples - start));
     for (int i = 0; i < n; ++i) block[i] = square(start + i);
-    framer.process(static_cast<double>(start) / 11025.0, 1.0 / 11025.0, block.data(), n, nullptr,
-                   check);
+    framer.process(static_cast<double>(start) / 11025.0, 1.0 / 11025.0, block.data(), n, nullptr, check);
   }
   CHECK(check.count == numFrames);  // the last frame ends exactly on the last sample
   CHECK(check.wrongTimes == 0);

@@ -28,7 +28,8 @@ struct Reference {
   std::deque<double> window;
   int n;
   FrictionMapping mapping;
-  explicit Reference(int windowSamples, FrictionMapping m = {}) : window(windowSamples, 0.0), n(windowSamples), mapping(m) {}
+  explicit Reference(int windowSamples, FrictionMapping m = {})
+      : window(windowSamples, 0.0), n(windowSamples), mapping(m) {}
   double operator()(float a) {
     double x = std::isfinite(a) ? std::fabs(double(a)) : (std::isnan(a) ? 0.0 : 1e30);
     window.push_back(x);
@@ -114,7 +115,8 @@ TEST_CASE("per-sample agreement with equations (1) and (2) at 44.1 to 192 kHz") 
     Noise noise;
     std::vector<float> in(3000);
     // Noise whose level sweeps through the whole clip range and beyond.
-    for (size_t i = 0; i < in.size(); ++i) in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
+    for (size_t i = 0; i < in.size(); ++i)
+      in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
     auto out = runCore(c, in);
     for (size_t i = 0; i < in.size(); ++i) REQUIRE(out[i] == Approx(ref(in[i])).margin(1e-6));
   }
@@ -141,7 +143,8 @@ TEST_CASE("denormals and tiny levels read as loForce") {
   Core c(192);
   c.core.setWindowSamples(192);
   std::vector<float> in(2000);
-  for (size_t i = 0; i < in.size(); ++i) in[i] = (i % 2 ? 1 : -1) * std::numeric_limits<float>::denorm_min() * (1 + i % 7);
+  for (size_t i = 0; i < in.size(); ++i)
+    in[i] = (i % 2 ? 1 : -1) * std::numeric_limits<float>::denorm_min() * (1 + i % 7);
   for (float f : runCore(c, in)) REQUIRE(f == 0.14f);
 }
 
@@ -254,7 +257,8 @@ TEST_CASE("fast logarithm: worst error over the clip range, and when it is not u
     // Log-spaced levels from -31 to +1 dB, plus the exact bounds and their float neighbours.
     for (int i = 0; i < count; ++i) in[i] = static_cast<float>(std::pow(10.0, (-31.0 + 32.0 * i / (count - 1)) / 20.0));
     const float lo = static_cast<float>(std::pow(10.0, -1.5));
-    for (float x : {lo, std::nextafter(lo, 0.f), std::nextafter(lo, 1.f), 1.f, std::nextafter(1.f, 0.f), std::nextafter(1.f, 2.f)})
+    for (float x : {lo, std::nextafter(lo, 0.f), std::nextafter(lo, 1.f), 1.f, std::nextafter(1.f, 0.f),
+                    std::nextafter(1.f, 2.f)})
       in.push_back(x), out.push_back(0.f);
     c.core.process(in.data(), out.data(), static_cast<int>(in.size()));
     double worst = 0;
@@ -287,7 +291,8 @@ TEST_CASE("fast logarithm: worst error over the clip range, and when it is not u
 TEST_CASE("block sizes, in-place processing and tiny rings give the same forces") {
   Noise noise;
   std::vector<float> in(5000);
-  for (size_t i = 0; i < in.size(); ++i) in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
+  for (size_t i = 0; i < in.size(); ++i)
+    in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
   for (int maxWindow : {1, 3, 48, 200, 1000}) {
     const int n = std::max(1, maxWindow * 2 / 3);
     std::vector<float> whole;

@@ -17,8 +17,8 @@ namespace {
 
 // Catmull-Rom in its matrix form, written independently of the kernel under test.
 double catmullRom(double t, double y0, double y1, double y2, double y3) {
-  return 0.5 * (2 * y1 + (-y0 + y2) * t + (2 * y0 - 5 * y1 + 4 * y2 - y3) * t * t +
-                (-y0 + 3 * y1 - 3 * y2 + y3) * t * t * t);
+  return 0.5 *
+         (2 * y1 + (-y0 + y2) * t + (2 * y0 - 5 * y1 + 4 * y2 - y3) * t * t + (-y0 + 3 * y1 - 3 * y2 + y3) * t * t * t);
 }
 
 std::vector<float> ramp(int n) {
@@ -132,7 +132,8 @@ TEST_CASE("samplesPerMm: zero, negative and huge are well defined") {
   auto v = ramp(64);
   SignalView s{v.data(), 64, 1};
   SECTION("zero holds the first sample wherever the puck is") {
-    for (double p : {-5.0, 0.0, 3.3, 1e6}) CHECK(readSpatial(s, 0, kf::spatialIndex(p, 0, 0), Interpolation::Cubic) == v[0]);
+    for (double p : {-5.0, 0.0, 3.3, 1e6})
+      CHECK(readSpatial(s, 0, kf::spatialIndex(p, 0, 0), Interpolation::Cubic) == v[0]);
   }
   SECTION("negative lays the signal out to the left of the origin") {
     CHECK(kf::spatialIndex(-2.0, 0.0, -4.0) == 8.0);
@@ -169,9 +170,9 @@ TEST_CASE("the block reader equals the per-sample reader bit for bit") {
     // Positions (mm, origin 2, 4 samples/mm): inside, at and across both borders, far outside,
     // non-finite, in runs long enough for whole inside pieces and mixed pieces.
     std::vector<float> pos;
-    for (int i = 0; i < 300; ++i) pos.push_back(static_cast<float>(2.0 + 0.03 * i));         // inside
-    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(1.5 + 0.0137 * i));       // index -2 .. 9
-    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(2.0 + 8.6 + 0.0071 * i)); // 34.4 .. 40
+    for (int i = 0; i < 300; ++i) pos.push_back(static_cast<float>(2.0 + 0.03 * i));          // inside
+    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(1.5 + 0.0137 * i));        // index -2 .. 9
+    for (int i = 0; i < 200; ++i) pos.push_back(static_cast<float>(2.0 + 8.6 + 0.0071 * i));  // 34.4 .. 40
     for (float x : {nan, inf, -inf, 1e30, -1e30, 2.0 - 0.25, 2.0 - 0.2499, 2.0 + 9.25, 2.0 + 9.2499})
       pos.push_back(static_cast<float>(x));
     for (int i = 0; i < 100; ++i) pos.push_back(static_cast<float>(2.0 + 0.09 * i));

@@ -20,8 +20,7 @@ constexpr double kCountMm = 0.021;
 constexpr double kRateHz = 125.0;
 constexpr double kIntervalS = 1.0 / kRateHz;
 constexpr double kPi = 3.14159265358979323846;
-const TrajectoryMode kModes[] = {TrajectoryMode::Hold, TrajectoryMode::Linear,
-                                 TrajectoryMode::Predictive};
+const TrajectoryMode kModes[] = {TrajectoryMode::Hold, TrajectoryMode::Linear, TrajectoryMode::Predictive};
 
 using Motion = std::function<double(double)>;  // true x (mm) at time t (s)
 
@@ -49,8 +48,8 @@ struct Rendered {
 };
 
 // Lockstep delivery: before each block, every report timed before the block's end is added.
-Rendered renderReports(TrajectoryMode mode, const std::vector<Report>& reports, double durationS,
-                       double sampleRateHz, int blockSize, double originMm = 0.0) {
+Rendered renderReports(TrajectoryMode mode, const std::vector<Report>& reports, double durationS, double sampleRateHz,
+                       int blockSize, double originMm = 0.0) {
   TrajectoryReconstructor rec(kRateHz, mode);
   Rendered out;
   const double durS = 1.0 / sampleRateHz;
@@ -65,8 +64,7 @@ Rendered renderReports(TrajectoryMode mode, const std::vector<Report>& reports, 
       rec.addReport(reports[next].timeS, reports[next].dxMm, 0.0);
       ++next;
     }
-    rec.render(startS, durS, n, originMm, out.xMm.data() + start, nullptr,
-               out.vxMmPerS.data() + start, nullptr);
+    rec.render(startS, durS, n, originMm, out.xMm.data() + start, nullptr, out.vxMmPerS.data() + start, nullptr);
   }
   for (int64_t i = 0; i < total; ++i) out.timeS.push_back(i * durS);
   return out;
@@ -132,9 +130,8 @@ TEST_CASE("TrajectoryReconstructor: error and lag against a known trajectory", "
     const Score hold = score(TrajectoryMode::Hold, c.x, 3.0);
     const Score linear = score(TrajectoryMode::Linear, c.x, 3.0);
     const Score predictive = score(TrajectoryMode::Predictive, c.x, 3.0);
-    INFO(c.name << ": rms mm / lag ms: hold " << hold.rmsMm << " / " << hold.lagMs << ", linear "
-                << linear.rmsMm << " / " << linear.lagMs << ", predictive " << predictive.rmsMm
-                << " / " << predictive.lagMs);
+    INFO(c.name << ": rms mm / lag ms: hold " << hold.rmsMm << " / " << hold.lagMs << ", linear " << linear.rmsMm
+                << " / " << linear.lagMs << ", predictive " << predictive.rmsMm << " / " << predictive.lagMs);
     // The paper's linear interpolation lags by about one update interval (8 ms).
     CHECK(linear.lagMs == Approx(8.0).margin(1.0));
     CHECK(hold.lagMs == Approx(4.0).margin(1.0));
@@ -159,12 +156,10 @@ TEST_CASE("TrajectoryReconstructor: ends exactly on the sum of the displacements
         sumX += cx * kCountMm;
         sumY += cy * kCountMm;
         for (; sample * durS < k * kIntervalS; sample += blockSize)
-          rec.render(sample * durS, durS, blockSize, originMm, x.data(), y.data(), vx.data(),
-                     vy.data());
+          rec.render(sample * durS, durS, blockSize, originMm, x.data(), y.data(), vx.data(), vy.data());
       }
       for (int i = 0; i < 10; ++i, sample += blockSize)  // let the last one play out
-        rec.render(sample * durS + 4 * kIntervalS, durS, blockSize, originMm, x.data(), y.data(),
-                   vx.data(), vy.data());
+        rec.render(sample * durS + 4 * kIntervalS, durS, blockSize, originMm, x.data(), y.data(), vx.data(), vy.data());
       INFO("mode " << int(mode) << " block " << blockSize);
       CHECK(rec.reportedXMm() == sumX);
       CHECK(rec.renderedXMm() == sumX);
@@ -194,8 +189,8 @@ TEST_CASE("TrajectoryReconstructor: several reports in one block", "[trajectory]
     // start + i * dur in one case and (start + i) * dur in the other, an ulp apart.)
     double worst = 0.0;
     for (size_t i = 1; i + 1 < r.xMm.size(); ++i) {
-      const double oneSample = std::max(std::fabs(fine.xMm[i] - fine.xMm[i - 1]),
-                                        std::fabs(fine.xMm[i + 1] - fine.xMm[i]));
+      const double oneSample =
+          std::max(std::fabs(fine.xMm[i] - fine.xMm[i - 1]), std::fabs(fine.xMm[i + 1] - fine.xMm[i]));
       worst = std::max(worst, std::fabs(r.xMm[i] - fine.xMm[i]) - oneSample);
     }
     CHECK(worst < 1e-5);
@@ -211,7 +206,7 @@ TEST_CASE("TrajectoryReconstructor: several reports in one block", "[trajectory]
   std::vector<float> out(4800);
   for (int k = 0; k < 10; ++k) rec.addReport(0.01, 0.5, 0.0);
   rec.render(0.0, 1.0 / 48000, 4800, 0.0, out.data(), nullptr, nullptr, nullptr);
-  CHECK(out[479] == 0.0f);  // before 10 ms
+  CHECK(out[479] == 0.0f);                                  // before 10 ms
   CHECK(maxStep(out) < 5.0 / (kIntervalS * 48000) * 1.01);  // 5 mm over one interval
   CHECK(out.back() == 5.0f);
   CHECK(rec.reportsTaken() == 10);
@@ -287,8 +282,7 @@ TEST_CASE("TrajectoryReconstructor: zero-count reports, flags, bad values", "[tr
     for (int k = 2; k <= 20; ++k) rec.addReport(k * kIntervalS, 0.0, 0.0, k == 5 ? 2u : 0u);
     rec.addReport(0.2, std::nan(""), INFINITY);
     std::vector<float> x(48000 / 4), y(x.size()), vx(x.size()), vy(x.size());
-    rec.render(0.0, 1.0 / 48000, static_cast<int>(x.size()), 0.0, x.data(), y.data(), vx.data(),
-               vy.data());
+    rec.render(0.0, 1.0 / 48000, static_cast<int>(x.size()), 0.0, x.data(), y.data(), vx.data(), vy.data());
     INFO("mode " << int(mode));
     CHECK(allFinite(x));
     CHECK(allFinite(vx));
@@ -319,8 +313,7 @@ TEST_CASE("TrajectoryReconstructor: switching mode never jumps", "[trajectory]")
   CHECK(maxStep(out) < 130.0 * 2.0 / 48000);
 }
 
-TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 minutes",
-          "[trajectory][long]") {
+TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 minutes", "[trajectory][long]") {
   // The device clock runs 100 ppm fast against audio; reports reach the audio side at the
   // next 64-sample block after 3 ms + 0..0.4 ms. Mapped times feed the reconstructor.
   const Motion x = [](double t) {
@@ -341,8 +334,7 @@ TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 
     double nextArrivalS = 0.0, nextDeviceS = kIntervalS;
     auto scheduleNext = [&]() {
       nextDeviceS = k * kIntervalS;
-      nextArrivalS = std::ceil((audioOfDevice(nextDeviceS) + 0.003 + queueS(rng)) / (block * durS)) *
-                     (block * durS);
+      nextArrivalS = std::ceil((audioOfDevice(nextDeviceS) + 0.003 + queueS(rng)) / (block * durS)) * (block * durS);
     };
     scheduleNext();
     double worstErrorMm = 0.0, worstStepMm = 0.0, lastX = 0.0, worstSpeed = 0.0;
@@ -376,9 +368,8 @@ TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 
       }
       if (start % 48000 == 0 && blockS > 30.0) driftSum += mapper.driftPpm(), ++driftCount;
     }
-    INFO("mode " << int(mode) << ": worst error " << worstErrorMm << " mm, worst step "
-                 << worstStepMm << " mm, reset " << mapper.resetCount() << ", mean drift "
-                 << driftSum / driftCount << " ppm");
+    INFO("mode " << int(mode) << ": worst error " << worstErrorMm << " mm, worst step " << worstStepMm << " mm, reset "
+                 << mapper.resetCount() << ", mean drift " << driftSum / driftCount << " ppm");
     CHECK(finite);
     CHECK(mapper.resetCount() == 0);
     CHECK(driftSum / driftCount == Approx(-100.0).margin(10.0));  // the loop's drift, averaged
