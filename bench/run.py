@@ -2,8 +2,10 @@
 """KineticFriction speed-against-error benchmarks: builds what it needs, runs everything, prints
 the ratios with their errors, and writes bench/REPORT.md plus PNG plots into bench/.
 
-    /usr/bin/python3 bench/run.py                 # everything (about 3-4 minutes on 2 cores)
-    /usr/bin/python3 bench/run.py --only timing   # one part: build, log, timing, spatial, loudness, drift
+    scripts/bench.sh                              # scripts/setup.sh (install, build), then this
+    /usr/bin/python3 bench/run.py                 # everything (about 7 minutes on 2 cores, build excluded)
+    /usr/bin/python3 bench/run.py --only timing   # one part (repeatable): build, log, timing, spatial,
+                                                  # loudness, drift, reconstruction, e2e, scale
 
 Parts:
   log       bench/log_choice.cpp: the logarithm of equation (2), std::log10 against faster ones
@@ -12,7 +14,15 @@ Parts:
             the KFBenchClock UGen (wall and thread CPU time per block, written to the file)
   spatial   error of SpatialBufRd and BufRd against the exact signal and the exact index
   loudness  error of the three loudness-to-force chains against equations (1) and (2) in double
-  drift     the same error after a long render (default 20 minutes of audio)
+  drift     the same error after a long render (default 20 minutes of audio), and the Catch2 test
+            `no drift: 10^9 samples ...` of build/tests/dsp_tests (the core alone, 10^9 samples)
+  reconstruction  build/bench/kf_reconstruction_bench: FrictionMouseIn's modes (hold, linear,
+            predictive) against the simulated puck's true trajectory: lag, RMS error, CPU
+  e2e       realtime: scsynth on `jackd -d dummy` (48 kHz, period 64), a FrictionPilot on
+            FrictionDevice.sim for 10 s (twice), then kfStatus: loop period, report-to-UGen and
+            force-to-magnet latencies (bench/rt_bench.py, through tests/realtime/rt.py)
+  scale     realtime: voices of the pilot chain on one simulated device, added stepwise until
+            scsynth misses periods, at 48 and 192 kHz (bench/rt_bench.py)
 """
 import argparse
 import json
@@ -40,7 +50,7 @@ SYSTEM_PLUGIN_DIR = "/usr/lib/SuperCollider/plugins"
 SR = 48000
 BLOCK = 64
 T0 = time.monotonic()
-PARTS = ["build", "log", "timing", "spatial", "loudness", "drift"]
+PARTS = ["build", "log", "timing", "spatial", "loudness", "drift", "reconstruction", "e2e", "scale"]
 
 
 def log(msg):
@@ -65,19 +75,42 @@ class Env:
     def log_choice_exe(self):
         return self.build / "bench" / "kf_log_choice"
 
+    def cache_value(self, key, default=None):
+        cache = self.build / "CMakeCache.txt"
+        if cache.exists():
+            for line in cache.read_text().splitlines():
+                if line.startswith(key + ":"):
+                    return line.split("=", 1)[1]
+        return default
+
+    def extension_dir(self):
+        return Path(self.cache_value("KF_EXTENSION_DIR", str(self.build / "KineticFriction")))
+
+    def tests_enabled(self):
+        return (self.cache_value("KF_TESTS", "ON") or "ON").upper() in ("ON", "1", "TRUE", "YES")
+
 
 def build(env):
+    """The targets the bench runs, in the build folder scripts/setup.sh makes (configured the same
+    way if it is not there yet), and the extension folder the realtime parts load."""
     if not (env.build / "CMakeCache.txt").exists():
-        log(f"configuring {env.build}")
-        subprocess.run(["cmake", "-S", str(ROOT), "-B", str(env.build), "-DKF_TESTS=OFF"], check=True,
+        log(f"configuring {env.build} (as scripts/setup.sh does)")
+        subprocess.run(["cmake", "-S", str(ROOT), "-B", str(env.build), "-DCMAKE_BUILD_TYPE=Release"], check=True,
                        stdout=subprocess.DEVNULL)
-    log("building KineticFriction, KFBenchClock, kf_log_choice (-j2)")
-    proc = subprocess.run(["cmake", "--build", str(env.build), "-j2", "--target", "KineticFriction", "KFBenchClock",
-                           "kf_log_choice"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    targets = ["KineticFriction", "KFBenchClock", "kf_log_choice", "kf_reconstruction_bench"]
+    if env.tests_enabled():
+        targets.append("dsp_tests")
+    log(f"building {', '.join(targets)} (-j2)")
+    proc = subprocess.run(["cmake", "--build", str(env.build), "-j2", "--target"] + targets,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     if proc.returncode != 0:
         print(proc.stdout[-4000:])
-        raise SystemExit("build failed (if bench/ is not yet in the top-level CMakeLists.txt, add "
-                         "`if(KF_WITH_SC AND EXISTS ${PROJECT_SOURCE_DIR}/bench/CMakeLists.txt) add_subdirectory(bench) endif()`)")
+        raise SystemExit("build failed")
+    proc = subprocess.run(["cmake", "--install", str(env.build)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True)
+    if proc.returncode != 0:
+        print(proc.stdout[-4000:])
+        raise SystemExit("cmake --install failed")
 
 
 def prepare_classes(env):
@@ -114,7 +147,7 @@ def run_sclang(env, code, timeout=300):
 
 def render(env, score, out, channels, sample_format="float", timeout=900):
     cmd = ["scsynth", "-N", str(score), "_", str(out), str(SR), "WAV", sample_format, "-o", str(channels), "-i", "0",
-           "-z", str(BLOCK), "-U", env.plugin_path(), "-m", "262144", "-a", "1024"]
+           "-z", str(BLOCK), "-U", env.plugin_path(), "-m", "262144", "-a", "1024", "-w", "1024"]
     t = time.monotonic()
     proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           timeout=timeout, text=True, errors="replace")
@@ -139,6 +172,10 @@ PILOT_PERIOD = 100
 MAPPINGS = [4000, 500, 8]  # samples per mm, Table 1
 SPEEDS = [100, 100, 334]   # mm/s the positions sweep at, per mapping
 ORIGIN = 10.0              # mm, as a synth control in both chains
+# The speeds of the error grid: the device's slowest step (2.6 mm/s) to its fastest (334 mm/s).
+GRID_SPEEDS = [2.6, 20, 100, 334]
+GRID = [(spm, v) for spm in MAPPINGS for v in GRID_SPEEDS]
+SPATIAL_S = 4.0
 LTF_N = 48                 # round(48000 * 0.001)
 
 # The per-instance SynthDefs of the timing phases. `bus`, `spm` and `origin` are controls, so
@@ -220,7 +257,10 @@ Score(score.asArray).writeOSCFile({sc_str(env.work / 'timing.osc')});
 
 
 def spatial_score_code(env, seconds):
-    # Channels: for each case, [position, spat1, spat2, spat4, bufrd1, bufrd2, bufrd4].
+    # Channels: for each case, [position, spat1, spat2, spat4, bufrd1, bufrd2, bufrd4]. The grid
+    # cases first (each mapping at each speed), then far origin and long buffer.
+    grid_spms = [spm for spm, _ in GRID]
+    grid_speeds = [v for _, v in GRID]
     return f"""
 // ---- spatial accuracy
 {{
@@ -229,14 +269,19 @@ var readers = {{ |buf, pos, spm, origin|
           ++ [1, 2, 4].collect {{ |interp| BufRd.ar(1, buf, (pos - origin) * spm, 0, interp) }}
 }};
 var def = SynthDef(\\kfb_spatial, {{
-    var pilot = {POSITIONS_SC};
-    var spms = [\\spm0.kr({MAPPINGS[0]}), \\spm1.kr({MAPPINGS[1]}), \\spm2.kr({MAPPINGS[2]})], origin = \\origin.kr({ORIGIN});
+    // A triangle at the case's speed over the middle of the signal: all of it (-2 %..102 %) if
+    // one cycle of {seconds} s gets there, else as far as one cycle does.
+    var pilot = {grid_spms}.collect {{ |spm, k|
+        var len = {PILOT_FRAMES} / spm, speed = {grid_speeds}[k], a = min(len * 0.52, speed * {seconds} / 4);
+        {ORIGIN} + (len * 0.5) + (a * LFTri.ar(speed / (4 * a), k % 4))
+    }};
+    var spms = \\spms.kr({grid_spms}), origin = \\origin.kr({ORIGIN});
     var farOrigin = \\farOrigin.kr(1000), farSpm = \\farSpm.kr(4000), longSpm = \\longSpm.kr(4000), zero = \\zero.kr(0);
     // far from the origin: 1000 mm + a 100 mm/s sweep over the 6 mm signal
     var farPos = farOrigin + 3 + (3.1 * LFTri.ar(100 / (2 * 6.2)));
     // a long buffer: index about 1e7 (2500 mm at 4000 samples/mm), a slow +-0.45 mm sweep
     var longPos = 2500 + (0.45 * LFTri.ar(0.5));
-    Out.ar(0, 3.collect {{ |k| readers.(0, pilot[k], spms[k], origin) }}.flatten
+    Out.ar(0, {len(GRID)}.collect {{ |k| readers.(0, pilot[k], spms[k], origin) }}.flatten
         ++ readers.(1, farPos, farSpm, farOrigin) ++ readers.(2, longPos, longSpm, zero));
 }});
 var score = [
@@ -340,6 +385,14 @@ def analyse_timing(env, order, instances, phase_s, settle_s=0.25, tail_s=0.05):
                 entry[f"{clock}-{base_label}"] = {"median": float(np.median(r)), "min": float(np.min(r)),
                                                   "max": float(np.max(r)), "all": r}
         res["ratios"][label] = entry
+    # Every reader against BufRd cubic (the reference of the speed-against-error plot).
+    res["vs_bufrd4"] = {}
+    for name in ("spat1", "spat2", "spat4", "bufrd1", "bufrd2", "bufrd4"):
+        entry = {}
+        for base_label, base in (("empty", "empty"), ("source", "srcpos")):
+            r = [(xa - xe) / (xb - xe) for xa, xb, xe in zip(per[name]["cpu"], per["bufrd4"]["cpu"], per[base]["cpu"])]
+            entry[f"cpu-{base_label}"] = {"median": float(np.median(r)), "min": float(np.min(r)), "max": float(np.max(r))}
+        res["vs_bufrd4"][name] = entry
     return res
 
 
@@ -376,7 +429,7 @@ def analyse_spatial(env):
     data = data[BLOCK:]  # the first block holds the constructors' initial values
     pilot = soundfile.read(str(env.work / "pilot.wav"), dtype="float32")[0]
     res = {"pilot": {}, "index": {}}
-    cases = [(f"pilot {spm} samples/mm", k * 7, spm, ORIGIN) for k, spm in enumerate(MAPPINGS)]
+    cases = [(f"pilot {spm} samples/mm, {v} mm/s", k * 7, spm, ORIGIN) for k, (spm, v) in enumerate(GRID)]
     for label, c, spm, origin in cases:
         pos = data[:, c].astype(np.float64)
         idx = (pos - np.float64(np.float32(origin))) * np.float64(np.float32(spm))  # what the UGen was given, exactly
@@ -394,14 +447,17 @@ def analyse_spatial(env):
                     "max_vs_double_read": float(e_same.max()), "rms_vs_double_read": float(np.sqrt(np.mean(e_same ** 2)))}
         res["pilot"][label] = entry
         res["pilot"][label]["samples"] = int(inside.sum())
+        res["pilot"][label]["spm"] = spm
+        res["pilot"][label]["speed"] = GRID[c // 7][1]
     # Index precision on the mod-16 ramp: the output of a linear or cubic read is the index mod 16
     # wherever the taps do not straddle a wrap; none gives floor(index) mod 16.
-    for label, c, spm, origin in (("far origin: 1000 mm + x, 4000 samples/mm", 21, 4000, 1000.0),
-                                  ("long buffer: index ~1e7, 4000 samples/mm", 28, 4000, 0.0)):
+    g = 7 * len(GRID)
+    for label, c, spm, origin in (("far origin: 1000 mm + x, 4000 samples/mm", g, 4000, 1000.0),
+                                  ("long buffer: index ~1e7, 4000 samples/mm", g + 7, 4000, 0.0)):
         pos = data[:, c].astype(np.float64)
         idx = (pos - origin) * spm
         r = np.floor(idx) % 16
-        ok = (r >= 1) & (r <= 13) & (idx >= 1) & (idx <= (PILOT_FRAMES if c == 21 else 12_000_000) - 3)
+        ok = (r >= 1) & (r <= 13) & (idx >= 1) & (idx <= (PILOT_FRAMES if c == g else 12_000_000) - 3)
         entry = {"index_min": float(idx.min()), "index_max": float(idx.max()),
                  "position_ulp_mm": float(np.spacing(np.float32(np.abs(pos).max()))),
                  "index_step_from_position_ulp": float(np.spacing(np.float32(np.abs(pos).max())) * spm)}
@@ -472,6 +528,63 @@ def run_log_choice(env):
                 row[k] = float(v)
             rows.append(row)
     return {"rows": rows, "stdout": proc.stdout}
+
+
+DRIFT_TEST = "no drift: 10^9 samples of white noise against a double recomputation"
+
+
+def run_drift_test(env):
+    """The Catch2 test of the LoudnessToFriction core over 10^9 samples (n = 192, noise at about
+    -18 dB, compared with a double recomputation every 10^8 samples); its INFO line holds the
+    worst error."""
+    exe = env.build / "tests" / "dsp_tests"
+    if not exe.exists():
+        log(f"{exe} not built (KF_TESTS off): skipping the 10^9-sample drift test")
+        return None
+    t = time.monotonic()
+    proc = subprocess.run([str(exe), DRIFT_TEST, "-s"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    wall = time.monotonic() - t
+    m = re.search(r"worst \|error\| ([-+0-9.eE]+) N", proc.stdout)
+    if proc.returncode != 0 or not m:
+        raise SystemExit(f"drift test failed ({proc.returncode}):\n{proc.stdout[-3000:]}")
+    return {"worst_n": float(m.group(1)), "samples": 1_000_000_000, "wall_s": wall,
+            "command": f"{exe.relative_to(ROOT) if exe.is_relative_to(ROOT) else exe} \"{DRIFT_TEST}\" -s"}
+
+
+def run_reconstruction(env, runs=3):
+    """kf_reconstruction_bench `runs` times: accuracy is deterministic (the simulated puck), the
+    CPU per sample is the median of each run's five interleaved rounds; the spread is over runs."""
+    exe = env.build / "bench" / "kf_reconstruction_bench"
+    outs = []
+    for _ in range(runs):
+        proc = subprocess.run([str(exe)], stdout=subprocess.PIPE, text=True, check=True)
+        outs.append(json.loads(proc.stdout))
+    res = {"accuracy": outs[0]["accuracy"], "runs": runs,
+           "cpu_runs": {mode: [o["cpuNsPerSample"][mode] for o in outs] for mode in outs[0]["cpuNsPerSample"]},
+           "deterministic": all(o["accuracy"] == outs[0]["accuracy"] for o in outs)}
+    res["cpu"] = {mode: float(np.median(v)) for mode, v in res["cpu_runs"].items()}
+    return res
+
+
+def reconstruction_goal(rc):
+    """Predictive lag <= 0.5x linear (the paper's mode) at no more than linear's RMS error, for
+    every movement."""
+    rows = {}
+    for r in rc["accuracy"]:
+        rows.setdefault(r["movement"], {})[r["mode"]] = r
+    checks = []
+    for movement, m in rows.items():
+        p, lin = m["predictive"], m["linear"]
+        lag_ratio = p["lagMs"] / lin["lagMs"] if lin["lagMs"] > 0 else float("inf")
+        checks.append({"movement": movement, "lag_ratio": lag_ratio, "pred_lag_ms": p["lagMs"],
+                       "lin_lag_ms": lin["lagMs"], "pred_rms_mm": p["rmsErrorMm"], "lin_rms_mm": lin["rmsErrorMm"],
+                       "met": lag_ratio <= 0.5 and p["rmsErrorMm"] <= lin["rmsErrorMm"]})
+    return checks
+
+
+def summarize_runs(values):
+    v = [x for x in values if x is not None]
+    return {"median": float(np.median(v)), "min": float(np.min(v)), "max": float(np.max(v))} if v else None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -548,6 +661,113 @@ def plot_log_choice(lc, path):
     plt.close(fig)
 
 
+READERS = [("spat1", "SpatialBufRd none"), ("spat2", "SpatialBufRd linear"), ("spat4", "SpatialBufRd cubic"),
+           ("bufrd1", "BufRd none"), ("bufrd2", "BufRd linear"), ("bufrd4", "BufRd cubic")]
+
+
+def plot_spatial_tradeoff(tm, sp, path):
+    """CPU against error: each reader's CPU ratio to BufRd cubic (median over rounds, bars: min..max)
+    against its max error vs the continuous signal, one point per mapping and speed."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), sharey=True)
+    markers = {MAPPINGS[0]: "o", MAPPINGS[1]: "s", MAPPINGS[2]: "^"}
+    for ax, stat in zip(axes, ("max_vs_signal", "rms_vs_signal")):
+        for j, (name, label) in enumerate(READERS):
+            r = tm["vs_bufrd4"][name]["cpu-empty"]
+            color = f"C{j}"
+            for entry in sp["pilot"].values():
+                e = entry[label][stat]
+                jitter = 1 + 0.012 * (GRID_SPEEDS.index(entry["speed"]) - 1.5)
+                ax.errorbar(r["median"] * jitter, max(e, 1e-9), xerr=[[r["median"] - r["min"]], [r["max"] - r["median"]]],
+                            fmt=markers[entry["spm"]], color=color, ms=5, elinewidth=0.6, alpha=0.8,
+                            label=label if entry is next(iter(sp["pilot"].values())) else None)
+        ax.set_yscale("log")
+        ax.set_xlabel("CPU per sample / BufRd cubic (median over rounds, min..max)")
+        ax.set_title(("max" if stat.startswith("max") else "rms") + " |error| vs the continuous sine", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("|error| (full scale 1)")
+    axes[0].legend(fontsize=7, loc="lower left")
+    axes[1].text(0.02, 0.02, "o 4000, s 500, ^ 8 samples/mm;\nspeeds 2.6, 20, 100, 334 mm/s left to right",
+                 transform=axes[1].transAxes, fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_reconstruction(rc, path):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    movements = list(dict.fromkeys(r["movement"] for r in rc["accuracy"]))
+    modes = ["hold", "linear", "predictive"]
+    w = 0.27
+    for k, mode in enumerate(modes):
+        rows = {r["movement"]: r for r in rc["accuracy"] if r["mode"] == mode}
+        x = np.arange(len(movements)) + (k - 1) * w
+        axes[0].bar(x, [rows[m]["lagMs"] for m in movements], w, color=f"C{k}", label=mode)
+        axes[1].bar(x, [rows[m]["rmsErrorMm"] for m in movements], w, color=f"C{k}",
+                    label=f"{mode} ({rc['cpu'][mode]:.1f} ns/sample)")
+    for ax, ylabel in zip(axes, ("lag (ms)", "RMS position error (mm)")):
+        ax.set_xticks(range(len(movements)))
+        ax.set_xticklabels(movements, fontsize=8)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3, axis="y")
+    axes[1].set_yscale("log")
+    axes[0].legend(fontsize=8)
+    axes[1].legend(fontsize=8)
+    fig.suptitle("FrictionMouseIn reconstruction against the simulated puck's true trajectory", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_e2e(e2e, path):
+    what = [("loop period", "1 kHz loop period"), ("report to UGen", "report -> UGen"),
+            ("force to magnet", "force -> magnet")]
+    fig, ax = plt.subplots(figsize=(9, 4))
+    for i, (key, label) in enumerate(what):
+        for j, run in enumerate(e2e["runs"]):
+            x = i + (j - (len(e2e["runs"]) - 1) / 2) * 0.2
+            v = run[key]
+            ax.plot([x, x], [v["p50_ms"], v["max_ms"]], color="0.6", lw=1)
+            ax.plot(x, v["p50_ms"], "o", color="C0", label="p50" if i == j == 0 else None)
+            ax.plot(x, v["p99_ms"], "s", color="C3", label="p99" if i == j == 0 else None)
+            ax.plot(x, v["max_ms"], "v", color="k", label="max" if i == j == 0 else None)
+    ax.axhline(1.0 + BLOCK / SR * 1e3, color="C3", ls="--", lw=0.8, label="force goal: 1 ms + one block")
+    ax.axhline(1.2, color="C2", ls=":", lw=0.8, label="loop goal: 1 ms + 200 us (p99)")
+    ax.set_xticks(range(len(what)))
+    ax.set_xticklabels([w[1] for w in what])
+    ax.set_yscale("log")
+    ax.set_ylabel("ms")
+    ax.set_title(f"realtime, jackd dummy 48 kHz / 64, FrictionPilot on FrictionDevice.sim, {len(e2e['runs'])} runs", fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_scale(scale, path):
+    fig, axes = plt.subplots(1, len(scale), figsize=(5.5 * len(scale), 4), squeeze=False)
+    for ax, (rate, sc) in zip(axes[0], scale.items()):
+        st = sorted(sc["steps"], key=lambda r: r["voices"])
+        v = [r["voices"] for r in st]
+        ax.plot(v, [r["avg_cpu"] for r in st], "o-", color="C0", label="scsynth avg CPU %")
+        ax.plot(v, [r["peak_cpu"] for r in st], "s", color="C1", ms=4, label="scsynth peak CPU %")
+        ax2 = ax.twinx()
+        ax2.bar(v, [max(r["client_xruns"], 0.5) for r in st], width=max(v) * 0.015, color="C3", alpha=0.5,
+                label="xruns in the window")
+        ax2.axhline(sc["xrun_limit"], color="C3", ls="--", lw=0.8)
+        ax2.set_yscale("log")
+        ax2.set_ylabel("JACK: scsynth not finished (per window)", color="C3", fontsize=8)
+        ax.axvline(sc["max_without_xrun"], color="k", ls=":", lw=0.8)
+        ax.set_xlabel("voices")
+        ax.set_ylabel("%")
+        ax.set_title(f"{int(rate) // 1000} kHz: {sc['max_without_xrun']} voices before the first failing step", fontsize=10)
+        ax.legend(fontsize=7, loc="upper left")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def summary_lines(results):
     """The lines run.py prints at the end and REPORT.md quotes."""
     lines = []
@@ -562,11 +782,19 @@ def summary_lines(results):
                          f"wall {w['median']:.3f}x  | source subtracted: CPU {cs['median']:.3f}x [{cs['min']:.3f}..{cs['max']:.3f}]")
         lines.append("  CPU ns per instance-sample (median, minus the empty phase): " + ", ".join(
             f"{n} {np.median(v):.2f}" for n, v in tm["ns"]["cpu"].items()))
+        if "vs_bufrd4" in tm:
+            lines.append("  CPU / BufRd cubic: " + ", ".join(
+                f"{label} {tm['vs_bufrd4'][n]['cpu-empty']['median']:.3f}x "
+                f"[{tm['vs_bufrd4'][n]['cpu-empty']['min']:.3f}..{tm['vs_bufrd4'][n]['cpu-empty']['max']:.3f}]"
+                for n, label in READERS if n != "bufrd4"))
     if sp:
-        for label, entry in sp["pilot"].items():
-            s, b = entry["SpatialBufRd cubic"], entry["BufRd cubic"]
-            lines.append(f"error {label}, cubic: SpatialBufRd max {fmt(s['max_vs_signal'])} (vs double read {fmt(s['max_vs_double_read'])}), "
-                         f"BufRd max {fmt(b['max_vs_signal'])} (vs double read {fmt(b['max_vs_double_read'])})")
+        for spm in MAPPINGS:
+            entries = [e for e in sp["pilot"].values() if e.get("spm") == spm]
+            if not entries:
+                continue
+            parts = [f"{label} {fmt(max(e[label]['max_vs_signal'] for e in entries))}" for _, label in READERS]
+            lines.append(f"error vs signal, max over {', '.join(str(e['speed']) for e in entries)} mm/s at {spm} samples/mm: "
+                         + ", ".join(parts))
         for label, entry in sp["index"].items():
             parts = []
             for k in ("cubic", "linear"):
@@ -582,6 +810,30 @@ def summary_lines(results):
         for name in dr["first"]:
             lines.append(f"drift {name:20s} after {dr['minutes']} min: max {fmt(dr['last'][name]['max_n'])} N "
                          f"(first {dr.get('capture_s', 2)} s: {fmt(dr['first'][name]['max_n'])} N)")
+    dt = results.get("drift_test")
+    if dt:
+        lines.append(f"drift LoudnessToFriction core after 10^9 samples (Catch2, n = 192): worst {fmt(dt['worst_n'])} N")
+    rc = results.get("reconstruction")
+    if rc:
+        for r in rc["accuracy"]:
+            lines.append(f"reconstruction {r['movement']:26s} {r['mode']:10s} lag {r['lagMs']:6.3f} ms, "
+                         f"rms error {r['rmsErrorMm']:.5f} mm")
+        lines.append("reconstruction CPU ns/sample (median of runs [min..max]): " + ", ".join(
+            f"{m} {rc['cpu'][m]:.2f} [{min(v):.2f}..{max(v):.2f}]" for m, v in rc["cpu_runs"].items()))
+    e2e = results.get("e2e")
+    if e2e:
+        for key in ("loop period", "report to UGen", "force to magnet"):
+            vals = "; ".join(f"p50 {r[key]['p50_ms']:.3f} p99 {r[key]['p99_ms']:.3f} max {r[key]['max_ms']:.3f}"
+                             for r in e2e["runs"])
+            lines.append(f"realtime {key:16s} (ms, per run): {vals}")
+        lines.append("realtime xruns reported by jackd during the runs: " + ", ".join(
+            str(r["client_xruns"]) for r in e2e["runs"]))
+    scale = results.get("scale")
+    if scale:
+        for rate, sc in scale.items():
+            lines.append(f"scale {int(rate) // 1000} kHz: {sc['max_without_xrun']} voices without missed periods, "
+                         f"first failing step {sc['first_with_xrun']} voices"
+                         + (f" (runs: {', '.join(str(x) for x in sc['all_runs'])})" if sc.get("all_runs") else ""))
     lc = results.get("log")
     if lc:
         for r in lc["rows"]:
@@ -592,25 +844,63 @@ def summary_lines(results):
     return lines
 
 
+FORCE_GOAL_MS = 1.0 + BLOCK / SR * 1e3  # 1 ms frames + one audio block
+JITTER_GOAL_MS = 0.2
+
+
 def goals(results):
+    """Every goal with its measured value: MET / NOT MET, or NOT MEASURED when its part did not run."""
     out = []
     tm, sp, ld = results.get("timing"), results.get("spatial"), results.get("loudness")
     if tm and sp:
-        r = tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-empty"]["median"]
+        e = tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-empty"]
         rs = tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-source"]["median"]
         long = sp["index"]["long buffer: index ~1e7, 4000 samples/mm"]
-        exact = long["SpatialBufRd cubic"]["max_index_error"] < 1e-3 <= long["BufRd cubic"]["max_index_error"]
-        met = r <= 0.8 and exact
-        out.append(f"SpatialBufRd <= 0.8x BufRd (cubic), exact index where BufRd's is not: "
-                   f"{'MET' if met else 'NOT MET'} (ratio {r:.3f}x, {rs:.3f}x with the source subtracted; index error "
+        worst = max(en["SpatialBufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values())
+        worst_b = max(en["BufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values())
+        met = e["median"] <= 0.8
+        out.append(f"SpatialBufRd cubic <= 0.8x BufRd cubic: {'MET' if met else 'NOT MET'} (CPU {e['median']:.3f}x "
+                   f"[{e['min']:.3f}..{e['max']:.3f}] over rounds, {rs:.3f}x with the source subtracted; max error vs "
+                   f"the signal {fmt(worst)} against BufRd's {fmt(worst_b)}; index error at ~1e7 "
                    f"{fmt(long['SpatialBufRd cubic']['max_index_error'])} vs {fmt(long['BufRd cubic']['max_index_error'])} samples)")
+    else:
+        out.append("SpatialBufRd cubic <= 0.8x BufRd cubic: NOT MEASURED (run --only timing --only spatial)")
     if tm and ld:
-        r = tm["ratios"]["LoudnessToFriction/RunningSum chain"]["cpu-empty"]["median"]
+        e = tm["ratios"]["LoudnessToFriction/RunningSum chain"]["cpu-empty"]
         rs = tm["ratios"]["LoudnessToFriction/RunningSum chain"]["cpu-source"]["median"]
-        e = ld["errors"]["LoudnessToFriction"]["max_n"]
-        met = r <= 0.5 and e <= 1e-6
-        out.append(f"LoudnessToFriction <= 0.5x the chain at <= 1e-6 N: {'MET' if met else 'NOT MET'} "
-                   f"(ratio {r:.3f}x, {rs:.3f}x with the source subtracted; max error {fmt(e)} N)")
+        err = ld["errors"]["LoudnessToFriction"]["max_n"]
+        met = e["median"] <= 0.5 and err <= 1e-6
+        out.append(f"LoudnessToFriction <= 0.5x the RunningSum chain at <= 1e-6 N: {'MET' if met else 'NOT MET'} "
+                   f"(CPU {e['median']:.3f}x [{e['min']:.3f}..{e['max']:.3f}], {rs:.3f}x with the source subtracted; "
+                   f"max error {fmt(err)} N)")
+    else:
+        out.append("LoudnessToFriction <= 0.5x the chain at <= 1e-6 N: NOT MEASURED")
+    rc = results.get("reconstruction")
+    if rc:
+        checks = reconstruction_goal(rc)
+        met = all(c["met"] for c in checks)
+        out.append("predictive lag <= 0.5x linear (the paper's mode) at <= its RMS error: "
+                   f"{'MET' if met else 'NOT MET'} (" + "; ".join(
+                       f"{c['movement']}: lag {c['pred_lag_ms']:.3f} vs {c['lin_lag_ms']:.3f} ms = {c['lag_ratio']:.3f}x, "
+                       f"rms {c['pred_rms_mm']:.4f} vs {c['lin_rms_mm']:.4f} mm" for c in checks) + ")")
+    else:
+        out.append("predictive lag <= 0.5x linear at <= its RMS error: NOT MEASURED")
+    e2e = results.get("e2e")
+    if e2e:
+        p99 = [r["force to magnet"]["p99_ms"] for r in e2e["runs"]]
+        mx = [r["force to magnet"]["max_ms"] for r in e2e["runs"]]
+        out.append(f"force latency (frame end -> magnet) p99 <= 1 ms + one block = {FORCE_GOAL_MS:.2f} ms: "
+                   f"{'MET' if max(p99) <= FORCE_GOAL_MS else 'NOT MET'} (p99 {', '.join(f'{v:.3f}' for v in p99)} ms "
+                   f"in {len(p99)} runs; max {', '.join(f'{v:.3f}' for v in mx)} ms)")
+        jit = [r["loop period"]["p99_ms"] - 1.0 for r in e2e["runs"]]
+        pmax = [r["loop period"]["max_ms"] for r in e2e["runs"]]
+        out.append(f"1 kHz loop jitter p99 <= 200 us (period p99 - 1 ms): "
+                   f"{'MET' if max(jit) <= JITTER_GOAL_MS else 'NOT MET'} "
+                   f"({', '.join(f'{v * 1e3:.0f}' for v in jit)} us in {len(jit)} runs; period max "
+                   f"{', '.join(f'{v:.3f}' for v in pmax)} ms)")
+    else:
+        out.append("force latency <= 1 ms + one block: NOT MEASURED")
+        out.append("loop jitter p99 <= 200 us: NOT MEASURED")
     return out
 
 
@@ -623,7 +913,7 @@ def notes(results):
     r = tm["ratios"]
     logs = {row["name"]: row for row in lc["rows"]}
     cur, ln = logs["std::log10 (double)"], logs["std::log (double) * log10(e), the exact path"]
-    pilot = sp["pilot"][f"pilot {MAPPINGS[0]} samples/mm"]
+    pilot = sp["pilot"][f"pilot {MAPPINGS[0]} samples/mm, 100 mm/s"]
     long = sp["index"]["long buffer: index ~1e7, 4000 samples/mm"]
     far = sp["index"]["far origin: 1000 mm + x, 4000 samples/mm"]
     return ["## What the numbers say", "",
@@ -641,8 +931,8 @@ def notes(results):
             "in the same operations and order as `cubicHermite`, so the output equals the per-sample reader bit for "
             "bit (tests/dsp/test_spatial_reader.cpp checks it). Most of what is left is the index pass (double "
             "arithmetic two lanes wide on SSE2), which is why none, where BufRd's own work is smallest, stays at "
-            "about BufRd's cost. On this shared VM the absolute ns move between runs by up to 1.5x (BufRd cubic "
-            "4.1..6.5 ns); the ratios of one render are what to compare.",
+            "about BufRd's cost. On this shared VM absolute ns move a lot between runs (see Repeatability); "
+            "the ratios of one render are what to compare.",
             f"- **Index precision.** In the pilot at {MAPPINGS[0]} samples/mm (origin {ORIGIN} mm) BufRd's float "
             f"`(pos - origin) * spm` costs {fmt(pilot['BufRd cubic']['max_vs_double_read'])} of amplitude against a "
             f"double read of the same buffer; SpatialBufRd {fmt(pilot['SpatialBufRd cubic']['max_vs_double_read'])}. "
@@ -681,17 +971,209 @@ def notes(results):
             "The timing input's level sweeps -40..+6 dB once per measured window (about 65 % of samples inside).", ""]
 
 
+def key_numbers(results):
+    """The headline numbers, with their spread inside this run where there is one:
+    label -> (value, spread text)."""
+    k = {}
+    tm = results.get("timing")
+    if tm:
+        for label in ("SpatialBufRd/BufRd cubic", "SpatialBufRd/BufRd linear", "SpatialBufRd/BufRd none",
+                      "LoudnessToFriction/RunningSum chain", "LoudnessToFriction/Amplitude chain"):
+            e = tm["ratios"][label]["cpu-empty"]
+            k[f"CPU {label}"] = (e["median"], f"{e['min']:.3f}..{e['max']:.3f} over {tm['rounds']} rounds")
+        if "vs_bufrd4" in tm:
+            for n, label in READERS[:2]:
+                e = tm["vs_bufrd4"][n]["cpu-empty"]
+                k[f"CPU {label}/BufRd cubic"] = (e["median"], f"{e['min']:.3f}..{e['max']:.3f} over {tm['rounds']} rounds")
+    sp = results.get("spatial")
+    if sp:
+        k["max error SpatialBufRd cubic vs signal"] = (max(en["SpatialBufRd cubic"]["max_vs_signal"]
+                                                        for en in sp["pilot"].values()), "deterministic render")
+    ld = results.get("loudness")
+    if ld:
+        k["max error LoudnessToFriction (N)"] = (ld["errors"]["LoudnessToFriction"]["max_n"],
+                                                 "8 s of WhiteNoise: a new seed each render")
+    dt = results.get("drift_test")
+    if dt:
+        k["drift after 10^9 samples (N)"] = (dt["worst_n"], "deterministic")
+    rc = results.get("reconstruction")
+    if rc:
+        for m in ("linear", "predictive"):
+            v = rc["cpu_runs"][m]
+            k[f"reconstruction CPU {m} (ns/sample)"] = (rc["cpu"][m], f"{min(v):.2f}..{max(v):.2f} over {len(v)} runs")
+        r = [p / q for p, q in zip(rc["cpu_runs"]["predictive"], rc["cpu_runs"]["linear"])]
+        k["reconstruction CPU predictive/linear"] = (float(np.median(r)), f"{min(r):.3f}..{max(r):.3f} over {len(r)} runs")
+        for c in reconstruction_goal(rc):
+            k[f"predictive/linear lag, {c['movement']}"] = (c["lag_ratio"], "deterministic (simulated puck)")
+    e2e = results.get("e2e")
+    if e2e:
+        for key in ("loop period", "report to UGen", "force to magnet"):
+            v = [r[key]["p99_ms"] for r in e2e["runs"]]
+            k[f"realtime {key} p99 (ms)"] = (float(np.median(v)), f"{min(v):.3f}..{max(v):.3f} over {len(v)} runs")
+    sc = results.get("scale")
+    if sc:
+        for rate, e in sc.items():
+            runs = e.get("all_runs", [e["max_without_xrun"]])
+            k[f"voices at {int(rate) // 1000} kHz"] = (e["max_without_xrun"], f"{min(runs)}..{max(runs)} over {len(runs)} searches")
+    return k
+
+
+def repeatability_lines(results):
+    prev = results.get("previous")
+    cur = key_numbers(results)
+    L = ["## Repeatability", "",
+         "Spread inside this run (rounds of the timing render, runs of the reconstruction bench and of the "
+         "realtime scene) and the same number from the previous run of the whole bench (bench/results.json "
+         "before this run overwrote it). Error numbers of NRT renders with fixed inputs and of the simulated "
+         "puck are deterministic: they repeat exactly.", ""]
+    if not prev:
+        L += ["(no previous run recorded)", ""]
+    L += ["| number | this run | spread in this run | previous run | change |", "| --- | --- | --- | --- | --- |"]
+    pk = (prev or {}).get("keys", {})
+    for label, (v, spread) in cur.items():
+        p = pk.get(label)
+        pv = p[0] if p else None
+        change = f"{100 * (v - pv) / pv:+.1f} %" if pv not in (None, 0) else ""
+        L.append(f"| {label} | {fmt(v, 4)} | {spread} | {fmt(pv, 4) if pv is not None else ''} | {change} |")
+    if prev:
+        def changes(pred):
+            out = []
+            for label, (v, _) in cur.items():
+                p = pk.get(label)
+                if pred(label) and p and p[0]:
+                    out.append(abs(v - p[0]) / abs(p[0]))
+            return f"{100 * max(out):.0f} %" if out else "(not in the previous run)"
+        inside = []
+        for label, (v, spread) in cur.items():
+            p = pk.get(label)
+            m = re.match(r"([-0-9.e+]+)\.\.([-0-9.e+]+) over", spread)
+            if p and m and label.startswith("CPU "):
+                inside.append(float(m.group(1)) <= p[0] <= float(m.group(2)))
+        L += ["", f"Previous run: {prev.get('date', '?')}. Between the two runs: the timing render's CPU ratios moved "
+              f"by up to {changes(lambda x: x.startswith('CPU '))} ({sum(inside)} of {len(inside)} previous values "
+              "inside this run's min..max over rounds); absolute ns per sample (the reconstruction bench) by up to "
+              f"{changes(lambda x: x.endswith('(ns/sample)'))} while its predictive/linear ratio moved "
+              f"{changes(lambda x: x == 'reconstruction CPU predictive/linear')}; realtime p99 latencies by up to "
+              f"{changes(lambda x: x.startswith('realtime'))}; voices by up to "
+              f"{changes(lambda x: x.startswith('voices'))}. This 2-core VM's speed changes between runs "
+              "(neighbours, frequency): compare the ratios of one run, not absolute ns across runs."]
+    L.append("")
+    return L
+
+
+def extra_sections(results, cmd):
+    L = []
+    dt = results.get("drift_test")
+    if dt:
+        L += ["## Drift after 10^9 samples", "", f"`{dt['command']}` (also `{cmd} --only drift`)", "",
+              "The Catch2 test runs the LoudnessToFriction core (n = 192, the paper's 1 ms at 192 kHz) over 10^9 "
+              "samples of white noise at about -18 dB (inside the clip range) in blocks of 4096, and every 10^8 "
+              "samples compares the output with equations (1) and (2) recomputed in double from the last n inputs "
+              f"(and the running mean with the exact mean to 1e-12 relative). Worst error over the checks: "
+              f"**{fmt(dt['worst_n'])} N** (the float output's rounding is about 3e-8 N); {dt['wall_s']:.1f} s.", ""]
+    rc = results.get("reconstruction")
+    if rc:
+        checks = reconstruction_goal(rc)
+        L += ["## FrictionMouseIn: reconstruction modes against the true trajectory", "",
+              f"`build/bench/kf_reconstruction_bench` (source bench/reconstruction_bench.cpp; `{cmd} --only "
+              "reconstruction`; plot: `reconstruction.png`)", "", "![reconstruction](reconstruction.png)", "",
+              "The simulated device (the paper profile: 125 Hz reports, 0.021 mm counts) is driven by a hand "
+              "script; the reconstructed x at audio rate (48 kHz) is compared with the simulated puck's true x. Lag: "
+              "the shift of the reconstruction that best matches the truth; RMS error: without any shift (what the "
+              "ear and hand get); at lag: after removing the lag. CPU: ns per rendered sample of "
+              "`TrajectoryReconstructor::render`, reports arriving as at 250 mm/s, median of 5 interleaved rounds "
+              f"per run, {rc['runs']} runs (median [min..max]).", "",
+              "| movement | mode | lag (ms) | RMS error (mm) | RMS error at lag (mm) | max step (mm) |",
+              "| --- | --- | --- | --- | --- | --- |"]
+        for r in rc["accuracy"]:
+            L.append(f"| {r['movement']} | {r['mode']} | {r['lagMs']:.3f} | {r['rmsErrorMm']:.5f} | "
+                     f"{r['rmsErrorAtLagMm']:.5f} | {r['maxStepMm']:.5f} |")
+        L += ["", "| mode | CPU ns/sample | [min..max] over runs | / linear |", "| --- | --- | --- | --- |"]
+        for m, v in rc["cpu_runs"].items():
+            L.append(f"| {m} | {rc['cpu'][m]:.2f} | {min(v):.2f}..{max(v):.2f} | {rc['cpu'][m] / rc['cpu']['linear']:.3f} |")
+        met = all(c["met"] for c in checks)
+        L += ["", f"Goal: predictive reconstruction at least halves the paper mode's (linear) lag at no more than "
+              f"its RMS error: **{'MET' if met else 'NOT MET'}** for " + "; ".join(
+                  f"{c['movement']} ({c['lag_ratio']:.3f}x the lag, {c['pred_rms_mm'] / c['lin_rms_mm']:.3f}x the RMS error)"
+                  for c in checks) + ".", ""]
+    e2e = results.get("e2e")
+    if e2e:
+        L += ["## End to end in realtime", "",
+              f"`{cmd} --only e2e` (bench/rt_bench.py through tests/realtime/rt.py; plot: `e2e.png`)", "",
+              "![e2e](e2e.png)", "",
+              "`jackd -r -d dummy -r 48000 -p 64` (rt.py's server: no realtime scheduling), scsynth booted by "
+              "sclang against it with block 64; a `FrictionPilot(0, \\mapping1)` synth (FrictionMouseIn linear -> "
+              "SpatialBufRd cubic -> LoudnessToFriction -> FrictionOut, audio delayed by 1 ms) starts on the empty "
+              "slot, then `FrictionDevice.sim` opens it with a hand pushing the puck back and forth over the 6 mm "
+              f"signal at 12 mm/s; after {e2e['seconds']:.0f} s `dev.status` posts the device thread's histograms "
+              "(10 us bins; a quantile is its bin's upper edge), counted from the open: `loop period`, the time "
+              "between two wake-ups of the device thread's 1 kHz loop (absolute schedule: a late wake-up is "
+              "followed by a short period); `report to UGen`, the device thread taking a report -> the first "
+              "FrictionMouseIn block that takes it; `force to magnet`, the end of a 1 ms force frame in "
+              "FrictionOut -> the device thread handing it to the magnet backend. Jitter is reported as the "
+              "period's p99 minus 1 ms (the late tail; the histogram's p1 is not printed by kfStatus). "
+              f"{len(e2e['runs'])} runs:", "",
+              "| run | measure | p50 (ms) | p99 (ms) | max (ms) | n |", "| --- | --- | --- | --- | --- | --- |"]
+        for i, r in enumerate(e2e["runs"]):
+            for key in ("loop period", "report to UGen", "force to magnet"):
+                v = r[key]
+                L.append(f"| {i + 1} | {key} | {v['p50_ms']:.3f} | {v['p99_ms']:.3f} | {v['max_ms']:.3f} | {v['n']} |")
+        L += ["", "Queue overflows (reports/frames): " + ", ".join(f"{r.get('overflows')}" for r in e2e["runs"])
+              + "; JACK xruns during the runs (scsynth not finished / dummy driver late): "
+              + ", ".join(f"{r['client_xruns']} / {r['driver_xruns']}" for r in e2e["runs"])
+              + "; scsynth avg CPU " + ", ".join(f"{r['avg_cpu']:.1f} %" for r in e2e["runs"] if r.get("avg_cpu") is not None)
+              + ". A force frame can only end at a block boundary and the device thread takes it at its next "
+              "1 ms wake-up, so force to magnet is at most one block (1.33 ms) plus one loop period when nothing "
+              "is late.", ""]
+    sc = results.get("scale")
+    if sc:
+        first = next(iter(sc.values()))
+        L += ["## Scale: pilot voices in realtime", "", f"`{cmd} --only scale` (bench/rt_bench.py; plot: `scale.png`)", "",
+              "![scale](scale.png)", "",
+              "A voice is the pilot chain of `FrictionPilot.ar` without its FrictionOut (one FrictionOut per device is "
+              "the rule): `FrictionMouseIn.ar(0)` (linear) -> `SpatialBufRd` cubic (mappings 4000, 500, 8 samples/mm "
+              "in turn) -> `LoudnessToFriction`, the audio through `DelayL` (50 ms buffer, 1 ms delay) to the "
+              "output, the force added onto a bus; one `FrictionOut` at the tail commands the mean force. All voices "
+              "read one `FrictionDevice.sim` on slot 0 (its hand moves the puck over the signal) on the device "
+              "thread. jackd runs the dummy driver with realtime scheduling here (`jackd -R -P 70 -d dummy -p 64`, "
+              "as a performer runs it: with rt.py's `-r` the idle server already misses about one period a second "
+              "on this VM). Voices are added in steps (0, 8, doubling, then bisection between the last passing and "
+              f"the first failing step); each step settles {first['settle_s']} s and is measured for "
+              f"{first['window_s']} s. An xrun is JACK's `client = SuperCollider was not finished` line in jackd's "
+              f"output; a step fails when those exceed {100 * first['xrun_fraction']:.0f} % of the window's periods "
+              "in the window and again in a second window (isolated xruns come from the VM's scheduling at any "
+              "load: they are counted and shown, not used). scsynth's avg and peak CPU (`s.avgCPU`, `s.peakCPU`) are "
+              "shown alongside.", ""]
+        for rate, e in sc.items():
+            L += [f"{int(rate) // 1000} kHz: **{e['max_without_xrun']} voices** pass, the next step "
+                  f"({e['first_with_xrun']}) fails, in the median of {len(e.get('all_runs', [0]))} searches "
+                  f"(voices passing in each: {', '.join(str(x) for x in e.get('all_runs', []))}); its steps"
+                  + f" ({e['wall_s']:.0f} s, limit {e['xrun_limit']} xruns per window).", "",
+                  "| voices | xruns (window 1) | xruns (window 2) | dummy driver late | avg CPU % | peak CPU % |",
+                  "| --- | --- | --- | --- | --- | --- |"]
+            for r in e["steps"]:
+                L.append(f"| {r['voices']} | {r['client_xruns']} | {r['retry_client_xruns'] if r['retry_client_xruns'] >= 0 else ''} | "
+                         f"{r['driver_xruns']} | {r['avg_cpu']:.1f} | {r['peak_cpu']:.1f} |")
+            L.append("")
+    return L
+
+
 def write_report(results, args, path):
     cmd = "/usr/bin/python3 bench/run.py"
+    meta = results.get("meta", {})
     L = ["# KineticFriction benchmarks: speed against error", "",
-         f"Written by `{cmd}` ({time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} cores, "
-         f"{'scsynth ' + subprocess.run(['scsynth', '-v'], stdout=subprocess.PIPE, text=True).stdout.split()[1]}). "
-         "Each section names the command that reproduces its numbers alone. Timings on a shared machine "
-         "move by a few per cent between runs; the spread over rounds is given with each ratio.", ""]
-    L += ["## Summary (as printed by the run)", "", "```"] + summary_lines(results) + ["```", ""]
+         f"Written by `scripts/bench.sh` (scripts/setup.sh, then `{cmd}`) on {meta.get('date', '?')}, "
+         f"{os.cpu_count()} cores, "
+         f"{'scsynth ' + subprocess.run(['scsynth', '-v'], stdout=subprocess.PIPE, text=True).stdout.split()[1]}. "
+         f"The last run ({'all parts' if set(meta.get('parts', PARTS)) >= set(PARTS) else 'parts: ' + ', '.join(meta.get('parts', []))}) "
+         f"took {meta.get('bench_s', 0) / 60:.1f} min after the build "
+         f"({meta.get('build_s', 0):.0f} s of building before it, excluded; a fresh clone's scripts/setup.sh "
+         "build of everything takes longer). Each section names the command that reproduces its numbers alone; "
+         "every pair is measured side by side in the same run (the same render, or the same process).", ""]
     g = goals(results)
-    if g:
-        L += ["## Goals", ""] + [f"- {x}" for x in g] + [""]
+    L += ["## Goals", ""] + [f"- {x}" for x in g] + [""]
+    L += ["## Summary (as printed by the run)", "", "```"] + summary_lines(results) + ["```", ""]
+    L += repeatability_lines(results)
     L += notes(results)
     tm = results.get("timing")
     if tm:
@@ -721,20 +1203,39 @@ def write_report(results, args, path):
         L.append("")
     sp = results.get("spatial")
     if sp:
-        L += ["## Error: SpatialBufRd and BufRd", "", f"`{cmd} --only spatial` (plot: `spatial_index.png`)", "",
-              "BufRd is driven by `(pos - origin) * spm` in float UGens, with `loop: 0`; SpatialBufRd by the same "
-              "float position, origin and samplesPerMm. The reference index is computed in double from the float "
-              "values both were given. `vs signal`: against sin(2 pi index / 100); `vs double read`: against the same "
-              "interpolation of the same float buffer evaluated in double at the exact index (so it isolates index "
-              "and arithmetic error from interpolation error). Only indices with every tap inside the signal count.", "",
-              "| case | reader | max vs signal | rms vs signal | max vs double read | rms vs double read |",
-              "| --- | --- | --- | --- | --- | --- |"]
-        for label, entry in sp["pilot"].items():
-            for k, v in entry.items():
-                if k == "samples":
-                    continue
-                L.append(f"| {label} | {k} | {fmt(v['max_vs_signal'])} | {fmt(v['rms_vs_signal'])} | "
-                         f"{fmt(v['max_vs_double_read'])} | {fmt(v['rms_vs_double_read'])} |")
+        L += ["## SpatialBufRd: speed against error, every interpolation order", "",
+              f"`{cmd} --only timing --only spatial` (plots: `spatial_tradeoff.png`, `spatial_index.png`)", "",
+              "![CPU against error](spatial_tradeoff.png)", "",
+              "CPU: the timing render above (400 instances per phase, positions of the three pilot mappings), each "
+              "reader's (phase - empty) over BufRd cubic's (phase - empty), per round; median [min..max] over rounds. "
+              "Error: a separate render of every reader on the same float position, for each pilot mapping (Table 1) "
+              f"at {', '.join(str(v) for v in GRID_SPEEDS)} mm/s (a triangle sweep over the middle of the signal, "
+              f"one cycle in {SPATIAL_S:.0f} s, or over all of it, -2..102 %, where the speed allows). BufRd is driven "
+              "by `(pos - origin) * spm` in float UGens, with `loop: 0`; SpatialBufRd by the same float position, "
+              "origin and samplesPerMm. The reference index is computed in double from the float values both were "
+              "given; `vs signal` is against the exact continuous signal the buffer samples, sin(2 pi index / 100); "
+              "`vs double read` against the same interpolation of the same float buffer evaluated in double at the "
+              "exact index (so it isolates index and arithmetic error from interpolation error). Only indices with "
+              "every tap inside the signal count.", ""]
+        if tm and "vs_bufrd4" in tm:
+            L += ["| reader | CPU / BufRd cubic | [min..max] | source subtracted | max error vs signal, worst case | "
+                  "rms vs signal, worst case |", "| --- | --- | --- | --- | --- | --- |"]
+            for n, label in READERS:
+                e, es = tm["vs_bufrd4"][n]["cpu-empty"], tm["vs_bufrd4"][n]["cpu-source"]
+                worst = max(en[label]["max_vs_signal"] for en in sp["pilot"].values())
+                worst_rms = max(en[label]["rms_vs_signal"] for en in sp["pilot"].values())
+                L.append(f"| {label} | {e['median']:.3f} | {e['min']:.3f}..{e['max']:.3f} | {es['median']:.3f} | "
+                         f"{fmt(worst)} | {fmt(worst_rms)} |")
+            L.append("")
+        for stat, title in (("max_vs_signal", "max |error| vs the continuous signal"),
+                            ("rms_vs_signal", "rms error vs the continuous signal"),
+                            ("max_vs_double_read", "max |error| vs the same interpolation in double (index error)")):
+            L += [f"{title}:", "", "| mapping, speed | " + " | ".join(label for _, label in READERS) + " |",
+                  "| --- |" + " --- |" * len(READERS)]
+            for entry in sp["pilot"].values():
+                L.append(f"| {entry['spm']} samples/mm, {entry['speed']} mm/s | "
+                         + " | ".join(fmt(entry[label][stat]) for _, label in READERS) + " |")
+            L.append("")
         L += ["", "Index precision, read from a buffer holding k mod 16 (a linear or cubic read then outputs the "
               "index mod 16 wherever the taps do not straddle a wrap). Effective index minus the exact index of the "
               "float position each UGen received, in samples:", "",
@@ -770,6 +1271,7 @@ def write_report(results, args, path):
             a, b = dr["first"][name], dr["last"][name]
             L.append(f"| {name} | {fmt(a['max_n'])} | {fmt(b['max_n'])} | {fmt(a['rms_n'])} | {fmt(b['rms_n'])} |")
         L.append("")
+    L += extra_sections(results, cmd)
     lc = results.get("log")
     if lc:
         L += ["## The logarithm of equation (2)", "", "`build-bench/bench/kf_log_choice` (built from `bench/log_choice.cpp` "
@@ -792,19 +1294,32 @@ def write_report(results, args, path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", action="append", choices=PARTS, help="run only these parts (repeatable)")
-    ap.add_argument("--build-dir", default=str(ROOT / "build-bench"))
+    ap.add_argument("--build-dir", default=str(ROOT / "build"), help="default: build/, as scripts/setup.sh makes it")
     ap.add_argument("--work-dir", default=None, help="scratch folder (default: a new one under /tmp)")
     ap.add_argument("--instances", type=int, default=400)
     ap.add_argument("--phase-s", type=float, default=1.5)
-    ap.add_argument("--rounds", type=int, default=12)
+    ap.add_argument("--rounds", type=int, default=20)
     ap.add_argument("--drift-min", type=float, default=20)
+    ap.add_argument("--e2e-s", type=float, default=10.0, help="seconds of each realtime end-to-end run")
+    ap.add_argument("--e2e-runs", type=int, default=3)
+    ap.add_argument("--scale-runs", type=int, default=3, help="scale searches per sample rate")
     ap.add_argument("--no-report", action="store_true", help="print only; leave bench/REPORT.md and the plots alone")
+    ap.add_argument("--report-only", action="store_true",
+                    help="measure nothing: rewrite bench/REPORT.md from bench/results.json")
     args = ap.parse_args()
     parts = args.only or PARTS
+    if args.report_only:
+        merged = json.loads((BENCH / "results.json").read_text())
+        write_report(merged, args, BENCH / "REPORT.md")
+        log("rewrote bench/REPORT.md from bench/results.json")
+        return
     env = Env(args.build_dir, args.work_dir or tempfile.mkdtemp(prefix="kf-bench-"))
     log(f"work dir {env.work}")
-    if "build" in parts or not (env.build / "bench" / "KFBenchClock.so").exists():
+    if "build" in parts or not (env.build / "bench" / "KFBenchClock.so").exists() \
+            or not (env.build / "bench" / "kf_reconstruction_bench").exists():
         build(env)
+    build_s = time.monotonic() - T0
+    bench_t0 = time.monotonic()
     results = {}
     results_path = BENCH / "results.json"
 
@@ -828,7 +1343,7 @@ def main():
             long = np.zeros(long_frames, dtype=np.float32)
             long[k0: k0 + 10_000] = (np.arange(k0, k0 + 10_000) % 16).astype(np.float32)
             soundfile.write(env.work / "long.wav", long, SR, subtype="FLOAT")
-            code += spatial_score_code(env, 4.0)
+            code += spatial_score_code(env, SPATIAL_S)
         if "loudness" in parts:
             code += loudness_score_code(env, 8.0)
         if "drift" in parts:
@@ -848,7 +1363,7 @@ def main():
                 plot_timing(results["timing"], BENCH / "timing.png")
         if "spatial" in parts:
             log("spatial accuracy render")
-            render(env, env.work / "spatial.osc", env.work / "spatial.wav", 38)
+            render(env, env.work / "spatial.osc", env.work / "spatial.wav", 7 * len(GRID) + 14)
             results["spatial"] = analyse_spatial(env)
             for line in summary_lines({"spatial": results["spatial"]}):
                 print(line)
@@ -873,15 +1388,73 @@ def main():
                 print(line)
     if "log" in parts and not args.no_report:
         plot_log_choice(results["log"], BENCH / "log_choice.png")
+    if "timing" in parts and "spatial" in parts and not args.no_report:
+        plot_spatial_tradeoff(results["timing"], results["spatial"], BENCH / "spatial_tradeoff.png")
 
+    if "drift" in parts:
+        log("drift test: 10^9 samples through the LoudnessToFriction core (Catch2)")
+        dt = run_drift_test(env)
+        if dt:
+            results["drift_test"] = dt
+            log(f"drift test: worst {fmt(dt['worst_n'])} N ({dt['wall_s']:.1f} s)")
+    if "reconstruction" in parts:
+        log("reconstruction bench (3 runs)")
+        results["reconstruction"] = run_reconstruction(env)
+        for line in summary_lines({"reconstruction": results["reconstruction"]}):
+            print(line)
+        if not args.no_report:
+            plot_reconstruction(results["reconstruction"], BENCH / "reconstruction.png")
+    if "e2e" in parts or "scale" in parts:
+        sys.path.insert(0, str(BENCH))
+        import rt_bench  # noqa: E402
+        rt = rt_bench.harness(env.extension_dir(), env.work / "rt")
+        if not (env.extension_dir() / "plugins").exists():
+            raise SystemExit(f"no extension folder at {env.extension_dir()}: run scripts/setup.sh (or --only build)")
+    if "e2e" in parts:
+        runs = []
+        for i in range(args.e2e_runs):
+            log(f"realtime end to end, run {i + 1} of {args.e2e_runs} ({args.e2e_s:.0f} s)")
+            runs.append(rt_bench.run_e2e(rt, seconds=args.e2e_s, log=log))
+        results["e2e"] = {"runs": runs, "seconds": args.e2e_s}
+        if not args.no_report:
+            plot_e2e(results["e2e"], BENCH / "e2e.png")
+    if "scale" in parts:
+        results["scale"] = {}
+        for rate in (48000, 192000):
+            runs = []
+            for i in range(args.scale_runs):
+                log(f"scale at {rate} Hz, run {i + 1} of {args.scale_runs}")
+                runs.append(rt_bench.run_scale(rt, rate, log=log))
+            # The median run (the lower middle one for an even count) is the one reported in full.
+            ordered = sorted(runs, key=lambda r: r["max_without_xrun"])
+            best = dict(ordered[(len(ordered) - 1) // 2])
+            best["all_runs"] = [r["max_without_xrun"] for r in runs]
+            results["scale"][str(rate)] = best
+        if not args.no_report:
+            plot_scale(results["scale"], BENCH / "scale.png")
+
+    results["meta"] = {"date": time.strftime("%Y-%m-%d %H:%M"), "build_s": build_s,
+                       "bench_s": time.monotonic() - bench_t0, "parts": parts}
     print()
     print("==== summary")
-    for line in summary_lines(results) + goals(results):
+    for line in summary_lines(results):
         print(line)
+    print("==== goals")
+    for line in goals(results):
+        print(line)
+    log(f"bench took {results['meta']['bench_s'] / 60:.1f} min after {build_s:.0f} s of building")
     if not args.no_report:
         # Parts not run this time keep their previous numbers in the report.
         old = json.loads(results_path.read_text()) if results_path.exists() else {}
+        old.pop("previous", None)
         merged = {**old, **{k: v for k, v in results.items()}}
+        if old:
+            merged["previous"] = {"date": old.get("meta", {}).get("date", "?"),
+                                  "keys": {}}
+            try:
+                merged["previous"]["keys"] = {k: list(v) for k, v in key_numbers(old).items()}
+            except (KeyError, TypeError, ValueError):
+                pass  # an older results.json without these numbers
         for v in merged.get("spatial", {}).get("index", {}).values():
             v.pop("_traces", None)
         results_path.write_text(json.dumps(merged, indent=1, default=float))
