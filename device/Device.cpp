@@ -52,7 +52,7 @@ void Device::pump(double nowS) {
   // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
   std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
-  pumpLocked(nowS);
+  pumpLocked(nowS - lockstepOriginS_);
 }
 
 void Device::pumpLocked(double nowS) {

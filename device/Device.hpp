@@ -43,11 +43,10 @@ class Device {
   // Stop flag, join, magnet off, recording closed. Idempotent; not from the audio thread.
   void close();
 
-  // One round of work at device time nowS: force frames from the audio queue through
-  // ForceSafety to the force backend, the watchdog, reports up to nowS into the audio queue,
-  // recording. Does nothing for nowS <= the last pumped time (several UGens may call it),
-  // while the state is being changed (recording started/stopped), after close, and in
-  // realtime mode (where the device thread is the only pumper).
+  // One round of work at device time nowS (lockstep: audio time, less the origin): force frames from the audio queue
+  // through ForceSafety to the force backend, the watchdog, reports up to nowS into the audio queue, recording. Does
+  // nothing for nowS <= the last pumped time (several UGens may call it), while the state is being changed (recording
+  // started/stopped), after close, and in realtime mode (where the device thread is the only pumper).
   void pump(double nowS);
 
   // Audio side (one consumer / one producer thread): never allocate, lock or wait.
@@ -60,6 +59,10 @@ class Device {
 
   const DeviceSpec& spec() const { return spec_; }
   bool isLockstep() const { return lockstep_; }
+  // Lockstep: the audio time at which the device opened, its time 0 (as a realtime device's
+  // clock starts at open). pump() takes audio time and subtracts it. Set before first use.
+  void setLockstepOriginS(double audioTimeS) { lockstepOriginS_ = audioTimeS; }
+  double lockstepOriginS() const { return lockstepOriginS_; }
   bool isClosed() const { return closed_.load(std::memory_order_acquire); }
   TelemetrySnapshot telemetry() const;
 
@@ -78,6 +81,7 @@ class Device {
 
   const DeviceSpec spec_;
   const bool lockstep_;
+  double lockstepOriginS_ = 0.0;
   const DeviceOptions options_;
   std::shared_ptr<MouseBackend> mouse_;
   std::shared_ptr<ForceBackend> force_;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "AudioClock.hpp"
 #include "DeviceFactory.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
@@ -115,8 +116,11 @@ kf::HandScript handScriptOf(const CommandData* data) {
 
 // --- stages shared by the open commands ----------------------------------------------------
 
-bool publishStage(World*, void* raw) {  // RT
+bool publishStage(World* world, void* raw) {  // RT
   auto* data = static_cast<CommandData*>(raw);
+  // A lockstep device's time starts with the next block, as a realtime one's starts at open.
+  if (data->device != nullptr && data->device->isLockstep())
+    data->device->setLockstepOriginS(kf::sc::blockStartTimeS(world));
   data->previous = kf::sc::exchangeSlot(data->index, data->device);
   return true;
 }

@@ -14,6 +14,9 @@ struct Slot {
 };
 
 Slot gSlots[kNumDeviceSlots];
+// One counter for all slots, so that a generation names one device wherever it is: a UGen
+// moved to another slot sees a new generation even if both slots were opened equally often.
+std::atomic<uint32_t> gNextGeneration{1};
 
 // Closes every device left open when scsynth exits, so no magnet stays on: joins the device
 // threads and drives the magnets off.
@@ -53,7 +56,7 @@ SlotView viewSlot(int index, int64_t blockCounter, double lockstepTimeS) {
 Device* exchangeSlot(int index, Device* device) {
   if (!isValidSlot(index)) return device;
   Slot& slot = gSlots[index];
-  slot.generation.fetch_add(1, std::memory_order_acq_rel);
+  slot.generation.store(gNextGeneration.fetch_add(1, std::memory_order_relaxed), std::memory_order_release);
   slot.reportsBlock = -1;
   slot.numReports = 0;
   return slot.device.exchange(device, std::memory_order_acq_rel);

@@ -38,10 +38,11 @@ class FrictionMouseIn : public SCUnit {
 
     const kf::DeviceSpec& spec = slot.device->spec();
     const bool lockstep = slot.device->isLockstep();
+    const double originS = slot.device->lockstepOriginS();
     for (int i = 0; i < slot.numReports; ++i) {
       const kf::MouseReport& r = slot.reports[i];
       // Lockstep devices run on audio time; realtime ones on their own clock, mapped here.
-      const double reportS = lockstep ? r.deviceTimeS : mClock.map(r.deviceTimeS, startS);
+      const double reportS = lockstep ? r.deviceTimeS + originS : mClock.map(r.deviceTimeS, startS);
       mTrajectory.addReport(reportS, r.dxCounts * spec.countMm, r.dyCounts * spec.countMm, r.flags);
     }
     mTrajectory.setMode(kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation))));

@@ -41,8 +41,10 @@ class FrictionOut : public SCUnit {
     const double deviceNowS = device->nowS();
     const double framePeriodS = device->spec().forceFramePeriodS;
     auto sink = [&](double frameTimeS, float forceN) {
+      // Lockstep devices take frames on their own time (audio time less their origin).
+      const double deviceFrameS = device->isLockstep() ? frameTimeS - device->lockstepOriginS() : frameTimeS;
       device->pushForceFrame(
-          kf::ForceFrame{frameTimeS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
+          kf::ForceFrame{deviceFrameS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
     };
     const double sampleDurS = 1.0 / sampleRate();
     if (isAudioRateIn(kForceN)) {

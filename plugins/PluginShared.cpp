@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdarg>
+#include <cstdint>
 #include <cstdio>
 
 InterfaceTable* ft = nullptr;
@@ -10,30 +11,40 @@ namespace kf::sc {
 
 namespace {
 
-// A ring of message slots in static storage: formatting needs no allocation, and a slot is
-// only reused after 64 later messages, long after the NRT thread printed it.
+// A ring of message slots in static storage: formatting needs no allocation. A slot is busy
+// from its formatting until the NRT thread has printed it; a message finding its slot still
+// busy (more than kSlots messages in flight) is dropped rather than written over a slot that
+// is being printed.
 constexpr int kSlots = 64;
 constexpr int kSlotChars = 256;
 char gSlots[kSlots][kSlotChars];
+std::atomic<bool> gSlotBusy[kSlots];
 std::atomic<unsigned> gNextSlot{0};
 
-void printSlot(FifoMsg* msg) { Print("%s", static_cast<const char*>(msg->mData)); }
+void printSlot(FifoMsg* msg) {
+  const int index = static_cast<int>(reinterpret_cast<intptr_t>(msg->mData));
+  Print("%s", gSlots[index]);
+  gSlotBusy[index].store(false, std::memory_order_release);
+}
 
 }  // namespace
 
 void postFromRt(World* world, const char* format, ...) {
-  char* slot = gSlots[gNextSlot.fetch_add(1, std::memory_order_relaxed) % kSlots];
+  const int index = static_cast<int>(gNextSlot.fetch_add(1, std::memory_order_relaxed) % kSlots);
+  if (gSlotBusy[index].exchange(true, std::memory_order_acquire)) return;
+  char* slot = gSlots[index];
   va_list args;
   va_start(args, format);
   std::vsnprintf(slot, kSlotChars, format, args);
   va_end(args);
   if (!world->mRealTime) {
     Print("%s", slot);
+    gSlotBusy[index].store(false, std::memory_order_release);
     return;
   }
   FifoMsg msg;
-  msg.Set(world, printSlot, nullptr, slot);
-  SendMsgFromRT(world, msg);
+  msg.Set(world, printSlot, nullptr, reinterpret_cast<void*>(static_cast<intptr_t>(index)));
+  if (!SendMsgFromRT(world, msg)) gSlotBusy[index].store(false, std::memory_order_release);
 }
 
 void clearUnitOnAllocFailure(Unit* unit, const char* ugenName) {

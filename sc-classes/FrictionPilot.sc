@@ -219,12 +219,18 @@ FrictionPilot {
 		if(server.serverRunning.not) { Error("FrictionPilot.play: server % is not running".format(server)).throw };
 		if(synth.notNil) { ^this };
 		defName = ("frictionPilot" ++ this.class.prDeviceIndex(device, "play")).asSymbol;
+		// The synth is claimed now, so that a second play does nothing and a free before it starts
+		// (below) keeps it from starting at all.
+		synth = Synth.basicNew(defName, server);
 		forkIfNeeded {
+			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
 			this.class.synthDef(defName, device).add;
 			server.sync;
-			synth = Synth(defName, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm, \origin, origin,
-				\friction, friction, \amp, amp, \out, out], server);
+			if(synth === starting) {
+				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm,
+					\origin, origin, \friction, friction, \amp, amp, \out, out]));
+			};
 		};
 	}
 

@@ -166,3 +166,30 @@ def test_specs_use_the_design_names_and_audio_delay_is_one_ms():
                  "E 1.0 0.0016"]:
         assert line in out, line
     assert "maxForceN, 1.0" in out and "tactileLatencyS, 0.003" in out, "profile names reach the server by setting name"
+
+
+def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
+    """Device time starts at the open, as in realtime: a hand script opened at 0.5 s runs from
+    0.5 s (whole blocks: 0.5 s is 375 blocks of 64 at 48 kHz)."""
+    hand = "FrictionHand.path([[0, 0], [0.3, 20], [0.6, 5]])"
+    early, _ = render_device("open_early", f"FrictionDevice.sim(nil, 0, {hand})", 1.2)
+    late, _ = kfsc.score_and_render("open_late", f"""
+        var dev = FrictionDevice.sim(nil, 0, {hand});
+        var def = SynthDef(\\open_late, {{
+            Out.ar(0, FrictionMouseIn.ar(0, 0, 1) ++ [FrictionOut.ar(0, DC.ar(0.3))])
+        }});
+        score = Score([
+            [0.5, dev.openMsg],
+            [0.5, ['/d_recv', def.asBytes]],
+            [0.5, Synth.basicNew(\\open_late, nil, 1000).newMsg],
+            [1.7, dev.closeMsg],
+            [1.75, ['/c_set', 0, 0]]]);
+    """, sample_rate=SR, channels=5)
+    shift = int(0.5 * SR)
+    n = int(1.1 * SR)
+    assert np.max(np.abs(early[:n, 0])) > 3, "the puck moved"
+    # The same motion, 0.5 s later. Not bit for bit: report times are rendered against absolute
+    # audio time, so a report may land one sample apart (a speed step a sample early or late).
+    np.testing.assert_allclose(late[shift:shift + n, 0], early[:n, 0], atol=0.021)
+    speed_differs = np.abs(late[shift:shift + n, 2] - early[:n, 2]) > 1e-3
+    assert np.mean(speed_differs) < 1e-3
