@@ -8,6 +8,7 @@
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry)
 //   kfClose      index
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -36,7 +37,7 @@ struct CommandData {
   char path[kMaxPathChars];
   kf::Device* device;    // opened by stage 2, or the target of record/status
   kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
-  double values[kMaxValues];
+  double* values;        // the hand script (kfOpenSim only), RTAlloc'd to its size
 };
 
 void copyString(char* to, const char* from, size_t capacity) {
@@ -55,6 +56,7 @@ CommandData* newCommand(World* world, const char* name, sc_msg_iter* args) {
   data->numValues = data->numOverrides = 0;
   data->path[0] = '\0';
   data->device = data->previous = nullptr;
+  data->values = nullptr;
   return data;
 }
 
@@ -75,7 +77,11 @@ bool checkSlot(World* world, CommandData* data) {
   return false;
 }
 
-void freeCommand(World* world, void* data) { RTFree(world, data); }
+void freeCommand(World* world, void* raw) {
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->values != nullptr) RTFree(world, data->values);
+  RTFree(world, data);
+}
 
 void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
          AsyncStageFn stage4) {
@@ -152,12 +158,16 @@ void openSimCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   CommandData* data = newCommand(world, "kfOpenSim", args);
   if (data == nullptr) return;
   data->kind = args->geti(-1);
-  const int count = args->geti(0);
-  for (int i = 0; i < count && args->remain() > 0; ++i) {
-    const double v = args->getd(0.0);
-    if (data->numValues < kMaxValues) data->values[data->numValues++] = v;
+  const int count = std::min(args->geti(0), kMaxValues);
+  if (count > 0) {
+    data->values = static_cast<double*>(RTAlloc(world, sizeof(double) * count));
+    if (data->values == nullptr) {
+      kf::sc::postFromRt(world, "kfOpenSim: RT memory allocation failed for the hand script\n");
+      return freeCommand(world, data);
+    }
   }
-  if (count > kMaxValues) kf::sc::postFromRt(world, "kfOpenSim: hand script truncated to %d values\n", kMaxValues);
+  for (int i = 0; i < count && args->remain() > 0; ++i) data->values[data->numValues++] = args->getd(0.0);
+  if (count == kMaxValues) kf::sc::postFromRt(world, "kfOpenSim: hand script limited to %d values\n", kMaxValues);
   readOverrides(args, data);
   if (!checkSlot(world, data)) return freeCommand(world, data);
   run(world, replyAddr, data, openSimStage, publishStage, deletePreviousStage);
