@@ -29,12 +29,11 @@ class FrictionMouseIn : public SCUnit {
     const double startS = kf::sc::blockStartTimeS(mWorld);
     const kf::sc::SlotView slot = kf::sc::viewSlot(index, mWorld->mBufCounter, startS + kf::sc::blockDurationS(mWorld));
     if (slot.device == nullptr) {
-      warnClosed(index);
+      mSlot.closed(mWorld, "FrictionMouseIn", index, "position and speed are 0.");
       for (int c = 0; c < 4; ++c) std::fill_n(out(c), numSamples, 0.f);
       return;
     }
-    mWarnedClosed = false;
-    if (slot.generation != mGeneration) attach(*slot.device, slot.generation);
+    if (mSlot.isNew(slot.generation)) attach(*slot.device);
 
     const kf::DeviceSpec& spec = slot.device->spec();
     const bool lockstep = slot.device->isLockstep();
@@ -50,24 +49,15 @@ class FrictionMouseIn : public SCUnit {
   }
 
   // A new device in the slot: start from its origin, with its update rate.
-  void attach(const kf::Device& device, uint32_t generation) {
-    mGeneration = generation;
+  void attach(const kf::Device& device) {
     mTrajectory.~TrajectoryReconstructor();
     new (&mTrajectory) kf::TrajectoryReconstructor(device.spec().updateRateHz);
     mClock.reset();
   }
 
-  void warnClosed(int index) {
-    if (mWarnedClosed) return;
-    mWarnedClosed = true;
-    mGeneration = 0;
-    kf::sc::postFromRt(mWorld, "FrictionMouseIn: no device is open at index %d; position and speed are 0.\n", index);
-  }
-
   kf::TrajectoryReconstructor mTrajectory;
   kf::DeviceClockMapper mClock;
-  uint32_t mGeneration = 0;
-  bool mWarnedClosed = false;
+  kf::sc::SlotFollower mSlot;
 };
 
 }  // namespace

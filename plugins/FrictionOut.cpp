@@ -28,12 +28,11 @@ class FrictionOut : public SCUnit {
     uint32_t generation = 0;
     kf::Device* device = kf::sc::deviceOfSlot(index, startS + kf::sc::blockDurationS(mWorld), &generation);
     if (device == nullptr) {
-      warnClosed(index);
+      mSlot.closed(mWorld, "FrictionOut", index, "no force is sent.");
       std::fill_n(out(0), numSamples, mMinForceN);  // no device: its magnet is off
       return;
     }
-    mWarnedClosed = false;
-    if (generation != mGeneration) attach(*device, generation);
+    if (mSlot.isNew(generation)) attach(*device);
 
     // Each frame is stamped with the device-clock time its millisecond ended: now, less the
     // audio time between the frame's end and the end of this block.
@@ -57,25 +56,16 @@ class FrictionOut : public SCUnit {
     }
   }
 
-  void attach(const kf::Device& device, uint32_t generation) {
-    mGeneration = generation;
+  void attach(const kf::Device& device) {
     const kf::DeviceSpec& spec = device.spec();
     mMinForceN = static_cast<float>(spec.minForceN);
     mFramer.~ForceFramer();
     new (&mFramer) kf::ForceFramer(spec.forceFramePeriodS, spec.minForceN, spec.maxForceN);
   }
 
-  void warnClosed(int index) {
-    if (mWarnedClosed) return;
-    mWarnedClosed = true;
-    mGeneration = 0;
-    kf::sc::postFromRt(mWorld, "FrictionOut: no device is open at index %d; no force is sent.\n", index);
-  }
-
   kf::ForceFramer mFramer;
   float mMinForceN = static_cast<float>(kf::DeviceSpec{}.minForceN);  // of the last device seen
-  uint32_t mGeneration = 0;
-  bool mWarnedClosed = false;
+  kf::sc::SlotFollower mSlot;
 };
 
 }  // namespace

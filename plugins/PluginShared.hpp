@@ -15,6 +15,29 @@ void postFromRt(World* world, const char* format, ...) __attribute__((format(pri
 // Turns a unit whose RTAlloc failed into one that outputs silence, with one message.
 void clearUnitOnAllocFailure(Unit* unit, const char* ugenName);
 
+// Which device a device UGen follows: one warning while its slot is closed (again after a device
+// came and went), and word of a device it has not seen yet, so that it resets its state.
+class SlotFollower {
+ public:
+  void closed(World* world, const char* ugenName, int index, const char* consequence) {
+    generation_ = 0;
+    if (warned_) return;
+    warned_ = true;
+    postFromRt(world, "%s: no device is open at index %d; %s\n", ugenName, index, consequence);
+  }
+  // True when the slot's device (by generation) is not the one followed so far.
+  bool isNew(uint32_t generation) {
+    warned_ = false;
+    if (generation == generation_) return false;
+    generation_ = generation;
+    return true;
+  }
+
+ private:
+  uint32_t generation_ = 0;
+  bool warned_ = false;
+};
+
 }  // namespace kf::sc
 
 // Registration hooks, one per UGen file, called from PluginLoad.

@@ -59,20 +59,3 @@ TEST_CASE("device thread with producer, consumer, telemetry reader and recording
   CHECK(popped.load() + 20 >= telemetry.reports);
   CHECK(telemetry.frames > 100);
 }
-
-TEST_CASE("queue stress under tsan") {
-  SpscQueue<uint64_t> queue(16);
-  constexpr uint64_t kItems = 200000;
-  std::thread producer([&] {
-    for (uint64_t i = 0; i < kItems; ++i)
-      while (!queue.push(i)) std::this_thread::yield();
-  });
-  uint64_t expected = 0;
-  bool inOrder = true;
-  while (expected < kItems) {
-    uint64_t value = 0;
-    if (queue.pop(value)) inOrder = inOrder && value == expected++;
-  }
-  producer.join();
-  CHECK(inOrder);
-}
