@@ -7,7 +7,7 @@ an audio device or realtime scheduling.
 
 Environment:
     KF_EXTENSION_DIR     the extension folder (default: <repo>/build/KineticFriction)
-    KF_SHARED_DATA_DIR   the project's shared data (default: <repo>/../shared/data)
+    KF_TEST_DATA_DIR     recorded device data (default: <repo>/tests/data)
     KF_TEST_WORK_DIR     where scripts, logs and recordings go (default: a new temp dir)
     KF_RT_KEEP_LOGS      set: print the log paths of every run
 """
@@ -23,7 +23,7 @@ from pathlib import Path
 
 REPO_DIR = Path(__file__).resolve().parents[2]
 EXTENSION_DIR = Path(os.environ.get("KF_EXTENSION_DIR") or REPO_DIR / "build" / "KineticFriction")
-SHARED_DATA_DIR = Path(os.environ.get("KF_SHARED_DATA_DIR") or REPO_DIR.parent / "shared" / "data")
+TEST_DATA_DIR = Path(os.environ.get("KF_TEST_DATA_DIR") or REPO_DIR / "tests" / "data")
 WORK_DIR = Path(os.environ.get("KF_TEST_WORK_DIR") or tempfile.mkdtemp(prefix="kf-realtime-"))
 WORK_DIR.mkdir(parents=True, exist_ok=True)
 

@@ -12,7 +12,7 @@ import pytest
 
 import rt
 
-HID_FILE = rt.SHARED_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+HID_FILE = rt.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 COUNT_MM = 0.021
 FORCE_N = 0.4
 
@@ -170,7 +170,6 @@ def hid_track():
     return np.array(times), np.array(xs), np.array(ys)
 
 
-@pytest.mark.skipif(not HID_FILE.exists(), reason=f"no recorded mouse at {HID_FILE} (set KF_SHARED_DATA_DIR)")
 def test_replay_of_a_hid_recording_moves_the_puck(jack):
     track_t, track_x, track_y = hid_track()
     duration = track_t[-1]

@@ -14,7 +14,7 @@ import soundfile
 
 EXTENSION_DIR = Path(os.environ.get("KF_EXTENSION_DIR", Path(__file__).resolve().parents[2] / "build" / "KineticFriction"))
 SYSTEM_PLUGIN_DIR = "/usr/lib/SuperCollider/plugins"
-SHARED_DATA_DIR = Path(os.environ.get("KF_SHARED_DATA_DIR", Path(__file__).resolve().parents[3] / "shared" / "data"))
+TEST_DATA_DIR = Path(os.environ.get("KF_TEST_DATA_DIR", Path(__file__).resolve().parents[1] / "data"))
 WORK_DIR = Path(os.environ.get("KF_TEST_WORK_DIR") or tempfile.mkdtemp(prefix="kf-scenes-"))
 WORK_DIR.mkdir(parents=True, exist_ok=True)
 

@@ -5,7 +5,7 @@ import numpy as np
 import kfsc
 
 SR = 48000
-HID_FILE = kfsc.SHARED_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+HID_FILE = kfsc.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 
 
 def render_device(name, open_code, seconds, force="DC.ar(0.3)", extra_events="", interpolation=1):
