@@ -1,0 +1,75 @@
+"""A JACK server on the dummy driver: a real-time audio clock without a sound card."""
+import os
+import random
+import subprocess
+import time
+
+from . import paths
+
+
+class JackServer:
+    """jackd -n <unique name> -d dummy -r <rate> -p <period>, in the background.
+
+    Clients find it through JACK_DEFAULT_SERVER in `env`; JACK_NO_START_SERVER keeps them from
+    starting a server of their own when this one is gone. By default jackd runs without realtime
+    scheduling (-r), which needs no rights; `realtime_priority` (e.g. 70) runs its and its
+    clients' process threads SCHED_FIFO, as a performer would (needs root or an rtprio limit)."""
+
+    def __init__(self, sample_rate=48000, period=64, realtime_priority=None):
+        self.name = f"kfrt{os.getpid()}x{random.randrange(16 ** 6):06x}"
+        self.sample_rate = sample_rate
+        self.period = period
+        self.realtime_priority = realtime_priority
+        self.proc = None
+        self.log_path = paths.work_dir() / f"jackd-{self.name}.log"
+        self.env = dict(os.environ)
+        self.env.update(JACK_DEFAULT_SERVER=self.name, JACK_NO_START_SERVER="1",
+                        JACK_NO_AUDIO_RESERVATION="1")
+
+    def command(self):
+        scheduling = ["-r"] if self.realtime_priority is None else ["-R", "-P", str(self.realtime_priority)]
+        return ["jackd", "-n", self.name, *scheduling, "-d", "dummy", "-r", str(self.sample_rate),
+                "-p", str(self.period), "-C", "2", "-P", "2"]
+
+    def start(self, timeout_s=20.0):
+        with open(self.log_path, "w") as log:
+            self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
+                                         stderr=subprocess.STDOUT, env=self.env)
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"jackd exited ({self.proc.returncode}):\n{self.log()}")
+            probe = subprocess.run(["jack_lsp"], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, env=self.env, timeout=10, text=True)
+            if probe.returncode == 0 and "system:playback_1" in probe.stdout:
+                return self
+            time.sleep(0.2)
+        self.stop()
+        raise RuntimeError(f"jackd did not come up in {timeout_s} s:\n{self.log()}")
+
+    def alive(self):
+        return self.proc is not None and self.proc.poll() is None
+
+    def stop(self):
+        if self.proc is None:
+            return
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5)
+        self.proc = None
+
+    def log(self):
+        try:
+            return self.log_path.read_text(errors="replace")[-3000:]
+        except OSError:
+            return ""
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()

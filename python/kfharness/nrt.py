@@ -1,0 +1,44 @@
+"""Renders of Scores with scsynth -N and the plugin loaded."""
+import subprocess
+import time
+
+from . import paths, readers, sclang
+
+
+def plugin_path(extra_dirs=()):
+    """scsynth's -U: the system plugins, the extension's plugin folder, and any extra folders."""
+    dirs = [paths.SYSTEM_PLUGIN_DIR, paths.extension_dir() / "plugins", *extra_dirs]
+    return ":".join(str(d) for d in dirs)
+
+
+def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, timeout=300,
+           sample_format="float", memory_kb=65536, extra_args=(), plugin_dirs=()):
+    """Renders an OSC score file; returns scsynth's output (an AssertionError if it failed)."""
+    cmd = ["scsynth", "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
+           "-o", str(channels), "-i", "0", "-z", str(block_size), "-U", plugin_path(plugin_dirs),
+           "-m", str(memory_kb), *map(str, extra_args)]
+    proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          timeout=timeout, text=True, errors="replace")
+    failed = proc.returncode != 0 or "FAILURE" in proc.stdout or "not installed" in proc.stdout
+    assert not failed, f"scsynth -N failed ({proc.returncode}):\n{proc.stdout[-4000:]}"
+    return proc.stdout
+
+
+def timed_render(*args, **kwargs):
+    """render(), and how long it took in s."""
+    t = time.monotonic()
+    render(*args, **kwargs)
+    return time.monotonic() - t
+
+
+def score_and_render(name, score_code, sample_rate=48000, channels=1, **render_args):
+    """score_code is sclang that leaves a Score in `score`; returns (frames x channels float32,
+    scsynth output)."""
+    score_path = paths.work_dir() / f"{name}.osc"
+    wav_path = paths.work_dir() / f"{name}-render.wav"
+    sclang.run_script(f"var score;\n{score_code.strip().rstrip(';')};\n"
+                      f"score.writeOSCFile({sclang.sc_string(score_path)});", name=name)
+    log = render(score_path, wav_path, sample_rate, channels, **render_args)
+    data, rate = readers.read_wav(wav_path)
+    assert rate == sample_rate
+    return data, log

@@ -1,0 +1,191 @@
+"""Headless sclang: its environment, a language config with the extension's classes, and two ways
+to run code: `run_script` (plain sclang, e.g. to write Scores) and `run_with_server` (a realtime
+scsynth booted by sclang against a JACK server; see jack.py)."""
+import os
+import random
+import re
+import subprocess
+import time
+
+from . import paths, procs
+
+
+def sc_string(text):
+    """A Python str as an sclang string literal."""
+    return '"' + str(text).replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def environment(base=None):
+    """What headless sclang needs: no display (offscreen Qt), Qt WebEngine without its sandbox (as
+    root) and a private XDG_RUNTIME_DIR."""
+    env = dict(os.environ if base is None else base)
+    runtime = paths.work_dir() / "xdg-runtime"
+    runtime.mkdir(mode=0o700, parents=True, exist_ok=True)
+    os.chmod(runtime, 0o700)
+    env.update(QT_QPA_PLATFORM="offscreen", QTWEBENGINE_DISABLE_SANDBOX="1", XDG_RUNTIME_DIR=str(runtime))
+    return env
+
+
+def config(include_paths=None):
+    """A language config (sclang -l) that adds the classes to the standard library; default: the
+    extension folder's Classes."""
+    include_paths = include_paths or [paths.extension_dir() / "Classes"]
+    conf = paths.work_dir() / f"sclang_conf-{abs(hash(tuple(map(str, include_paths))))}.yaml"
+    lines = "".join(f"    - {p}\n" for p in include_paths)
+    conf.write_text(f"includePaths:\n{lines}excludePaths: []\npostInlineWarnings: false\n")
+    return conf
+
+
+# The code is compiled by a fixed wrapper, so that a syntax error is reported and exits instead
+# of leaving sclang waiting.
+SCRIPT_WRAPPER = """var fn = File.readAllString(%(code)s).compile;
+if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
+  { fn.value; "KF-SCRIPT-OK".postln; 0.exit }.try { |error|
+    error.reportError; "KF-SCRIPT-ERROR".postln; 1.exit } };
+"""
+
+
+def _script_files(code, name):
+    key = f"{name}-{os.getpid()}-{random.randrange(16 ** 6):06x}"
+    code_path = paths.work_dir() / f"{key}.code.scd"
+    code_path.write_text(code)
+    return key, code_path
+
+
+def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="script"):
+    """Runs `code` (synchronous sclang, no server) headless; returns its output. The code succeeds
+    when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok)."""
+    key, code_path = _script_files(code, name)
+    script = paths.work_dir() / f"{key}.scd"
+    script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path)))
+    proc = subprocess.run(["sclang", "-l", str(config(include_paths)), str(script)],
+                          stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          env=environment(), timeout=timeout, text=True, errors="replace")
+    out = proc.stdout
+    if expect_ok:
+        assert "KF-SCRIPT-OK" in out and proc.returncode == 0, f"sclang failed:\n{out[-4000:]}"
+    return out
+
+
+class SclangRun:
+    """The result of one sclang session with a server."""
+
+    def __init__(self, output, returncode, scsynth_pid, log_path):
+        self.output = output
+        self.returncode = returncode
+        self.scsynth_pid = scsynth_pid
+        self.log_path = log_path
+
+    @property
+    def ok(self):
+        return "KF-SCRIPT-OK" in self.output and self.returncode == 0
+
+    def lines(self, tag):
+        """The fields after `tag` on every line that starts with it."""
+        return [line[len(tag):].split() for line in self.output.splitlines() if line.startswith(tag)]
+
+    def error_lines(self):
+        return [line for line in self.output.splitlines() if line.startswith("ERROR")]
+
+
+SERVER_WRAPPER = r"""
+var fn = File.readAllString(%(code)s).compile;
+if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
+	var options, finish;
+	Server.local.addr = NetAddr("127.0.0.1", %(port)d);
+	Server.default = s = Server.local;
+	options = s.options;
+	options.sampleRate = %(rate)d;
+	options.blockSize = 64;
+	options.hardwareBufferSize = %(period)d;
+	options.numInputBusChannels = 2;
+	options.numOutputBusChannels = 2;
+	options.memSize = 65536;
+	options.maxLogins = 4;
+	options.bindAddress = "127.0.0.1";
+	KineticFriction.addPluginPath(options);
+	finish = { |code|
+		if(s.serverRunning) { s.quit };
+		AppClock.sched(0.5, { code.exit; nil });
+	};
+	// A last resort: never leave sclang running (the harness also kills it by pid).
+	SystemClock.sched(%(timeout)f, { "KF-SCRIPT-TIMEOUT".postln; finish.(3); nil });
+	// On AppClock, like code evaluated in the IDE: GUI (plot, scope, Window) works from it.
+	Routine {
+		var ok = false;
+		try {
+			s.bootSync;
+			"KF-SCSYNTH-PID %%".format(s.pid).postln;
+			s.sync;
+			"KF-SERVER-UP".postln;
+			fn.value;
+			ok = true;
+		} { |error|
+			error.reportError;
+			"KF-SCRIPT-ERROR".postln;
+		};
+		if(ok) { "KF-SCRIPT-OK".postln; finish.(0) } { finish.(1) };
+	}.play(AppClock);
+};
+"""
+
+
+def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None):
+    """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync` and
+    GUI work) with `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang
+    processes are gone when it returns, whatever happened. `env`: extra environment variables."""
+    assert jack.alive(), "jackd is not running"
+    port = port or procs.free_udp_port()
+    key, code_path = _script_files(code, name)
+    script = paths.work_dir() / f"{key}.scd"
+    script.write_text(SERVER_WRAPPER % dict(code=sc_string(code_path), port=port, rate=jack.sample_rate,
+                                            period=jack.period, timeout=max(timeout - 10, 5)))
+    log_path = paths.work_dir() / f"{key}.log"
+    run_env = environment(jack.env)
+    run_env.update(SC_JACK_DEFAULT_INPUTS="", SC_JACK_DEFAULT_OUTPUTS="")
+    run_env.update(env or {})
+    proc = None
+    scsynth_pid = None
+    known_children = set()
+    with open(log_path, "w+") as log:
+        try:
+            proc = subprocess.Popen(["sclang", "-l", str(config(include_paths)), str(script)],
+                                    stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                    env=run_env, cwd=paths.work_dir())
+            deadline = time.monotonic() + timeout
+            while proc.poll() is None and time.monotonic() < deadline:
+                known_children.update(procs.descendants(proc.pid))
+                time.sleep(0.1)
+            if proc.poll() is None:
+                known_children.update(procs.descendants(proc.pid))
+                log.write("\nKF-HARNESS: sclang timed out; killed\n")
+        finally:
+            if proc is not None:
+                procs.stop_pid(proc.pid, grace_s=2.0)
+                proc.wait()
+            log.flush()
+            output = log_path.read_text(errors="replace")
+            m = re.search(r"^KF-SCSYNTH-PID (\d+)", output, re.M)
+            if m:
+                scsynth_pid = int(m.group(1))
+                known_children.add(scsynth_pid)
+            # scsynth quits on /quit; give it a moment, then stop whatever is left, by pid.
+            for pid in sorted(known_children):
+                if not procs.wait_pid_gone(pid, 5.0):
+                    procs.stop_pid(pid)
+    if os.environ.get("KF_RT_KEEP_LOGS"):
+        print(f"sclang log: {log_path}")
+    return SclangRun(output, proc.returncode if proc else None, scsynth_pid, log_path)
+
+
+def require_ok(run, what="sclang"):
+    assert run.ok, f"{what} failed (rc {run.returncode}), log {run.log_path}:\n{run.output[-6000:]}"
+    return run
+
+
+def fill(template, **values):
+    """sclang code with @name@ placeholders filled (sclang uses % itself)."""
+    for k, v in values.items():
+        template = template.replace(f"@{k}@", str(v))
+    assert "@" not in re.sub(r'"[^"]*"', "", template), "unfilled placeholder"
+    return template
