@@ -22,14 +22,17 @@ def pid_alive(pid):
 
 
 def _children(pid):
+    """Direct children of pid, from /proc (processes may end while it is read)."""
     kids = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
+    for name in os.listdir("/proc"):
+        if not name.isdigit():
+            continue
         try:
-            fields = stat.read_text().rsplit(") ", 1)[1].split()
+            fields = Path(f"/proc/{name}/stat").read_text().rsplit(") ", 1)[1].split()
         except (OSError, IndexError):
             continue
         if int(fields[1]) == pid:
-            kids.append(int(stat.parent.name))
+            kids.append(int(name))
     return kids
 
 
