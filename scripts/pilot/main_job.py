@@ -6,16 +6,13 @@ Usage: scripts/pilot/main_job.py [--rate 48000] [--out out/pilot]
 """
 import argparse
 import csv
-import os
-import shutil
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import pilotlib as P  # noqa: E402
+from kfharness import paths
+from kfharness import pilot as P
 
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
@@ -179,7 +176,7 @@ def summary(scenes, results, rate, out_dir, elapsed):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rate", type=int, default=48000, help="render sample rate (Hz); the paper used 192000")
-    ap.add_argument("--out", default=str(P.REPO / "out" / "pilot"))
+    ap.add_argument("--out", default=str(paths.REPO_DIR / "out" / "pilot"))
     args = ap.parse_args()
     out_dir = Path(args.out).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -5,14 +5,14 @@ The simulated device runs on the wall clock, so the bounds are loose; the record
 thread's own clock) carries the exact numbers.
 """
 import struct
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-import rt
+from kfharness import paths, procs, readers, sclang
+from kfharness.jack import JackServer
 
-HID_FILE = rt.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 COUNT_MM = 0.021
 FORCE_N = 0.4
 
@@ -47,21 +47,21 @@ def positions(run):
 
 @pytest.fixture
 def jack():
-    with rt.JackServer() as server:
+    with JackServer() as server:
         yield server
 
 
 def test_sim_device_moves_the_puck_and_receives_the_force(jack):
-    record = rt.WORK_DIR / "sim-session.txt"
+    record = paths.work_dir() / "sim-session.txt"
     record.unlink(missing_ok=True)
-    run = rt.require_ok(rt.run_sclang("var dev, pos, force;\n" + POS_LISTENER + f"""
+    run = sclang.require_ok(sclang.run_with_server("var dev, pos, force;\n" + POS_LISTENER + f"""
         pos = Synth(\\kfPos, [\\device, 0]);
         force = Synth(\\kfForce, [\\device, 0, \\force, {FORCE_N}]);
         s.sync;
         ~t0 = Main.elapsedTime;
         dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[50, 1.5]]));
         s.sync;  // kfRecord right after kfOpenSim does not find the device yet (see below)
-        dev.record({rt.sc_string(record)});
+        dev.record({sclang.sc_string(record)});
         s.sync;
         "KF-OPENED %".format(Main.elapsedTime - ~t0).postln;
         2.5.wait;
@@ -111,7 +111,7 @@ def test_sim_device_moves_the_puck_and_receives_the_force(jack):
     assert len(settled) >= 10 and np.allclose(settled, FORCE_N, atol=1e-6), settled
 
     # --- the recording: reports, frames at the commanded force, magnet off after the frames stop
-    header, records = rt.read_session(record)
+    header, records = readers.read_session(record)
     assert float(header["countMm"]) == pytest.approx(COUNT_MM)
     reports = [f for tag, f in records if tag == "R"]
     frames = [f for tag, f in records if tag == "F"]
@@ -173,16 +173,18 @@ def hid_track():
 def test_replay_of_a_hid_recording_moves_the_puck(jack):
     track_t, track_x, track_y = hid_track()
     duration = track_t[-1]
-    run = rt.require_ok(rt.run_sclang("var dev, pos;\n" + POS_LISTENER + f"""
+    run = sclang.require_ok(sclang.run_with_server("var dev, pos;\n" + POS_LISTENER + f"""
         pos = Synth(\\kfPos, [\\device, 2]);
         s.sync;
         ~t0 = Main.elapsedTime;
-        dev = FrictionDevice.replay(s, {rt.sc_string(HID_FILE)}, 2);
+        dev = FrictionDevice.replay(s, {sclang.sc_string(HID_FILE)}, 2);
         s.sync;
         {duration + 1.0}.wait;
+        // The reader goes first: a closed slot reads 0, which is not the file's last position.
+        pos.free;
+        s.sync;
         dev.close;
         s.sync;
-        pos.free;
         {POS_DUMP}
     """, jack, name="replay", timeout=150))
     rows = positions(run)
@@ -203,15 +205,15 @@ def test_replay_of_a_hid_recording_moves_the_puck(jack):
 
 
 def test_quitting_the_server_turns_the_magnet_off(jack):
-    record = rt.WORK_DIR / "quit-session.txt"
+    record = paths.work_dir() / "quit-session.txt"
     record.unlink(missing_ok=True)
-    run = rt.require_ok(rt.run_sclang(f"""
+    run = sclang.require_ok(sclang.run_with_server(f"""
         var dev;
         SynthDef(\\kfForceOnly, {{ FrictionOut.ar(3, DC.ar({FORCE_N})) }}).add;
         s.sync;
         dev = FrictionDevice.sim(s, 3, FrictionHand.speeds([[20, 5]]));
         s.sync;
-        dev.record({rt.sc_string(record)});
+        dev.record({sclang.sc_string(record)});
         s.sync;
         Synth(\\kfForceOnly);
         s.sync;
@@ -222,8 +224,8 @@ def test_quitting_the_server_turns_the_magnet_off(jack):
         50.do {{ if(s.serverRunning) {{ 0.1.wait }} }};
     """, jack, name="quit"))
     assert "exited with exit code 0" in run.output, run.output[-3000:]
-    assert run.scsynth_pid and rt.wait_pid_gone(run.scsynth_pid, 5)
-    header, records = rt.read_session(record)
+    assert run.scsynth_pid and procs.wait_pid_gone(run.scsynth_pid, 5)
+    header, records = readers.read_session(record)
     frames = [f for tag, f in records if tag == "F"]
     assert len(frames) >= 300, f"{len(frames)} frames before the quit"
     assert np.allclose([f[3] for f in frames], FORCE_N, atol=1e-6)
@@ -233,11 +235,11 @@ def test_quitting_the_server_turns_the_magnet_off(jack):
 
 def test_record_right_after_open(jack):
     """`FrictionDevice.sim(s, ...).record(path)` in one go, as a user writes it."""
-    record = rt.WORK_DIR / "open-then-record.txt"
+    record = paths.work_dir() / "open-then-record.txt"
     record.unlink(missing_ok=True)
-    run = rt.require_ok(rt.run_sclang(f"""
+    run = sclang.require_ok(sclang.run_with_server(f"""
         var dev = FrictionDevice.sim(s, 4, FrictionHand.speeds([[50, 1]]));
-        dev.record({rt.sc_string(record)});
+        dev.record({sclang.sc_string(record)});
         dev.status;
         0.5.wait;
         dev.close;
@@ -245,5 +247,5 @@ def test_record_right_after_open(jack):
     """, jack, name="open-record"))
     assert "kfRecord: no device is open" not in run.output
     assert "kfStatus 4: closed" not in run.output
-    header, records = rt.read_session(record)
+    header, records = readers.read_session(record)
     assert any(tag == "R" for tag, _ in records)

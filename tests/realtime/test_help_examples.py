@@ -15,11 +15,10 @@ import os
 import re
 from pathlib import Path
 
-import pytest
+from kfharness import paths, sclang
+from kfharness.jack import JackServer
 
-import rt
-
-HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or rt.REPO_DIR / "HelpSource")
+HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or paths.REPO_DIR / "HelpSource")
 PIECE_PAUSE_S = 0.3
 BLOCK_TIME_S = 1.5
 # Nodes are freed after each file, not after each block: the guides are sessions (a pilot started
@@ -125,8 +124,8 @@ NOTE_PATTERNS = [re.compile(p) for p in (r"^FAILURE IN SERVER", r"^WARNING", r"^
 def test_every_help_example_runs_on_a_realtime_server():
     files = sorted(HELP_DIR.rglob("*.schelp"))
     assert files, "no help files"
-    with rt.JackServer() as jack:
-        run = rt.run_sclang(RUNNER % dict(files=", ".join(rt.sc_string(f) for f in files),
+    with JackServer() as jack:
+        run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
                                           piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
                                           free_each_block=str(FREE_EACH_BLOCK).lower()),
                             jack, name="help", timeout=240)
@@ -151,7 +150,7 @@ def test_every_help_example_runs_on_a_realtime_server():
             if any(p.search(line) for p in NOTE_PATTERNS):
                 notes.append(f"{where}: {line}")
 
-    summary = rt.WORK_DIR / "help-examples-summary.txt"
+    summary = paths.work_dir() / "help-examples-summary.txt"
     summary.write_text("\n".join(["PROBLEMS"] + problems + ["", "NOTES"] + notes) + "\n")
     print(f"log {run.log_path}\nsummary {summary}")
     print("\n".join(notes))

@@ -2,15 +2,15 @@
 record and replay, and closed slots."""
 import numpy as np
 
-import kfsc
+from kfharness import nrt, paths, readers, sclang
 
 SR = 48000
-HID_FILE = kfsc.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 
 
 def render_device(name, open_code, seconds, force="DC.ar(0.3)", extra_events="", interpolation=1):
     """Renders FrictionMouseIn's four outputs and FrictionOut's commanded force."""
-    return kfsc.score_and_render(name, f"""
+    return nrt.score_and_render(name, f"""
         var dev = {open_code};
         var def = SynthDef(\\{name}, {{
             Out.ar(0, FrictionMouseIn.ar(0, 0, {interpolation}) ++ [FrictionOut.ar(0, {force})])
@@ -23,15 +23,6 @@ def render_device(name, open_code, seconds, force="DC.ar(0.3)", extra_events="",
             [{seconds}, dev.closeMsg],
             [{seconds} + 0.05, ['/c_set', 0, 0]]]);
     """, sample_rate=SR, channels=5)
-
-
-def read_session(path):
-    lines = [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
-    assert lines[0][0] == "kf-session"
-    reports = np.array([[float(v) for v in l[1:]] for l in lines[1:] if l[0] == "R"])
-    frames = np.array([[float(v) for v in l[1:]] for l in lines[1:] if l[0] == "F"])
-    offs = [float(l[1]) for l in lines[1:] if l[0] == "O"]
-    return reports, frames, offs
 
 
 def test_steady_100_mm_per_s_hand_reads_100_mm_per_s_within_one_speed_level():
@@ -47,12 +38,13 @@ def test_steady_100_mm_per_s_hand_reads_100_mm_per_s_within_one_speed_level():
     assert abs(np.polyfit(t[steady], position, 1)[0] - 100) < 1.0
 
 
-def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_path=kfsc.WORK_DIR):
+def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_path=paths.work_dir()):
     rec = tmp_path / "frames.kfs"
     data, _ = render_device("frames", "FrictionDevice.sim(nil, 0, FrictionHand.speeds([[60, 2]]))", 1.0,
                             force="LFPulse.ar(50).range(0.2, 0.8)",
                             extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
-    _, frames, offs = read_session(rec)
+    session = readers.Session(rec)
+    frames, offs = session.frames, session.offs
     # Frames are the 1 ms means of the force: at 50 Hz each 10 ms half-period is 10 whole frames.
     assert len(frames) > 950
     commanded = frames[:, 3].astype(np.float32)  # written as floats
@@ -87,13 +79,13 @@ def test_out_of_range_force_is_clamped_and_nan_is_the_minimum():
 
 
 def test_record_then_replay_gives_identical_output():
-    rec = kfsc.WORK_DIR / "session.kfs"
+    rec = paths.work_dir() / "session.kfs"
     recorded, _ = render_device(
         "rec", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.5, 30], [1.0, 10], [1.5, 45]]), "
         "(reportJitterS: 0.0005, dropProbability: 0.05, seed: 7))", 1.6,
         extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
     replayed, _ = render_device("replay", f"FrictionDevice.replay(nil, \"{rec}\")", 1.6)
-    reports, _, _ = read_session(rec)
+    reports = readers.Session(rec).reports
     assert len(reports) > 150
     assert np.max(np.abs(recorded[:, 0])) > 25
     np.testing.assert_array_equal(recorded[:, :4], replayed[:, :4])
@@ -110,7 +102,7 @@ def test_hid_recorder_file_replays_through_the_ugens():
 
 
 def test_closed_slot_gives_zero_position_minimum_force_and_one_warning_each():
-    data, log = kfsc.score_and_render("closed", """
+    data, log = nrt.score_and_render("closed", """
         var def = SynthDef(\\closed, { Out.ar(0, FrictionMouseIn.ar(3) ++ [FrictionOut.ar(3, DC.ar(0.9))]) });
         score = Score([
             [0.0, ['/d_recv', def.asBytes]],
@@ -132,7 +124,7 @@ def test_same_score_renders_the_same_file_sample_for_sample():
 
 
 def test_bad_device_arguments_give_clear_errors():
-    out = kfsc.run_sclang("""
+    out = sclang.run_script("""
         var errors = List.new;
         [
             { FrictionHand.path([[0, 0], [-1, 3]]) },
@@ -152,15 +144,21 @@ def test_bad_device_arguments_give_clear_errors():
         assert text in out, text
 
 
-def test_specs_use_the_design_names_and_audio_delay_is_one_ms():
-    out = kfsc.run_sclang("""
+def test_specs_names_carry_units_old_names_still_work_and_audio_delay_is_one_ms():
+    out = sclang.run_script("""
         var d = FrictionDevice.sim(nil, 0), e = FrictionDevice.sim(nil, 1, nil, (maxForce: 1.0, tactileLatencyS: 0.003));
+        [\\countMm, \\updateRateHz, \\maxSpeedMmPerS, \\minForceN, \\maxForceN, \\audioLatencyS, \\tactileLatencyS].do { |k|
+            "UNIT % %".format(k, d.specs[k]).postln };
         [\\countMm, \\updateRate, \\maxSpeed, \\minForce, \\maxForce, \\audioLatency, \\tactileLatency].do { |k|
             "SPEC % %".format(k, d.specs[k]).postln };
         "DELAY %".format(d.audioDelay.round(1e-9)).postln;
         "E % %".format(e.specs[\\maxForce], e.audioDelay.round(1e-9)).postln;
         "EMSG %".format(e.openMsg).postln;
     """)
+    for line in ["UNIT countMm 0.021", "UNIT updateRateHz 125", "UNIT maxSpeedMmPerS 333.375", "UNIT minForceN 0.14",
+                 "UNIT maxForceN 1.4", "UNIT audioLatencyS 0.0014", "UNIT tactileLatencyS 0.0024"]:
+        assert line in out, line
+    # The names without units of earlier versions, as a user may have typed them.
     for line in ["SPEC countMm 0.021", "SPEC updateRate 125", "SPEC maxSpeed 333.375", "SPEC minForce 0.14",
                  "SPEC maxForce 1.4", "SPEC audioLatency 0.0014", "SPEC tactileLatency 0.0024", "DELAY 0.001",
                  "E 1.0 0.0016"]:
@@ -173,7 +171,7 @@ def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
     0.5 s (whole blocks: 0.5 s is 375 blocks of 64 at 48 kHz)."""
     hand = "FrictionHand.path([[0, 0], [0.3, 20], [0.6, 5]])"
     early, _ = render_device("open_early", f"FrictionDevice.sim(nil, 0, {hand})", 1.2)
-    late, _ = kfsc.score_and_render("open_late", f"""
+    late, _ = nrt.score_and_render("open_late", f"""
         var dev = FrictionDevice.sim(nil, 0, {hand});
         var def = SynthDef(\\open_late, {{
             Out.ar(0, FrictionMouseIn.ar(0, 0, 1) ++ [FrictionOut.ar(0, DC.ar(0.3))])

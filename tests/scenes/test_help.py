@@ -1,23 +1,21 @@
 """Every .schelp file parses with SCDoc, and every code example in it compiles."""
-from pathlib import Path
+from kfharness import paths, sclang
 
-import kfsc
-
-HELP_DIR = Path(__file__).resolve().parents[2] / "HelpSource"
-CLASS_DIR = Path(__file__).resolve().parents[2] / "sc-classes"
+HELP_DIR = paths.REPO_DIR / "HelpSource"
+CLASS_DIR = paths.REPO_DIR / "sc-classes"
 
 
 def test_every_help_file_parses_and_its_examples_compile():
     files = sorted(HELP_DIR.rglob("*.schelp"))
     assert files, "no help files"
-    paths = ", ".join(f'"{p}"' for p in files)
-    out = kfsc.run_sclang(f"""
+    help_files = ", ".join(sclang.sc_string(p) for p in files)
+    out = sclang.run_script(f"""
         var failures = 0, codeBlocks = {{ |node|
             if(node.id == \\CODEBLOCK) {{ [node.text] }} {{
                 (node.children ? []).collect(codeBlocks).flatten(1)
             }}
         }};
-        [{paths}].do {{ |path|
+        [{help_files}].do {{ |path|
             var doc = SCDoc.parseFileFull(path), blocks;
             if(doc.isNil) {{ "HELP-PARSE-FAILED %".format(path).postln; failures = failures + 1 }} {{
                 blocks = codeBlocks.(doc);
@@ -37,7 +35,7 @@ def test_every_help_file_parses_and_its_examples_compile():
 
 def test_every_class_has_a_help_file():
     classes = []
-    for sc in CLASS_DIR.rglob("*.sc"):
+    for sc in [*CLASS_DIR.rglob("*.sc"), *CLASS_DIR.rglob("*.sc.in")]:
         for line in sc.read_text().splitlines():
             if line and not line[0].isspace() and line[0].isupper() and "{" in line:
                 classes.append(line.split()[0])

@@ -1,27 +1,13 @@
-"""LoudnessToFriction rendered by scsynth -N against equations (1) and (2) recomputed here."""
+"""LoudnessToFriction rendered by scsynth -N against equations (1) and (2) recomputed in double
+(kfharness.reference)."""
 import numpy as np
 import pytest
 
-import kfsc
-
-PAPER = dict(lo_db=-30.0, hi_db=0.0, lo_force=0.14, hi_force=0.5, ref=1.0)
-
-
-def equations_1_and_2(a, n, lo_db=-30.0, hi_db=0.0, lo_force=0.14, hi_force=0.5, ref=1.0):
-    """Force per sample from the paper's equations, in double, silence before the start.
-    NaN counts as silence and Inf as the loudest level, as the UGen documents."""
-    a = np.abs(np.asarray(a, dtype=np.float64))
-    a = np.where(np.isnan(a), 0.0, np.where(np.isinf(a), 1e30, a))
-    # A direct sum per window (no running sum here: an Inf sample would wreck one in double).
-    mean = np.convolve(a, np.ones(n))[: len(a)] / n
-    with np.errstate(divide="ignore"):
-        db = 20 * np.log10(mean / ref)
-    db = np.clip(db, lo_db, hi_db)
-    return lo_force + (db - lo_db) / (hi_db - lo_db) * (hi_force - lo_force)
+from kfharness import nrt, reference, sclang
 
 
 def render_in_and_force(name, source, sample_rate, args="", seconds=0.5):
-    data, log = kfsc.score_and_render(name, f"""
+    data, log = nrt.score_and_render(name, f"""
         var def = SynthDef(\\{name}, {{
             var in = {source};
             Out.ar(0, [in, LoudnessToFriction.ar(in{args})])
@@ -54,7 +40,7 @@ def test_per_sample_agreement_with_equations_1_and_2(sample_rate):
     source = "WhiteNoise.ar(XLine.ar(0.003, 3, 0.4))"
     audio, force, _ = render_in_and_force(f"agree{sample_rate}", source, sample_rate, seconds=0.4)
     n = int(round(sample_rate * 0.001))
-    want = equations_1_and_2(audio, n)
+    want = reference.equations_1_and_2(audio, n)
     err = np.abs(force - want)
     assert np.max(err) <= 1e-6, f"worst {np.max(err)} N at sample {np.argmax(err)}"
     assert force.min() == np.float32(0.14) and force.max() == np.float32(0.5), "the sweep spans the clip range"
@@ -66,13 +52,13 @@ def test_nan_and_inf_input_never_give_nan_or_inf_force():
     audio, force, _ = render_in_and_force("nonfinite", source, 48000)
     assert np.any(np.isnan(audio)) and np.any(np.isinf(audio)), "the input really had NaN and Inf"
     assert np.all(np.isfinite(force))
-    assert np.max(np.abs(force - equations_1_and_2(audio, 48))) <= 1e-6
+    assert np.max(np.abs(force - reference.equations_1_and_2(audio, 48))) <= 1e-6
 
 
 def test_window_changes_while_running_up_to_max_window():
     # The window glides from 1 to 4 ms (maxWindow 5 ms); n follows per block.
     sample_rate, block = 48000, 64
-    data, _ = kfsc.score_and_render("window", """
+    data, _ = nrt.score_and_render("window", """
         var def = SynthDef(\\window, {
             var in = WhiteNoise.ar(0.3), window = Line.kr(0.001, 0.004, 0.3);
             Out.ar(0, [in, LoudnessToFriction.ar(in, window, maxWindow: 0.005), K2A.ar(window)])
@@ -90,18 +76,13 @@ def test_window_changes_while_running_up_to_max_window():
         n = int(np.floor(sample_rate * np.float64(np.float32(window[start + block - 1])) + 0.5))
         for i in range(start, start + block):
             mean = (csum[i + 1] - csum[max(i + 1 - n, 0)]) / n
-            want = equations_1_and_2_from_mean(mean)
+            want = reference.force_of_mean(mean)
             worst = max(worst, abs(force[i] - want))
     assert worst <= 1e-6
 
 
-def equations_1_and_2_from_mean(mean):
-    db = 20 * np.log10(mean) if mean > 0 else -np.inf
-    return 0.14 + (np.clip(db, -30, 0) + 30) / 30 * 0.36
-
-
 def test_control_rate_and_bad_arguments():
-    out = kfsc.run_sclang("""
+    out = sclang.run_script("""
         var errors = List.new;
         SynthDef(\\kr, { Out.kr(0, LoudnessToFriction.kr(SinOsc.kr(1), 0.01)) }).add;
         [

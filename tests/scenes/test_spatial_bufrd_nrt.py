@@ -2,13 +2,13 @@
 import numpy as np
 import soundfile
 
-import kfsc
+from kfharness import nrt, paths, reference
 
 SR = 48000
 
 
 def write_signal(name, frames):
-    path = kfsc.WORK_DIR / f"{name}.wav"
+    path = paths.work_dir() / f"{name}.wav"
     soundfile.write(str(path), np.asarray(frames, dtype=np.float32), SR, subtype="FLOAT")
     return path
 
@@ -21,7 +21,7 @@ def pilot_sine():
 def test_position_ramp_over_sine_gives_speed_times_density_over_period():
     path = write_signal("sine", pilot_sine())
     speed_mm_per_s, samples_per_mm = 50.0, 500.0  # index rate 25000 /s over 100-sample cycles
-    data, _ = kfsc.score_and_render("ramp", f"""
+    data, _ = nrt.score_and_render("ramp", f"""
         var def = SynthDef(\\ramp, {{
             Out.ar(0, SpatialBufRd.ar(1, 0, Sweep.ar(0, {speed_mm_per_s}), {samples_per_mm}, 0, 4))
         }});
@@ -33,7 +33,7 @@ def test_position_ramp_over_sine_gives_speed_times_density_over_period():
     """)
     x = data[:, 0]
     expected_hz = speed_mm_per_s * samples_per_mm / 100.0
-    assert abs(kfsc.zero_crossing_frequency(x, SR) / expected_hz - 1) < 1e-4
+    assert abs(reference.zero_crossing_frequency(x, SR) / expected_hz - 1) < 1e-4
     # Per sample against the continuous sine the buffer samples (cubic error only).
     t = (np.arange(len(x)) + 1) / SR  # Sweep has advanced one sample at its first output
     truth = np.sin(2 * np.pi * t * speed_mm_per_s * samples_per_mm / 100.0)
@@ -44,7 +44,7 @@ def test_position_ramp_over_sine_gives_speed_times_density_over_period():
 def test_silence_before_and_after_the_signal_and_fades_at_the_borders():
     path = write_signal("ones", np.ones(1000))
     # Position -1 mm .. +11 mm over 1.2 s with 100 samples per mm: the signal spans 0 .. 10 mm.
-    data, _ = kfsc.score_and_render("borders", f"""
+    data, _ = nrt.score_and_render("borders", f"""
         var def = SynthDef(\\borders, {{
             Out.ar(0, SpatialBufRd.ar(1, 0, Sweep.ar(0, 10) - 1, 100, 0, 4))
         }});
@@ -70,9 +70,9 @@ def test_silence_before_and_after_the_signal_and_fades_at_the_borders():
 
 def test_multichannel_buffer():
     frames = np.stack([pilot_sine(), -0.5 * pilot_sine()], axis=1)
-    path = kfsc.WORK_DIR / "stereo.wav"
+    path = paths.work_dir() / "stereo.wav"
     soundfile.write(str(path), frames.astype(np.float32), SR, subtype="FLOAT")
-    data, _ = kfsc.score_and_render("stereo", f"""
+    data, _ = nrt.score_and_render("stereo", f"""
         var def = SynthDef(\\stereo, {{
             Out.ar(0, SpatialBufRd.ar(2, 0, Sweep.ar(0, 20), 500))
         }});
@@ -88,9 +88,9 @@ def test_multichannel_buffer():
 
 def test_missing_freed_and_mismatched_buffers_give_silence_and_one_message_each():
     path = write_signal("sine2", pilot_sine())
-    stereo = kfsc.WORK_DIR / "stereo2.wav"
+    stereo = paths.work_dir() / "stereo2.wav"
     soundfile.write(str(stereo), np.stack([pilot_sine()] * 2, axis=1).astype(np.float32), SR, subtype="FLOAT")
-    data, log = kfsc.score_and_render("badbufs", f"""
+    data, log = nrt.score_and_render("badbufs", f"""
         var def = SynthDef(\\bad, {{ |out, buf|
             Out.ar(out, SpatialBufRd.ar(1, buf, Sweep.ar(0, 10), 500))
         }});
@@ -119,7 +119,7 @@ def test_missing_freed_and_mismatched_buffers_give_silence_and_one_message_each(
 
 def test_nan_and_inf_positions_give_silence():
     path = write_signal("sine3", pilot_sine())
-    data, _ = kfsc.score_and_render("nanpos", f"""
+    data, _ = nrt.score_and_render("nanpos", f"""
         var def = SynthDef(\\nanpos, {{
             var infinite = DC.ar(1e30) * 1e30, nan = infinite - infinite;
             // samplesPerMm through a control: the class rejects a literal inf.

@@ -2,33 +2,31 @@
 a simulated device, and the measurements the main job and the scene tests make on it.
 
 One copy of the shared logic: scripts/pilot/main_job.py and tests/scenes/test_pilot_claims.py
-both import this module. It drives sclang and scsynth through tests/scenes/kfsc.py.
+both use this module.
 """
-import sys
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "tests" / "scenes"))
-import kfsc  # noqa: E402
+from . import nrt, profile, readers, reference
+
+_PILOT = profile.pilot()
+_DEVICE = profile.device()
 
 # Table 1 of the paper, as printed (frequencies rounded there).
 TABLE1 = {
-    "mapping1": dict(samples_per_mm=4000, cycle_mm=0.025, width_mm=6.0, lo_hz=104.0, hi_hz=13360.0),
-    "mapping2": dict(samples_per_mm=500, cycle_mm=0.2, width_mm=48.0, lo_hz=13.0, hi_hz=1670.0),
-    "mapping3": dict(samples_per_mm=8, cycle_mm=12.5, width_mm=3000.0, lo_hz=0.2, hi_hz=26.7),
+    "mapping1": dict(samples_per_mm=_PILOT["mapping1SamplesPerMm"], cycle_mm=0.025, width_mm=6.0, lo_hz=104.0, hi_hz=13360.0),
+    "mapping2": dict(samples_per_mm=_PILOT["mapping2SamplesPerMm"], cycle_mm=0.2, width_mm=48.0, lo_hz=13.0, hi_hz=1670.0),
+    "mapping3": dict(samples_per_mm=_PILOT["mapping3SamplesPerMm"], cycle_mm=12.5, width_mm=3000.0, lo_hz=0.2, hi_hz=26.7),
 }
-SIGNAL_FRAMES = 24000
-CYCLE_FRAMES = 100
-MIN_FORCE_N = 0.14          # magnet off (the paper device)
-HI_FORCE_N = 0.5            # top of the paper's friction mapping
-COUNT_MM, UPDATE_HZ = 0.021, 125
-SPEED_STEP = COUNT_MM * UPDATE_HZ          # 2.625 mm/s: one count per report
-MAX_SPEED = SPEED_STEP * 127               # 333.375 mm/s
-PAPER_SPEEDS = (2.6, 334.0)                # as the paper rounds them
-AUDIO_DELAY_S = 0.001
+SIGNAL_FRAMES = _PILOT["signalFrames"]
+CYCLE_FRAMES = _PILOT["cycleFrames"]
+MIN_FORCE_N = _DEVICE["minForceN"]              # magnet off (the paper device)
+HI_FORCE_N = profile.mapping()["hiForceN"]       # top of the paper's friction mapping
+SPEED_STEP = _DEVICE["countMm"] * _DEVICE["updateRateHz"]  # 2.625 mm/s: one count per report
+MAX_SPEED = profile.max_speed_mm_per_s()         # 333.375 mm/s
+PAPER_SPEEDS = (2.6, 334.0)                      # as the paper rounds them
+AUDIO_DELAY_S = profile.audio_delay_s()
 
 # Channels of a FrictionPilot.score render with recordBus 2.
 CHANNELS = ["out_left", "out_right", "position", "speed", "audio", "delayed_audio", "force", "commanded_force"]
@@ -41,8 +39,7 @@ def frequency(speed_mm_per_s, samples_per_mm):
 
 def full_scale_sine_force():
     """Equations (1)-(2) for a full-scale sine: mean |sin| = 2/pi -> -3.92 dB -> 0.453 N."""
-    db = 20 * np.log10(2 / np.pi)
-    return MIN_FORCE_N + (np.clip(db, -30, 0) + 30) / 30 * (HI_FORCE_N - MIN_FORCE_N)
+    return float(reference.force_of_mean(2 / np.pi))
 
 
 @dataclass
@@ -105,8 +102,8 @@ def score_code(scene, record_path=None):
 
 def render(scene, sample_rate=48000, record_path=None):
     """Renders the scene; returns a dict of channel name -> float64 array, plus 't' (s) and 'sr'."""
-    data, _ = kfsc.score_and_render(f"pilot-{scene.name}-{sample_rate}", score_code(scene, record_path),
-                                    sample_rate=sample_rate, channels=len(CHANNELS))
+    data, _ = nrt.score_and_render(f"pilot-{scene.name}-{sample_rate}", score_code(scene, record_path),
+                                   sample_rate=sample_rate, channels=len(CHANNELS))
     out = {name: data[:, i].astype(np.float64) for i, name in enumerate(CHANNELS)}
     out["t"] = np.arange(len(data)) / sample_rate
     out["sr"] = sample_rate
@@ -115,20 +112,13 @@ def render(scene, sample_rate=48000, record_path=None):
 
 # ---- measurements ----
 
-def rising_crossings(x):
-    """Rising zero crossings located to a fraction of a sample."""
-    x = np.asarray(x, dtype=np.float64)
-    idx = np.nonzero((x[:-1] < 0) & (x[1:] >= 0))[0]
-    return idx + (-x[idx]) / (x[idx + 1] - x[idx])
-
-
 def cycle_frequencies(r, samples_per_mm, origin_mm, min_speed=SPEED_STEP):
     """For every signal cycle crossed in one steady direction: (time s, measured Hz from the
     audio's rising zero crossings, the formula's Hz from the mean speed over the same cycle).
     A cycle counts when the puck moved at >= min_speed in one direction throughout it and both
     crossings lie inside the signal (not at its borders with silence)."""
     sr = r["sr"]
-    c = rising_crossings(r["audio"])
+    c = reference.rising_crossings(r["audio"])
     index = (r["position"][np.round(c).astype(int).clip(0, len(r["position"]) - 1)] - origin_mm) * samples_per_mm
     c = c[(index > 2) & (index < SIGNAL_FRAMES - 3)]
     if len(c) < 2:
@@ -155,7 +145,7 @@ def segment_frequency(r, t0, t1):
     mean |speed| over the same crossings' span (mm/s)."""
     sr = r["sr"]
     i0, i1 = int(t0 * sr), int(t1 * sr)
-    c = rising_crossings(r["audio"][i0:i1]) + i0
+    c = reference.rising_crossings(r["audio"][i0:i1]) + i0
     if len(c) < 3:
         raise AssertionError(f"too few zero crossings in {t0}..{t1} s")
     f = sr * (len(c) - 1) / (c[-1] - c[0])
@@ -225,11 +215,7 @@ def lag_samples(reference, delayed, max_lag):
 
 def loudness_force(audio, sample_rate, window_s=0.001):
     """Equations (1)-(2) in numpy: the force the paper computes from an audio signal."""
-    n = int(round(sample_rate * window_s))
-    c = np.concatenate([np.zeros(n), np.cumsum(np.abs(audio))])
-    mean_abs = (c[n:] - c[:-n]) / n
-    db = 20 * np.log10(np.maximum(mean_abs, 1e-12))
-    return MIN_FORCE_N + (np.clip(db, -30, 0) + 30) / 30 * (HI_FORCE_N - MIN_FORCE_N)
+    return reference.equations_1_and_2(audio, int(round(sample_rate * window_s)))
 
 
 def device_force(frames, n_samples, sample_rate, min_force_n=MIN_FORCE_N):
@@ -247,9 +233,4 @@ def device_force(frames, n_samples, sample_rate, min_force_n=MIN_FORCE_N):
 
 def read_session_frames(path):
     """F lines of a kf-session recording: array of (frameTimeS, requestedN, commandedN)."""
-    rows = []
-    for line in Path(path).read_text().splitlines():
-        if line.startswith("F "):
-            f = line.split()
-            rows.append((float(f[2]), float(f[3]), float(f[4])))
-    return np.array(rows).reshape(-1, 3)
+    return readers.Session(path).frames[:, 1:4]
