@@ -20,7 +20,8 @@
 namespace {
 
 // The paper's mapping: [-30, 0] dB -> [0.14, 0.5] N.
-constexpr double kLoDb = -30.0, kHiDb = 0.0, kLoForceN = 0.14, kHiForceN = 0.5;
+constexpr double kLoDb = kf::paper::mapping::loDb, kHiDb = kf::paper::mapping::hiDb;
+constexpr double kLoForceN = kf::paper::mapping::loForceN, kHiForceN = kf::paper::mapping::hiForceN;
 constexpr double kForcePerDb = (kHiForceN - kLoForceN) / (kHiDb - kLoDb);
 constexpr double kForceOffset = kLoForceN - kLoDb * kForcePerDb;
 const double kLoAbs = std::pow(10.0, kLoDb / 20.0), kHiAbs = 1.0;

@@ -46,8 +46,8 @@ int main() {
   const Movement movements[] = {
       {"slow 10 mm/s", HandScript::speeds({{10.0, 3.0}}), 3.0},
       {"fast 250 mm/s", HandScript::speeds({{250.0, 1.0}}), 1.0},
-      {"reversing +-30 mm at 1 Hz",
-       HandScript::path({{0, 0}, {0.5, 30}, {1.0, 0}, {1.5, 30}, {2.0, 0}, {2.5, 30}}), 2.5},
+      {"reversing +-30 mm at 1 Hz", HandScript::path({{0, 0}, {0.5, 30}, {1.0, 0}, {1.5, 30}, {2.0, 0}, {2.5, 30}}),
+       2.5},
   };
   const char* modeNames[] = {"hold", "linear", "predictive"};
   std::printf("{\n  \"accuracy\": [\n");
@@ -55,10 +55,10 @@ int main() {
   for (const Movement& m : movements) {
     for (int mode = 0; mode < 3; ++mode) {
       const auto r = kf::test::reconstructAgainstSim(m.hand, m.seconds, static_cast<TrajectoryMode>(mode));
-      std::printf("%s    {\"movement\": \"%s\", \"mode\": \"%s\", \"lagMs\": %.3f, \"rmsErrorMm\": %.5f, "
-                  "\"rmsErrorAtLagMm\": %.5f, \"maxStepMm\": %.5f}",
-                  first ? "" : ",\n", m.name, modeNames[mode], r.lagS * 1e3, r.rmsErrorMm, r.rmsErrorAtLagMm,
-                  r.maxStepMm);
+      std::printf(
+          "%s    {\"movement\": \"%s\", \"mode\": \"%s\", \"lagMs\": %.3f, \"rmsErrorMm\": %.5f, "
+          "\"rmsErrorAtLagMm\": %.5f, \"maxStepMm\": %.5f}",
+          first ? "" : ",\n", m.name, modeNames[mode], r.lagS * 1e3, r.rmsErrorMm, r.rmsErrorAtLagMm, r.maxStepMm);
       first = false;
     }
   }

@@ -4,20 +4,23 @@
 
 #include <string_view>
 
+#include "PaperProfile.hpp"
+
 namespace kf {
 
 struct DeviceSpec {
-  double countMm = 0.021;        // one sensor count; 334 mm/s / (127 counts x 125 Hz)
-  double updateRateHz = 125.0;   // HID report rate of the mouse sensor
-  int maxCountsPerReport = 127;  // int8 counts per axis
-  double minForceN = 0.14;       // kinetic friction with the magnet off
-  double maxForceN = 1.4;
-  double audioLatencyS = 0.0014;
-  double tactileLatencyS = 0.0024;
-  double forceFramePeriodS = 0.001;   // 1 kHz force frames
-  double maxForceSlewNPerS = 2000.0;  // 1.26 N in 0.63 ms
-  double watchdogS = 0.05;            // no frame for this long -> magnet off (minForceN)
-  double magnetLagS = 0.0024;         // sim: first-order lag of the magnet's force
+  // The paper's device by default (profiles/paper.json).
+  double countMm = paper::device::countMm;            // one sensor count; 334 mm/s / (127 counts x 125 Hz)
+  double updateRateHz = paper::device::updateRateHz;  // HID report rate of the mouse sensor
+  int maxCountsPerReport = static_cast<int>(paper::device::maxCountsPerReport);  // int8 counts per axis
+  double minForceN = paper::device::minForceN;                                   // kinetic friction with the magnet off
+  double maxForceN = paper::device::maxForceN;
+  double audioLatencyS = paper::device::audioLatencyS;
+  double tactileLatencyS = paper::device::tactileLatencyS;
+  double forceFramePeriodS = paper::device::forceFramePeriodS;  // 1 kHz force frames
+  double maxForceSlewNPerS = paper::device::maxForceSlewNPerS;  // 1.26 N in 0.63 ms
+  double watchdogS = paper::device::watchdogS;                  // no frame for this long -> magnet off (minForceN)
+  double magnetLagS = paper::device::magnetLagS;                // sim: first-order lag of the magnet's force
 
   // maxCounts * countMm * updateRate: 334 mm/s for the paper profile.
   double maxSpeedMmPerS() const { return maxCountsPerReport * countMm * updateRateHz; }

@@ -14,6 +14,8 @@
 
 #include <cstdint>
 
+#include "PaperProfile.hpp"
+
 namespace kf {
 
 class ForceFramer {
@@ -21,7 +23,8 @@ class ForceFramer {
   // Receives each completed frame: its start time (audio seconds) and clamped mean force.
   using FrameSink = void (*)(void* context, double frameTimeS, float forceN);
 
-  ForceFramer(double framePeriodS = 0.001, double minForceN = 0.14, double maxForceN = 1.4);
+  ForceFramer(double framePeriodS = paper::device::forceFramePeriodS, double minForceN = paper::device::minForceN,
+              double maxForceN = paper::device::maxForceN);
 
   void setForceRange(double minForceN, double maxForceN);
   // Forgets the frame in progress and the last commanded value (back to minForceN).

@@ -8,14 +8,17 @@
 
 #include <cstdint>
 
+#include "PaperProfile.hpp"
+
 namespace kf {
 
+// The paper's mapping by default.
 struct FrictionMapping {
-  double loDb = -30.0;
-  double hiDb = 0.0;
-  double loForceN = 0.14;
-  double hiForceN = 0.5;
-  double ref = 1.0;  // a_ref: the mean |a| that reads 0 dB
+  double loDb = paper::mapping::loDb;
+  double hiDb = paper::mapping::hiDb;
+  double loForceN = paper::mapping::loForceN;
+  double hiForceN = paper::mapping::hiForceN;
+  double ref = paper::mapping::ref;  // a_ref: the mean |a| that reads 0 dB
 };
 
 // Equation (2) on one mean amplitude, in double: the reference the tests and benchmarks use.

@@ -28,7 +28,9 @@ TrajectoryMode trajectoryModeFromCode(int code) {
 }
 
 TrajectoryReconstructor::TrajectoryReconstructor(double updateRateHz, TrajectoryMode mode)
-    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : 125.0)), mode_(mode), nextMode_(mode) {}
+    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : paper::device::updateRateHz)),
+      mode_(mode),
+      nextMode_(mode) {}
 
 void TrajectoryReconstructor::reset() {
   axes_ = {};

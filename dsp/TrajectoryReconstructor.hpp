@@ -29,6 +29,8 @@
 #include <array>
 #include <cstdint>
 
+#include "PaperProfile.hpp"
+
 namespace kf {
 
 enum class TrajectoryMode : int { Hold = 0, Linear = 1, Predictive = 2 };
@@ -38,7 +40,8 @@ TrajectoryMode trajectoryModeFromCode(int code);
 
 class TrajectoryReconstructor {
  public:
-  explicit TrajectoryReconstructor(double updateRateHz = 125.0, TrajectoryMode mode = TrajectoryMode::Linear);
+  explicit TrajectoryReconstructor(double updateRateHz = paper::device::updateRateHz,
+                                   TrajectoryMode mode = TrajectoryMode::Linear);
 
   // Takes effect at the next report, so the output never jumps because of it.
   void setMode(TrajectoryMode mode) { nextMode_ = mode; }

@@ -3,6 +3,7 @@
 // init). Everything but `in` is read once per block.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "LoudnessToFriction.hpp"
 #include "PluginShared.hpp"
@@ -25,7 +26,7 @@ class LoudnessToFrictionUGen : public SCUnit {
       kf::sc::clearUnitOnAllocFailure(this, "LoudnessToFriction");
       return;
     }
-    mCore = new (&mCoreStorage) kf::LoudnessToFriction(mHistory, mCapacity);
+    mCore.emplace(mHistory, mCapacity);
     mCalcFunc = make_calc_function<LoudnessToFrictionUGen, &LoudnessToFrictionUGen::next>();
     updateParameters();
     out0(0) = mCore->peekForce(in0(kIn));  // initial value, without consuming the first sample
@@ -53,9 +54,8 @@ class LoudnessToFrictionUGen : public SCUnit {
 
   float* mHistory = nullptr;
   int mCapacity = 1;
-  // The core lives inside the unit (placement new): no allocation besides the history.
-  alignas(kf::LoudnessToFriction) unsigned char mCoreStorage[sizeof(kf::LoudnessToFriction)];
-  kf::LoudnessToFriction* mCore = nullptr;
+  // The core lives inside the unit, made once the history is allocated: no other allocation.
+  std::optional<kf::LoudnessToFriction> mCore;
   kf::FrictionMapping mMapping;
 };
 

@@ -13,25 +13,19 @@ enum class BufferProblem { None, NotAllocated, ChannelMismatch };
 
 class SpatialBufRd : public SCUnit {
  public:
-  SpatialBufRd() {
-    set_calc_function<SpatialBufRd, &SpatialBufRd::next>();
-    next(1);
-  }
+  // set_calc_function computes the first sample (next(1)), as SC's own UGens do.
+  SpatialBufRd() { set_calc_function<SpatialBufRd, &SpatialBufRd::next>(); }
 
  private:
   void next(int numSamples) {
     const SndBuf* buf = lookupBuffer();
-    const int numChannels = static_cast<int>(mNumOutputs);
-    BufferProblem problem = BufferProblem::None;
-    if (buf == nullptr || buf->data == nullptr || buf->frames <= 0)
-      problem = BufferProblem::NotAllocated;
-    else if (buf->channels != numChannels)
-      problem = BufferProblem::ChannelMismatch;
-    report(problem, buf);
-    if (problem != BufferProblem::None) {
-      for (int c = 0; c < numChannels; ++c) std::fill_n(out(c), numSamples, 0.f);
-      return;
-    }
+    if (buf == nullptr) return silence(BufferProblem::NotAllocated, buf, numSamples);
+    // Held for the block, as GET_BUF_SHARED does: under supernova another thread may reallocate
+    // the buffer meanwhile (no-op in scsynth).
+    LOCK_SNDBUF_SHARED(buf);
+    if (buf->data == nullptr || buf->frames <= 0) return silence(BufferProblem::NotAllocated, buf, numSamples);
+    if (buf->channels != static_cast<int>(mNumOutputs)) return silence(BufferProblem::ChannelMismatch, buf, numSamples);
+    report(BufferProblem::None, buf);
 
     const kf::SignalView signal{buf->data, buf->frames, buf->channels};
     const double samplesPerMm = in0(kSamplesPerMm);
@@ -43,22 +37,37 @@ class SpatialBufRd : public SCUnit {
                          interpolation, mOutBuf, numSamples);
   }
 
-  // The buffer for the bufnum input, global or local to the synth, or nullptr; looked up every
-  // block so that a freed or swapped buffer is seen at once.
+  void silence(BufferProblem problem, const SndBuf* buf, int numSamples) {
+    report(problem, buf);
+    for (uint32 c = 0; c < mNumOutputs; ++c) std::fill_n(out(c), numSamples, 0.f);
+  }
+
+  // The buffer for the bufnum input, global or local to the synth, or nullptr. As GET_BUF
+  // does, the SndBuf is found again only when bufnum changes: its slot stays put, and a freed or
+  // reallocated buffer shows in its fields at once.
   const SndBuf* lookupBuffer() {
     const float fbufnum = in0(kBufnum);
+    if (fbufnum == mFBufnum) return mBuf;
+    mFBufnum = fbufnum;
+    mBuf = nullptr;
     if (!(fbufnum >= 0.f)) return nullptr;
     const auto bufnum = static_cast<uint32>(fbufnum);
     mBufnum = static_cast<int>(bufnum);
-    if (bufnum < mWorld->mNumSndBufs) return mWorld->mSndBufs + bufnum;
-    const int localBufnum = static_cast<int>(bufnum - mWorld->mNumSndBufs);
-    if (localBufnum < mParent->localBufNum) return mParent->mLocalSndBufs + localBufnum;
-    return nullptr;
+    if (bufnum < mWorld->mNumSndBufs) {
+      mBuf = mWorld->mSndBufs + bufnum;
+    } else {
+      const int localBufnum = static_cast<int>(bufnum - mWorld->mNumSndBufs);
+      if (localBufnum < mParent->localBufNum) mBuf = mParent->mLocalSndBufs + localBufnum;
+    }
+    return mBuf;
   }
 
+  // One message each time the problem changes, unless the server runs quiet (verbosity -2 and
+  // below, as for SC's own buffer UGens).
   void report(BufferProblem problem, const SndBuf* buf) {
     if (problem == mProblem) return;
     mProblem = problem;
+    if (mWorld->mVerbosity <= -2) return;
     if (problem == BufferProblem::NotAllocated)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n", mBufnum);
     else if (problem == BufferProblem::ChannelMismatch)
@@ -67,6 +76,8 @@ class SpatialBufRd : public SCUnit {
   }
 
   BufferProblem mProblem = BufferProblem::None;
+  float mFBufnum = -1e9f;  // the bufnum input mBuf was found for
+  const SndBuf* mBuf = nullptr;
   int mBufnum = -1;
 };
 

@@ -2,28 +2,33 @@
 // or (later) hardware. Every command has a ...Msg twin that returns the OSC message, so the
 // same device can be used in a Score (pass server nil to only describe it).
 FrictionDevice {
-	classvar <paperSpecs, <settingNames;
+	classvar <oldSpecNames;
 	var <server, <index, <specs, <kind, <source, <overrides;
 
 	*initClass {
-		// DESIGN.md's names for the device's numbers, and the device library's setting names
-		// (with their units) that profiles use; either may be given in a profile.
-		settingNames = (
-			countMm: \countMm, updateRate: \updateRateHz, maxCountsPerReport: \maxCountsPerReport,
-			minForce: \minForceN, maxForce: \maxForceN, audioLatency: \audioLatencyS,
-			tactileLatency: \tactileLatencyS, forceFramePeriod: \forceFramePeriodS,
-			maxForceSlew: \maxForceSlewNPerS, watchdog: \watchdogS, magnetLag: \magnetLagS
+		// The names specs had before every name carried its unit. A user may have typed them, so
+		// a profile still accepts them and specs still answers to them (through its parent).
+		oldSpecNames = (
+			updateRate: \updateRateHz, maxSpeed: \maxSpeedMmPerS, minForce: \minForceN,
+			maxForce: \maxForceN, audioLatency: \audioLatencyS, tactileLatency: \tactileLatencyS,
+			forceFramePeriod: \forceFramePeriodS, maxForceSlew: \maxForceSlewNPerS,
+			watchdog: \watchdogS, magnetLag: \magnetLagS
 		);
-		paperSpecs = (
-			countMm: 0.021, updateRate: 125, maxCountsPerReport: 127, minForce: 0.14, maxForce: 1.4,
-			audioLatency: 0.0014, tactileLatency: 0.0024, forceFramePeriod: 0.001, maxForceSlew: 2000,
-			watchdog: 0.05, magnetLag: 0.0024
-		);
-		paperSpecs[\maxSpeed] = this.maxSpeedOf(paperSpecs);
+	}
+
+	// The paper's device numbers (profiles/paper.json) and its top speed, as specs has them.
+	*paperSpecs { ^this.specsOf(KineticFriction.paperDevice) }
+
+	// settings (device setting names) with maxSpeedMmPerS added and the old names as aliases.
+	*specsOf { |settings|
+		var specs = settings.copy;
+		specs[\maxSpeedMmPerS] = this.maxSpeedOf(specs);
+		specs.parent = oldSpecNames.collect { |name| specs[name] };
+		^specs
 	}
 
 	// counts x count size x update rate: 333.375 mm/s for the paper's device (the paper says 334).
-	*maxSpeedOf { |specs| ^specs[\countMm] * specs[\maxCountsPerReport] * specs[\updateRate] }
+	*maxSpeedOf { |specs| ^specs[\countMm] * specs[\maxCountsPerReport] * specs[\updateRateHz] }
 
 	// hand: a FrictionHand (nil: the puck stays put). profile: an Event of spec or simulation
 	// settings by name (e.g. (maxForceN: 1.0, puckMassKg: 0.2)); nil: the paper's numbers.
@@ -45,7 +50,7 @@ FrictionDevice {
 	}
 
 	// Audio is delayed by this much so that sound and touch arrive together (the paper: 1 ms).
-	audioDelay { ^specs[\tactileLatency] - specs[\audioLatency] }
+	audioDelay { ^specs[\tactileLatencyS] - specs[\audioLatencyS] }
 
 	openMsg {
 		^if(kind == \sim) {
@@ -84,11 +89,11 @@ FrictionDevice {
 		overrides = ();
 		(profile ? ()).keysValuesDo { |key, value|
 			if(value.isNumber.not) { Error("FrictionDevice: setting % must be a number, got %".format(key, value)).throw };
-			overrides[settingNames[key] ? key] = value;  // DESIGN names become setting names
+			overrides[oldSpecNames[key] ? key] = value;
 		};
-		specs = paperSpecs.copy;
-		settingNames.keysValuesDo { |name, setting| overrides[setting] !? { |v| specs[name] = v } };
-		specs[\maxSpeed] = this.class.maxSpeedOf(specs);
+		specs = KineticFriction.paperDevice;
+		specs.keys.do { |name| overrides[name] !? { |v| specs[name] = v } };
+		specs = this.class.specsOf(specs);
 	}
 
 	prOpen { this.prSend(this.openMsg) }

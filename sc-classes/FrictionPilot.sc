@@ -3,16 +3,23 @@
 // device's audioDelay so sound and touch arrive together) and felt (LoudnessToFriction ->
 // FrictionOut), on one device slot. Positions in mm, times in s, forces in N.
 FrictionPilot {
-	classvar <mappings, <signalFrames = 24000, <cycleFrames = 100;
-	classvar <paperLoForceN = 0.14, <paperHiForceN = 0.5, <paperAudioDelayS = 0.001;
+	classvar <mappings, <signalFrames, <cycleFrames;
+	classvar <paperLoForceN, <paperHiForceN, <paperAudioDelayS;
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
 	var <buffer, <synth, <defName;
 
 	*initClass {
+		var pilot = KineticFriction.paperPilot, mapping = KineticFriction.paperMapping;
 		// Table 1: samples per mm of the three mappings.
-		mappings = (mapping1: 4000, mapping2: 500, mapping3: 8);
+		mappings = (mapping1: pilot[\mapping1SamplesPerMm], mapping2: pilot[\mapping2SamplesPerMm],
+			mapping3: pilot[\mapping3SamplesPerMm]);
+		signalFrames = pilot[\signalFrames];
+		cycleFrames = pilot[\cycleFrames];
+		paperLoForceN = mapping[\loForceN];
+		paperHiForceN = mapping[\hiForceN];
+		paperAudioDelayS = KineticFriction.paperDevice.use { ~tactileLatencyS - ~audioLatencyS };
 		// What the recording outputs carry, in this order, from recordBus on.
 		recordChannelNames = [\positionMm, \speedMmPerS, \audio, \delayedAudio, \requestedForceN, \commandedForceN];
 	}
@@ -94,8 +101,11 @@ FrictionPilot {
 	// friction 0 keeps the magnet at loForceN (use the device's minimum, 0.14 N for the paper).
 	// amp scales only what is heard; the force follows the signal as read (amplitude 1 = 0 dB).
 	*ar { |device = 0, bufnum = 0, samplesPerMm = 4000, origin = 0, friction = 1, amp = 1,
-		audioDelay = 0.001, loForceN = 0.14, hiForceN = 0.5, maxAudioDelay = 0.05|
+		audioDelay, loForceN, hiForceN, maxAudioDelay = 0.05|
 		var mouse, audio, loudness, force, commanded, delayed;
+		audioDelay = audioDelay ? paperAudioDelayS;
+		loForceN = loForceN ? paperLoForceN;
+		hiForceN = hiForceN ? paperHiForceN;
 		[\samplesPerMm, samplesPerMm, \origin, origin, \friction, friction, \amp, amp,
 			\loForceN, loForceN, \hiForceN, hiForceN].pairsDo { |name, value|
 			if(value.isNumber and: { value.isNaN or: { value.abs == inf } }) {
@@ -114,7 +124,7 @@ FrictionPilot {
 		mouse = FrictionMouseIn.ar(device, 0, 1);
 		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4);
 		// Equations (1) and (2): 1 ms mean |a| -> dB -> [-30, 0] dB onto [lo, hi] N.
-		loudness = LoudnessToFriction.ar(audio, 0.001, -30, 0, loForceN, hiForceN, 1);
+		loudness = LoudnessToFriction.ar(audio, loForce: loForceN, hiForce: hiForceN);
 		force = loForceN + (friction.clip(0, 1) * (loudness - loForceN));
 		commanded = FrictionOut.ar(device, force);
 		// Audio latency 1.4 ms, tactile 2.4 ms: audio waits the difference (1 ms).
@@ -283,7 +293,7 @@ FrictionPilot {
 	}
 
 	*prMinForce { |device|
-		^if(device.isKindOf(FrictionDevice)) { device.specs[\minForce] } { paperLoForceN }
+		^if(device.isKindOf(FrictionDevice)) { device.specs[\minForceN] } { paperLoForceN }
 	}
 
 	*prCheckFriction { |on, method|

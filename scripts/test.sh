@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# Sets everything up (scripts/setup.sh), then runs every test: Catch2 (dsp, device), the
-# NRT scene tests, the help files, and the realtime tests against JACK's dummy driver.
+# Sets everything up (scripts/setup.sh), checks the habits CI enforces (scripts/check.sh:
+# formatting, pyflakes, the build without SuperCollider, the sanitizer build), then runs every
+# test of build/: Catch2 (dsp, device), the NRT scene tests (with scsynth and, when installed,
+# supernova), the help files, and the realtime tests against JACK's dummy driver.
+# Extra arguments go to ctest, e.g. scripts/test.sh -R scenes/
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/env.sh
+scripts/check.sh
 ctest --test-dir build --output-on-failure -j 1 "$@"

@@ -1,4 +1,6 @@
-"""Renders of Scores with scsynth -N and the plugin loaded."""
+"""Renders of Scores with scsynth -N (or supernova -N: KF_NRT_SERVER=supernova) and the plugin
+loaded."""
+import os
 import subprocess
 import time
 
@@ -13,14 +15,15 @@ def plugin_path(extra_dirs=()):
 
 def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, timeout=300,
            sample_format="float", memory_kb=65536, extra_args=(), plugin_dirs=()):
-    """Renders an OSC score file; returns scsynth's output (an AssertionError if it failed)."""
-    cmd = ["scsynth", "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
+    """Renders an OSC score file; returns the server's output (an AssertionError if it failed)."""
+    server = os.environ.get("KF_NRT_SERVER", "scsynth")
+    cmd = [server, "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
            "-o", str(channels), "-i", "0", "-z", str(block_size), "-U", plugin_path(plugin_dirs),
            "-m", str(memory_kb), *map(str, extra_args)]
     proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           timeout=timeout, text=True, errors="replace")
     failed = proc.returncode != 0 or "FAILURE" in proc.stdout or "not installed" in proc.stdout
-    assert not failed, f"scsynth -N failed ({proc.returncode}):\n{proc.stdout[-4000:]}"
+    assert not failed, f"{server} -N failed ({proc.returncode}):\n{proc.stdout[-4000:]}"
     return proc.stdout
 
 
