@@ -60,7 +60,7 @@ def test_sim_device_moves_the_puck_and_receives_the_force(jack):
         s.sync;
         ~t0 = Main.elapsedTime;
         dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[50, 1.5]]));
-        s.sync;  // kfRecord right after kfOpenSim does not find the device yet (see below)
+        s.sync;
         dev.record({sclang.sc_string(record)});
         s.sync;
         "KF-OPENED %".format(Main.elapsedTime - ~t0).postln;

@@ -101,8 +101,8 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
       trajectory.render(startS, kSampleDurS, kBlock, 0.0, x.data(), y.data(), vx.data(), vy.data());
       // SpatialBufRd
       const kf::SignalView sv{signal.data(), static_cast<int64_t>(signal.size()), 1};
-      for (int i = 0; i < kBlock; ++i)
-        audio[i] = kf::readSpatial(sv, 0, kf::spatialIndex(x[i], 0.0, 500.0), kf::Interpolation::Cubic);
+      float* audioOut[] = {audio.data()};
+      kf::readSpatialBlock(sv, x.data(), 1, 0.0, 500.0, kf::Interpolation::Cubic, audioOut, kBlock);
       // LoudnessToFriction
       loudness.process(audio.data(), forceN.data(), kBlock);
       // FrictionOut
