@@ -30,7 +30,8 @@ def spatial(tm, sp):
                   source=tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-source"]["median"],
                   worst=max(en["SpatialBufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values()),
                   worst_bufrd=max(en["BufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values()),
-                  index=long["SpatialBufRd cubic"]["max_index_error"], index_bufrd=long["BufRd cubic"]["max_index_error"])
+                  index=long["SpatialBufRd cubic"]["max_index_error"],
+                  index_bufrd=long["BufRd cubic"]["max_index_error"])
 
 
 def loudness(tm, ld):
@@ -58,9 +59,11 @@ def realtime(e2e):
     runs = e2e["runs"]
     p99 = [r["force to magnet"]["p99_ms"] for r in runs]
     jitter = [r["loop period"]["p99_ms"] - FORCE_FRAME_MS for r in runs]
-    return [render("goal_force", goal_ms=FORCE_GOAL_MS, frame_ms=FORCE_FRAME_MS, status=_status(max(p99) <= FORCE_GOAL_MS),
-                   p99=_values(p99), max=_values(r["force to magnet"]["max_ms"] for r in runs), runs=len(runs)),
-            render("goal_jitter", goal_us=JITTER_GOAL_MS * 1e3, frame_ms=FORCE_FRAME_MS, loop_khz=1 / FORCE_FRAME_MS,
+    return [render("goal_force", goal_ms=FORCE_GOAL_MS, frame_ms=FORCE_FRAME_MS,
+                   status=_status(max(p99) <= FORCE_GOAL_MS), p99=_values(p99),
+                   max=_values(r["force to magnet"]["max_ms"] for r in runs), runs=len(runs)),
+            render("goal_jitter", goal_us=JITTER_GOAL_MS * 1e3, frame_ms=FORCE_FRAME_MS,
+                   loop_khz=1 / FORCE_FRAME_MS,
                    status=_status(max(jitter) <= JITTER_GOAL_MS), jitter_us=_values(jitter, 0, 1e3), runs=len(runs),
                    period_max=_values(r["loop period"]["max_ms"] for r in runs))]
 

@@ -85,7 +85,9 @@ def run_scale(bench, sample_rate, window_s=2.0, settle_s=0.75, max_voices=8192, 
                            hi_db=MAPPING["hiDb"], lo_force_n=MAPPING["loForceN"], hi_force_n=MAPPING["hiForceN"],
                            ref=MAPPING["ref"], audio_delay_s=round(profile.audio_delay_s(), 9))
         t = time.monotonic()
-        run = sclang.run_with_server(code, server, timeout=budget_s + 90, name=f"bench-scale-{sample_rate}",
+        # The search stops itself after budget_s; the margin is for a loaded machine (sclang starved
+        # by a SCHED_FIFO scsynth at full load on one core and the other busy) to finish and quit.
+        run = sclang.run_with_server(code, server, timeout=2 * budget_s + 90, name=f"bench-scale-{sample_rate}",
                                      include_paths=bench.include_paths, server_options=SCALE_SERVER_OPTIONS)
     if not run.ok:
         _failed(f"scale run at {sample_rate} Hz", run)

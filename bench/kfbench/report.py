@@ -154,9 +154,9 @@ def e2e_section(e2e):
     runs = e2e["runs"]
     rows = [(i + 1, key, f"{r[key]['p50_ms']:.3f}", f"{r[key]['p99_ms']:.3f}", f"{r[key]['max_ms']:.3f}", r[key]["n"])
             for i, r in enumerate(runs) for key in realtime.MEASURES]
-    return render("e2e", cmd=CMD, rate=SR, period=E2E_PERIOD, block=BLOCK, audio_delay_ms=AUDIO_DELAY_MS, signal_mm=realtime.SIGNAL_MM,
-                  hand_mm_per_s=realtime.SIGNAL_MM / 0.5, seconds=e2e["seconds"], loop_khz=LOOP_HZ / 1000,
-                  frame_ms=FORCE_FRAME_MS, runs=len(runs), block_ms=BLOCK / SR * 1e3,
+    return render("e2e", cmd=CMD, rate=SR, period=E2E_PERIOD, block=BLOCK, audio_delay_ms=AUDIO_DELAY_MS,
+                  signal_mm=realtime.SIGNAL_MM, hand_mm_per_s=realtime.SIGNAL_MM / 0.5, seconds=e2e["seconds"],
+                  loop_khz=LOOP_HZ / 1000, frame_ms=FORCE_FRAME_MS, runs=len(runs), block_ms=BLOCK / SR * 1e3,
                   table=table(["run", "measure", "p50 (ms)", "p99 (ms)", "max (ms)", "n"], rows),
                   overflows=", ".join(f"{r.get('overflows')}" for r in runs),
                   xruns=", ".join(f"{r['client_xruns']} / {r['driver_xruns']}" for r in runs),
@@ -175,9 +175,9 @@ def scale_section(sc):
                             table=table(["voices", "xruns (window 1)", "xruns (window 2)", "dummy driver late",
                                          "avg CPU %", "peak CPU %"], rows)))
     first = next(iter(sc.values()))
-    return render("scale", cmd=CMD, mappings=", ".join(map(str, MAPPINGS)), audio_delay_ms=AUDIO_DELAY_MS, priority=realtime.REALTIME_PRIORITY,
-                  period=E2E_PERIOD, settle_s=first["settle_s"], window_s=first["window_s"],
-                  xrun_percent=100 * first["xrun_fraction"], rates="\n\n".join(rates))
+    return render("scale", cmd=CMD, mappings=", ".join(map(str, MAPPINGS)), audio_delay_ms=AUDIO_DELAY_MS,
+                  priority=realtime.REALTIME_PRIORITY, period=E2E_PERIOD, settle_s=first["settle_s"],
+                  window_s=first["window_s"], xrun_percent=100 * first["xrun_fraction"], rates="\n\n".join(rates))
 
 
 def log_section(lc, build_dir):
