@@ -102,7 +102,9 @@ def run_scale(bench, sample_rate, window_s=2.0, settle_s=0.75, max_voices=8192, 
            "realtime_jack": realtime, "xrun_fraction": xrun_fraction,
            "xrun_limit": int(run.lines("KF-SCALE-LIMIT ")[0][0]),
            "max_without_xrun": lo, "first_with_xrun": hi if hi >= 0 else None,
-           "capped": bool(run.lines("KF-SCALE-CAP")), "wall_s": time.monotonic() - t}
+           "capped": bool(run.lines("KF-SCALE-CAP")), "wall_s": time.monotonic() - t,
+           # the step at which scsynth stopped answering /sync (JACK no longer ran it), if any
+           "unresponsive_at": next((int(f[0]) for f in run.lines("KF-SCALE-UNRESPONSIVE ")), None)}
     log(f"scale {sample_rate} Hz: {lo} voices without an xrun, first xrun at {out['first_with_xrun']} "
         f"({len(steps)} steps, {out['wall_s']:.0f} s)")
     return out
