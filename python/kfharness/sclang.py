@@ -103,7 +103,7 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 	options.memSize = 65536;
 	options.maxLogins = 4;
 	options.bindAddress = "127.0.0.1";
-	KineticFriction.addPluginPath(options);
+%(options)s	KineticFriction.addPluginPath(options);
 	finish = { |code|
 		if(s.serverRunning) { s.quit };
 		AppClock.sched(0.5, { code.exit; nil });
@@ -130,16 +130,20 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 """
 
 
-def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None):
+def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None,
+                    server_options=None):
     """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync` and
     GUI work) with `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang
-    processes are gone when it returns, whatever happened. `env`: extra environment variables."""
+    processes are gone when it returns, whatever happened. `env`: extra environment variables;
+    `server_options`: ServerOptions to set over the defaults, e.g. {"memSize": 524288}."""
     assert jack.alive(), "jackd is not running"
     port = port or procs.free_udp_port()
     key, code_path = _script_files(code, name)
     script = paths.work_dir() / f"{key}.scd"
     script.write_text(SERVER_WRAPPER % dict(code=sc_string(code_path), port=port, rate=jack.sample_rate,
-                                            period=jack.period, timeout=max(timeout - 10, 5)))
+                                            period=jack.period, timeout=max(timeout - 10, 5),
+                                            options="".join(f"\toptions.{k} = {v};\n"
+                                                            for k, v in (server_options or {}).items())))
     log_path = paths.work_dir() / f"{key}.log"
     run_env = environment(jack.env)
     run_env.update(SC_JACK_DEFAULT_INPUTS="", SC_JACK_DEFAULT_OUTPUTS="")
