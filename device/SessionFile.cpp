@@ -1,10 +1,13 @@
 #include "SessionFile.hpp"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <sstream>
+
+#include "SettingBounds.hpp"
+#include "TextFileReader.hpp"
 
 namespace kf {
 
@@ -101,24 +104,41 @@ void Recorder::close() {
 }
 
 bool isSessionFile(const std::string& path) {
-  std::ifstream in(path);
-  std::string word;
-  return static_cast<bool>(in >> word) && word == kSessionFormatName;
+  TextFileReader reader;
+  std::string error, line;
+  if (!reader.open(path, error)) return false;
+  const TextFileReader::Line status = reader.next(line, kMaxSessionLineChars);
+  if (status != TextFileReader::Line::kOk && status != TextFileReader::Line::kCut) return false;
+  return line.compare(0, std::strlen(kSessionFormatName), kSessionFormatName) == 0 &&
+         (line.size() == std::strlen(kSessionFormatName) || line[std::strlen(kSessionFormatName)] == ' ');
 }
 
 bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out, std::string& error) {
-  std::ifstream in(path);
-  if (!in) {
-    error = "cannot read " + path;
-    return false;
-  }
   out = SessionData{};
   out.spec = spec;
+  TextFileReader reader;
+  if (!reader.open(path, error)) return false;
   std::string line;
-  int lineNumber = 0;
   bool haveHeader = false;
-  while (std::getline(in, line)) {
-    ++lineNumber;
+  for (;;) {
+    const TextFileReader::Line status = reader.next(line, kMaxSessionLineChars);
+    const int lineNumber = reader.lineNumber();
+    if (status == TextFileReader::Line::kEnd) break;
+    if (status == TextFileReader::Line::kError) {
+      error = lineError(path, lineNumber, "read error");
+      return false;
+    }
+    if (status == TextFileReader::Line::kTooLong) {
+      error = lineError(path, lineNumber, "line longer than " + std::to_string(kMaxSessionLineChars) + " characters");
+      return false;
+    }
+    if (status == TextFileReader::Line::kCut && haveHeader) {
+      // Recorder ends every line with '\n': a last line without it was cut (a crash, a full
+      // disk). Everything before it is kept.
+      out.warning = lineError(
+          path, lineNumber, "the last line was cut; loaded the " + std::to_string(lineNumber - 1) + " lines before it");
+      break;
+    }
     if (line.empty() || line[0] == '#') continue;
     std::istringstream fields(line);
     fields.imbue(std::locale::classic());
@@ -143,25 +163,38 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
         }
         const std::string key = pair.substr(0, equals);
         double value = 0.0;
-        // Unknown keys are skipped so newer files still load.
         if (!parseDouble(pair.substr(equals + 1), value)) {
           error = lineError(path, lineNumber, "bad value in header field " + pair);
           return false;
         }
-        out.spec.applyOverride(key, value);
+        // Unknown keys are skipped so newer files still load; known ones must be in bounds.
+        if (findSettingBounds(key) == nullptr) continue;
+        std::string why;
+        if (!out.spec.applyOverride(key, value, &why)) {
+          if (why.rfind("unknown", 0) == 0) continue;  // a bounded name that is not a spec field
+          error = lineError(path, lineNumber, "header: " + why);
+          return false;
+        }
+      }
+      std::string why;
+      if (!out.spec.isValid(&why)) {
+        error = lineError(path, lineNumber, "header: " + why);
+        return false;
       }
       haveHeader = true;
+      if (status == TextFileReader::Line::kCut) break;  // a header alone, cut after its last field
       continue;
     }
     std::vector<std::string> tokens;
-    for (std::string token; fields >> token;) tokens.push_back(token);
+    for (std::string token; tokens.size() < 8 && fields >> token;) tokens.push_back(token);
     bool ok = false;
     if (tag == "R") {
       TimedReport timed;
       MouseReport& r = timed.report;
       ok = tokens.size() == 6 && parseDouble(tokens[0], timed.hostTimeS) && parseDouble(tokens[1], r.deviceTimeS) &&
            parseInteger(tokens[2], r.dxCounts) && parseInteger(tokens[3], r.dyCounts) &&
-           parseInteger(tokens[4], r.buttons) && parseInteger(tokens[5], r.flags);
+           parseInteger(tokens[4], r.buttons) && parseInteger(tokens[5], r.flags) && std::isfinite(timed.hostTimeS) &&
+           std::isfinite(r.deviceTimeS);  // replay waits for hostTimeS
       if (ok) out.reports.push_back(timed);
     } else if (tag == "F") {
       RecordedFrame recorded;
@@ -171,10 +204,10 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
       if (ok) out.frames.push_back(recorded);
     } else if (tag == "O") {
       double timeS = 0.0;
-      ok = tokens.size() == 1 && parseDouble(tokens[0], timeS);
+      ok = tokens.size() == 1 && parseDouble(tokens[0], timeS) && std::isfinite(timeS);
       if (ok) out.offTimesS.push_back(timeS);
     } else {
-      error = lineError(path, lineNumber, "unknown record '" + tag + "'");
+      error = lineError(path, lineNumber, "unknown record '" + tag.substr(0, 32) + "'");
       return false;
     }
     if (!ok) {
@@ -183,7 +216,7 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
     }
   }
   if (!haveHeader) {
-    error = path + ": empty file, no kf-session header";
+    error = path + ": no kf-session header (only comments or blank lines)";
     return false;
   }
   return true;

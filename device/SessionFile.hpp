@@ -31,6 +31,7 @@ struct SessionData {
   std::vector<TimedReport> reports;
   std::vector<RecordedFrame> frames;
   std::vector<double> offTimesS;  // host times the magnet was driven off
+  std::string warning;            // e.g. a last line cut mid-way (dropped); empty if none
 };
 
 // Writes one session. Not thread-safe; the Device serialises access.
@@ -55,9 +56,15 @@ class Recorder {
   std::FILE* file_ = nullptr;
 };
 
-// True if the file starts with the kf-session header line.
+constexpr size_t kMaxSessionLineChars = 4096;
+
+// True if the file starts with the kf-session header line (false for anything that is not a
+// regular file: it is never read).
 bool isSessionFile(const std::string& path);
 // Reads a whole kf-session file; the header's fields override those of `spec` in out.spec.
+// Header values outside their bounds (SettingBounds) and lines longer than
+// kMaxSessionLineChars are errors; a last line without its newline (a recording cut short)
+// is dropped with out.warning.
 bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out, std::string& error);
 
 }  // namespace kf
