@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <string>
+
+#include "DeviceMessages.hpp"
 
 namespace kf {
 
@@ -43,7 +47,32 @@ void Device::threadMain() {
     const double nowS = std::chrono::duration<double>(now - openTime).count();
     if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
     std::lock_guard<std::mutex> lock(stateMutex_);
-    pumpLocked(nowS);
+    try {
+      pumpLocked(nowS);
+    } catch (const std::exception& e) {
+      failThread(e.what());
+      return;
+    } catch (...) {
+      failThread("unknown exception");
+      return;
+    }
+  }
+}
+
+void Device::failThread(const char* what) noexcept {
+  // A backend threw: nothing pumps this device any more, so its magnet goes off now.
+  try {
+    force_->driveOff();
+  } catch (...) {
+    force_->driveOffFromSignal();
+  }
+  safety_.resetToOff();
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  try {
+    recorder_.writeOff(std::max(lastPumpS_, 0.0));
+    recorder_.close();
+    postDeviceMessage((std::string("device thread stopped (") + what + "); magnet off, reopen the device").c_str());
+  } catch (...) {
   }
 }
 
@@ -92,7 +121,7 @@ void Device::pumpLocked(double nowS) {
     }
   } while (polled == kPollBatch);
 
-  recorder_.flush();
+  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
@@ -146,6 +175,18 @@ bool Device::startRecording(const std::string& path, std::string& error) {
 void Device::stopRecording() {
   std::lock_guard<std::mutex> lock(stateMutex_);
   recorder_.close();
+  if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+}
+
+std::string Device::recordingError() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return recorder_.error();
+}
+
+void Device::emergencyOff() noexcept {
+  force_->driveOffFromSignal();
+  telemetry_.setCommandedForce(static_cast<float>(spec_.minForceN));
+  recorder_.appendOffFromSignal(nowS());
 }
 
 }  // namespace kf

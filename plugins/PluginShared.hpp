@@ -46,3 +46,5 @@ void registerLoudnessToFriction();
 void registerFrictionMouseIn();
 void registerFrictionOut();
 void registerDeviceCommands();
+// Signal handlers that drive every open device's magnet off on the way out (ExitSafety.cpp).
+void installExitSafety();
