@@ -1,5 +1,7 @@
 #include "Device.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -85,6 +87,14 @@ void Device::pump(double nowS) {
 }
 
 void Device::pumpLocked(double nowS) {
+  // Announce the pump before looking at halted_ (both sequentially consistent): either
+  // emergencyOff() sees this pump and waits for it, or this pump sees the halt.
+  pumping_.store(true);
+  struct PumpDone {
+    std::atomic<bool>& flag;
+    ~PumpDone() { flag.store(false); }
+  } done{pumping_};
+  if (halted_.load()) return;
   if (!(nowS > lastPumpS_)) return;
 
   ForceFrame frame;
@@ -184,6 +194,15 @@ std::string Device::recordingError() {
 }
 
 void Device::emergencyOff() noexcept {
+  halted_.store(true);
+  // A pump running on another thread may still command a force and write records: let it
+  // finish first, for at most 50 ms (the handler may be running on that very thread).
+  timespec start{}, now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &start);
+  while (pumping_.load()) {
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    if ((now.tv_sec - start.tv_sec) * 1e9 + (now.tv_nsec - start.tv_nsec) > 50e6) break;
+  }
   force_->driveOffFromSignal();
   telemetry_.setCommandedForce(static_cast<float>(spec_.minForceN));
   recorder_.appendOffFromSignal(nowS());

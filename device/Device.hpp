@@ -73,8 +73,9 @@ class Device {
   std::string recordingError();
 
   // Async-signal-safe, from any thread (the handlers of plugins/ExitSafety.cpp): drives the
-  // magnet off without a lock and appends an off record to the recording. The process is on
-  // its way out; nothing else is cleaned up.
+  // magnet off without a lock and appends an off record to the recording; no pump runs after
+  // it (one under way on another thread is waited for, at most 50 ms). The process is on its
+  // way out; nothing else is cleaned up.
   void emergencyOff() noexcept;
 
   MouseBackend& mouseBackend() { return *mouse_; }
@@ -111,6 +112,9 @@ class Device {
   std::thread thread_;
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> closed_{false};
+  // emergencyOff(): no pump runs any more (halted_), and none is under way (pumping_).
+  std::atomic<bool> halted_{false};
+  std::atomic<bool> pumping_{false};
 };
 
 }  // namespace kf

@@ -25,6 +25,14 @@ class SlotFollower {
     warned_ = true;
     postFromRt(world, "%s: no device is open at index %d; %s\n", ugenName, index, consequence);
   }
+  // The device input is no slot number (NaN, inf, negative, 16 or more).
+  void badIndex(World* world, const char* ugenName, float input, int numSlots, const char* consequence) {
+    generation_ = 0;
+    if (warned_) return;
+    warned_ = true;
+    postFromRt(world, "%s: device %g is not a slot number 0..%d; %s\n", ugenName, static_cast<double>(input),
+               numSlots - 1, consequence);
+  }
   // True when the slot's device (by generation) is not the one followed so far.
   bool isNew(uint32_t generation) {
     warned_ = false;

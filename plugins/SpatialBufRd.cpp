@@ -1,7 +1,12 @@
 // SpatialBufRd: plays a buffer laid out on the surface, read at the puck's position.
 // Inputs: bufnum, position (mm), samplesPerMm, origin (mm), interpolation (1, 2, 4).
 // samplesPerMm, origin and interpolation are read once per block.
+#include <cmath>
+#include <cstdio>
+
+#include "AudioClock.hpp"
 #include "PluginShared.hpp"
+#include "PostLimiter.hpp"
 #include "SpatialReader.hpp"
 
 namespace {
@@ -9,7 +14,7 @@ namespace {
 enum Input { kBufnum, kPositionMm, kSamplesPerMm, kOriginMm, kInterpolation };
 
 // Why a block came out silent; posted once each time it changes.
-enum class BufferProblem { None, NotAllocated, ChannelMismatch };
+enum class BufferProblem { None, BadBufnum, NotAllocated, ChannelMismatch };
 
 class SpatialBufRd : public SCUnit {
  public:
@@ -23,7 +28,9 @@ class SpatialBufRd : public SCUnit {
     const SndBuf* buf = lookupBuffer();
     const int numChannels = static_cast<int>(mNumOutputs);
     BufferProblem problem = BufferProblem::None;
-    if (buf == nullptr || buf->data == nullptr || buf->frames <= 0)
+    if (mBadBufnum)
+      problem = BufferProblem::BadBufnum;
+    else if (buf == nullptr || buf->data == nullptr || buf->frames <= 0)
       problem = BufferProblem::NotAllocated;
     else if (buf->channels != numChannels)
       problem = BufferProblem::ChannelMismatch;
@@ -47,27 +54,45 @@ class SpatialBufRd : public SCUnit {
   // block so that a freed or swapped buffer is seen at once.
   const SndBuf* lookupBuffer() {
     const float fbufnum = in0(kBufnum);
-    if (!(fbufnum >= 0.f)) return nullptr;
+    // Checked as a float first: 2^32, 1e30, inf and NaN are no buffer (a cast to an integer
+    // would be undefined, and read buffer 0).
+    const double numBufs = static_cast<double>(mWorld->mNumSndBufs) + mParent->localBufNum;
+    mBadBufnum = !(fbufnum >= 0.f) || !(static_cast<double>(fbufnum) < numBufs);
+    mBufnumIn = fbufnum;
+    if (mBadBufnum) return nullptr;
     const auto bufnum = static_cast<uint32>(fbufnum);
     mBufnum = static_cast<int>(bufnum);
     if (bufnum < mWorld->mNumSndBufs) return mWorld->mSndBufs + bufnum;
-    const int localBufnum = static_cast<int>(bufnum - mWorld->mNumSndBufs);
-    if (localBufnum < mParent->localBufNum) return mParent->mLocalSndBufs + localBufnum;
-    return nullptr;
+    return mParent->mLocalSndBufs + (bufnum - mWorld->mNumSndBufs);
   }
 
+  // One message per change of problem, and per kind of problem at most one a second: a
+  // buffer reallocated 300 times a second posts a line, not hundreds.
   void report(BufferProblem problem, const SndBuf* buf) {
     if (problem == mProblem) return;
     mProblem = problem;
-    if (problem == BufferProblem::NotAllocated)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n", mBufnum);
+    if (problem == BufferProblem::None) return;
+    int heldBack = 0;
+    if (!mLimits[static_cast<int>(problem)].allow(kf::sc::blockStartTimeS(mWorld), heldBack)) return;
+    char more[64] = "";
+    if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
+    if (problem == BufferProblem::BadBufnum)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
+                         static_cast<double>(mBufnumIn),
+                         static_cast<int>(mWorld->mNumSndBufs) + mParent->localBufNum - 1, more);
+    else if (problem == BufferProblem::NotAllocated)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.%s\n", mBufnum,
+                         more);
     else if (problem == BufferProblem::ChannelMismatch)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.\n",
-                         mBufnum, buf->channels, static_cast<int>(mNumOutputs));
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.%s\n",
+                         mBufnum, buf->channels, static_cast<int>(mNumOutputs), more);
   }
 
   BufferProblem mProblem = BufferProblem::None;
   int mBufnum = -1;
+  float mBufnumIn = 0.f;
+  bool mBadBufnum = false;
+  kf::sc::PostLimiter mLimits[4];
 };
 
 }  // namespace
