@@ -64,9 +64,10 @@ std::string checkSetting(std::string_view name, double value) {
     return text;
   }
   if (isWithinBounds(*bounds, value)) return {};
-  std::snprintf(text, sizeof text, "%.*s = %.9g is out of range %g..%g%s%.*s%s", static_cast<int>(name.size()),
-                name.data(), value, bounds->min, bounds->max, bounds->unit.empty() ? "" : " ",
-                static_cast<int>(bounds->unit.size()), bounds->unit.data(), bounds->integer ? " (whole numbers)" : "");
+  std::snprintf(text, sizeof text, "%.*s = %g is out of range %g..%g%s%.*s%s", static_cast<int>(name.size()),
+                name.data(), std::isnan(value) ? std::fabs(value) : value, bounds->min, bounds->max,
+                bounds->unit.empty() ? "" : " ", static_cast<int>(bounds->unit.size()), bounds->unit.data(),
+                bounds->integer ? " (whole numbers)" : "");
   return text;
 }
 

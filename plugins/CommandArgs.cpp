@@ -27,6 +27,9 @@ bool fail(char* error, size_t errorSize, const char* format, ...) {
   return false;
 }
 
+// NaN without the sign printf would show ("-nan").
+double shown(double value) { return std::isnan(value) ? std::fabs(value) : value; }
+
 // A whole number in [min, max], finite.
 bool isWholeIn(double value, double min, double max) {
   return std::isfinite(value) && value >= min && value <= max && value == std::floor(value);
@@ -172,7 +175,7 @@ bool readIndex(OscArgReader& args, int numSlots, CommandArgs& out, char* error, 
   double value = 0.0;
   if (!args.readNumber(value)) return fail(error, errorSize, "device index: %s", describe(args));
   if (!isWholeIn(value, 0.0, numSlots - 1.0))
-    return fail(error, errorSize, "device index %g is not a slot number 0..%d", value, numSlots - 1);
+    return fail(error, errorSize, "device index %g is not a slot number 0..%d", shown(value), numSlots - 1);
   out.index = static_cast<int>(value);
   return true;
 }
@@ -182,7 +185,7 @@ bool readPath(OscArgReader& args, CommandArgs& out, char* error, size_t errorSiz
   size_t length = 0;
   if (!args.readString(text, length)) return fail(error, errorSize, "path: %s", describe(args));
   if (length >= static_cast<size_t>(kMaxPathChars))
-    return fail(error, errorSize, "path of %zu characters is longer than %d; refused", length, kMaxPathChars - 1);
+    return fail(error, errorSize, "path of %zu characters is longer than %d", length, kMaxPathChars - 1);
   std::memcpy(out.path, text, length);
   out.path[length] = '\0';
   return true;
@@ -196,7 +199,7 @@ bool readOverrides(OscArgReader& args, CommandArgs& out, char* error, size_t err
       return fail(error, errorSize, "argument %d: a setting name was expected, it is %s", args.position() + 1,
                   describe(args));
     if (out.numOverrides == kMaxOverrides)
-      return fail(error, errorSize, "more than %d settings; refused", kMaxOverrides);
+      return fail(error, errorSize, "more than %d settings", kMaxOverrides);
     if (length == 0 || length >= static_cast<size_t>(kMaxKeyChars))
       return fail(error, errorSize, "setting name of %zu characters (1..%d allowed)", length, kMaxKeyChars - 1);
     double value = 0.0;
@@ -242,10 +245,11 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
       double kind = 0.0, count = 0.0;
       if (!args.readNumber(kind)) return fail(error, errorSize, "hand script kind: %s", describe(args));
       if (!isWholeIn(kind, -1.0, 2.0))
-        return fail(error, errorSize, "hand script kind %g is not -1 (none), 0 (path), 1 (speeds) or 2 (force)", kind);
+        return fail(error, errorSize, "hand script kind %g is not -1 (none), 0 (path), 1 (speeds) or 2 (force)",
+                    shown(kind));
       if (!args.readNumber(count)) return fail(error, errorSize, "hand script value count: %s", describe(args));
       if (!isWholeIn(count, 0.0, kMaxHandValues))
-        return fail(error, errorSize, "hand script value count %g is out of range 0..%d", count, kMaxHandValues);
+        return fail(error, errorSize, "hand script value count %g is out of range 0..%d", shown(count), kMaxHandValues);
       out.kind = static_cast<int>(kind);
       const int wanted = static_cast<int>(count);
       if ((out.kind == 0 || out.kind == 1) && wanted % 2 != 0)

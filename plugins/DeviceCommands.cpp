@@ -53,18 +53,24 @@ kf::sc::OscArgReader readerOf(sc_msg_iter* msg) {
   return kf::sc::OscArgReader(msg->tags + msg->count, msg->endpos, msg->rdpos, msg->endpos);
 }
 
-// Refused commands post one line each, at most one a second per command (a flood of bad
-// commands must not flood the post window).
+// Refused commands post one line each, and the same refusal at most once a second (a flood
+// of one bad command must not flood the post window; different problems all show).
 void postRefusal(World* world, const char* name, const char* error) {
-  static kf::sc::PostLimiter limiters[8];
-  static const char* names[8] = {};
-  int slot = 0;
-  while (slot < 7 && names[slot] != nullptr && names[slot] != name) ++slot;
-  names[slot] = name;
+  constexpr int kCauses = 16;
+  static kf::sc::PostLimiter limiters[kCauses];
+  static uint32_t causes[kCauses] = {};
+  uint32_t hash = 2166136261u;  // FNV-1a of command and message: the cause
+  for (const char* c : {name, error})
+    for (; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
+  int slot = static_cast<int>(hash % kCauses);
+  if (causes[slot] != hash) {  // another cause had this slot: start afresh
+    causes[slot] = hash;
+    limiters[slot] = kf::sc::PostLimiter();
+  }
   int suppressed = 0;
   if (!limiters[slot].allow(kf::sc::blockStartTimeS(world), suppressed)) return;
   if (suppressed > 0)
-    kf::sc::postFromRt(world, "%s: %s; refused (and %d more refused since the last message)\n", name, error,
+    kf::sc::postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error,
                        suppressed);
   else
     kf::sc::postFromRt(world, "%s: %s; refused\n", name, error);

@@ -52,7 +52,8 @@ class FrictionMouseIn : public SCUnit {
     // A NaN or infinite origin would make every position NaN: 0 instead, said once.
     double originMm = in0(kOriginMm);
     if (!std::isfinite(originMm)) {
-      if (!mWarnedOrigin) kf::sc::postFromRt(mWorld, "FrictionMouseIn: origin %g is not finite; 0 used.\n", originMm);
+      if (!mWarnedOrigin)
+        kf::sc::postFromRt(mWorld, "FrictionMouseIn: origin %g is not finite; 0 used.\n", kf::sc::shownValue(originMm));
       mWarnedOrigin = true;
       originMm = 0.0;
     } else {

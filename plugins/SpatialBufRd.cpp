@@ -78,7 +78,7 @@ class SpatialBufRd : public SCUnit {
     if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
     if (problem == BufferProblem::BadBufnum)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
-                         static_cast<double>(mBufnumIn),
+                         kf::sc::shownValue(mBufnumIn),
                          static_cast<int>(mWorld->mNumSndBufs) + mParent->localBufNum - 1, more);
     else if (problem == BufferProblem::NotAllocated)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.%s\n", mBufnum,
