@@ -8,25 +8,28 @@ namespace kf::sc {
 
 class PostLimiter {
  public:
-  explicit PostLimiter(double intervalS = 1.0) : intervalS_(intervalS) {}
+  explicit PostLimiter(float intervalS = 1.0f) : intervalS_(intervalS) {}
 
   // True when a message may be posted at audio time nowS; `suppressed` then holds how many
   // were held back since the last one.
   bool allow(double nowS, int& suppressed) {
-    if (posted_ && nowS >= lastS_ && nowS - lastS_ < intervalS_) {
+    const float now = static_cast<float>(nowS);
+    if (posted_ && now >= lastS_ && now - lastS_ < intervalS_) {
       ++suppressed_;
       return false;
     }
     posted_ = true;
-    lastS_ = nowS;
+    lastS_ = now;
     suppressed = suppressed_;
     suppressed_ = 0;
     return true;
   }
 
  private:
-  double intervalS_;
-  double lastS_ = 0.0;
+  // float, not double: it lives in units, which scsynth may place only 4-byte aligned; a
+  // second's resolution survives days of audio time in float.
+  float intervalS_;
+  float lastS_ = 0.f;
   bool posted_ = false;
   int suppressed_ = 0;
 };
