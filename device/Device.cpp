@@ -1,8 +1,14 @@
 #include "Device.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <string>
+
+#include "DeviceMessages.hpp"
 
 namespace kf {
 
@@ -43,7 +49,32 @@ void Device::threadMain() {
     const double nowS = std::chrono::duration<double>(now - openTime).count();
     if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
     std::lock_guard<std::mutex> lock(stateMutex_);
-    pumpLocked(nowS);
+    try {
+      pumpLocked(nowS);
+    } catch (const std::exception& e) {
+      failThread(e.what());
+      return;
+    } catch (...) {
+      failThread("unknown exception");
+      return;
+    }
+  }
+}
+
+void Device::failThread(const char* what) noexcept {
+  // A backend threw: nothing pumps this device any more, so its magnet goes off now.
+  try {
+    force_->driveOff();
+  } catch (...) {
+    force_->driveOffFromSignal();
+  }
+  safety_.resetToOff();
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  try {
+    recorder_.writeOff(std::max(lastPumpS_, 0.0));
+    recorder_.close();
+    postDeviceMessage((std::string("device thread stopped (") + what + "); magnet off, reopen the device").c_str());
+  } catch (...) {
   }
 }
 
@@ -56,6 +87,14 @@ void Device::pump(double nowS) {
 }
 
 void Device::pumpLocked(double nowS) {
+  // Announce the pump before looking at halted_ (both sequentially consistent): either
+  // emergencyOff() sees this pump and waits for it, or this pump sees the halt.
+  pumping_.store(true);
+  struct PumpDone {
+    std::atomic<bool>& flag;
+    ~PumpDone() { flag.store(false); }
+  } done{pumping_};
+  if (halted_.load()) return;
   if (!(nowS > lastPumpS_)) return;
 
   ForceFrame frame;
@@ -92,7 +131,7 @@ void Device::pumpLocked(double nowS) {
     }
   } while (polled == kPollBatch);
 
-  recorder_.flush();
+  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
@@ -146,6 +185,27 @@ bool Device::startRecording(const std::string& path, std::string& error) {
 void Device::stopRecording() {
   std::lock_guard<std::mutex> lock(stateMutex_);
   recorder_.close();
+  if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+}
+
+std::string Device::recordingError() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return recorder_.error();
+}
+
+void Device::emergencyOff() noexcept {
+  halted_.store(true);
+  // A pump running on another thread may still command a force and write records: let it
+  // finish first, for at most 50 ms (the handler may be running on that very thread).
+  timespec start{}, now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &start);
+  while (pumping_.load()) {
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    if ((now.tv_sec - start.tv_sec) * 1e9 + (now.tv_nsec - start.tv_nsec) > 50e6) break;
+  }
+  force_->driveOffFromSignal();
+  telemetry_.setCommandedForce(static_cast<float>(spec_.minForceN));
+  recorder_.appendOffFromSignal(nowS());
 }
 
 }  // namespace kf

@@ -69,6 +69,14 @@ class Device {
   // From a non-realtime thread. Starts a kf-session file with the spec in its header.
   bool startRecording(const std::string& path, std::string& error);
   void stopRecording();
+  // Why the last recording stopped by itself (a write error, also posted), or empty.
+  std::string recordingError();
+
+  // Async-signal-safe, from any thread (the handlers of plugins/ExitSafety.cpp): drives the
+  // magnet off without a lock and appends an off record to the recording; no pump runs after
+  // it (one under way on another thread is waited for, at most 50 ms). The process is on its
+  // way out; nothing else is cleaned up.
+  void emergencyOff() noexcept;
 
   MouseBackend& mouseBackend() { return *mouse_; }
   ForceBackend& forceBackend() { return *force_; }
@@ -78,6 +86,8 @@ class Device {
 
   void pumpLocked(double nowS);
   void threadMain();
+  // The device thread caught an exception from a backend: magnet off, recording closed.
+  void failThread(const char* what) noexcept;
 
   const DeviceSpec spec_;
   const bool lockstep_;
@@ -102,6 +112,9 @@ class Device {
   std::thread thread_;
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> closed_{false};
+  // emergencyOff(): no pump runs any more (halted_), and none is under way (pumping_).
+  std::atomic<bool> halted_{false};
+  std::atomic<bool> pumping_{false};
 };
 
 }  // namespace kf

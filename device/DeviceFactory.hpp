@@ -18,8 +18,10 @@ std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& s
                                       bool lockstep, std::string* error = nullptr, DeviceOptions options = {});
 
 // A ReplayBackend of a kf-session or hid-recorder file, with a CountingForceSink as the force
-// side. For kf-session files the spec of the file's header wins over `spec`.
+// side. For kf-session files the spec of the file's header wins over `spec`. `warning`
+// receives what was loaded despite a problem (a last line cut mid-way).
 std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
-                                         std::string& error, DeviceOptions options = {});
+                                         std::string& error, DeviceOptions options = {},
+                                         std::string* warning = nullptr);
 
 }  // namespace kf

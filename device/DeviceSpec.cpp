@@ -2,52 +2,60 @@
 
 #include <cmath>
 
+#include "SettingBounds.hpp"
+
 namespace kf {
 
 namespace {
-bool isPositive(double value) { return std::isfinite(value) && value > 0.0; }
-bool isNonNegative(double value) { return std::isfinite(value) && value >= 0.0; }
-}  // namespace
 
-bool DeviceSpec::applyOverride(std::string_view key, double value) {
-  if (!std::isfinite(value)) return false;
-  struct Entry {
-    std::string_view name;
-    double DeviceSpec::*field;
-    bool (*valid)(double);
-  };
-  static const Entry entries[] = {
-      {"countMm", &DeviceSpec::countMm, isPositive},
-      {"updateRateHz", &DeviceSpec::updateRateHz, isPositive},
-      {"minForceN", &DeviceSpec::minForceN, isNonNegative},
-      {"maxForceN", &DeviceSpec::maxForceN, isNonNegative},
-      {"audioLatencyS", &DeviceSpec::audioLatencyS, isNonNegative},
-      {"tactileLatencyS", &DeviceSpec::tactileLatencyS, isNonNegative},
-      {"forceFramePeriodS", &DeviceSpec::forceFramePeriodS, isPositive},
-      {"maxForceSlewNPerS", &DeviceSpec::maxForceSlewNPerS, isPositive},
-      {"watchdogS", &DeviceSpec::watchdogS, isPositive},
-      {"magnetLagS", &DeviceSpec::magnetLagS, isNonNegative},
-  };
-  for (const Entry& entry : entries) {
-    if (entry.name == key) {
-      if (!entry.valid(value)) return false;
-      this->*entry.field = value;
-      return true;
-    }
-  }
-  if (key == "maxCountsPerReport") {
-    if (value < 1.0 || value > 32767.0 || value != std::floor(value)) return false;
-    maxCountsPerReport = static_cast<int>(value);
-    return true;
-  }
+struct Field {
+  std::string_view name;
+  double DeviceSpec::*field;
+};
+constexpr Field kFields[] = {
+    {"countMm", &DeviceSpec::countMm},
+    {"updateRateHz", &DeviceSpec::updateRateHz},
+    {"minForceN", &DeviceSpec::minForceN},
+    {"maxForceN", &DeviceSpec::maxForceN},
+    {"audioLatencyS", &DeviceSpec::audioLatencyS},
+    {"tactileLatencyS", &DeviceSpec::tactileLatencyS},
+    {"forceFramePeriodS", &DeviceSpec::forceFramePeriodS},
+    {"maxForceSlewNPerS", &DeviceSpec::maxForceSlewNPerS},
+    {"watchdogS", &DeviceSpec::watchdogS},
+    {"magnetLagS", &DeviceSpec::magnetLagS},
+};
+
+bool fail(std::string* error, std::string message) {
+  if (error) *error = std::move(message);
   return false;
 }
 
-bool DeviceSpec::isValid() const {
-  return isPositive(countMm) && isPositive(updateRateHz) && maxCountsPerReport >= 1 && isNonNegative(minForceN) &&
-         isNonNegative(maxForceN) && minForceN <= maxForceN && isNonNegative(audioLatencyS) &&
-         isNonNegative(tactileLatencyS) && isPositive(forceFramePeriodS) && isPositive(maxForceSlewNPerS) &&
-         isPositive(watchdogS) && isNonNegative(magnetLagS);
+}  // namespace
+
+bool DeviceSpec::applyOverride(std::string_view key, double value, std::string* error) {
+  const bool isCounts = key == "maxCountsPerReport";
+  double DeviceSpec::*target = nullptr;
+  for (const Field& entry : kFields)
+    if (entry.name == key) target = entry.field;
+  if (target == nullptr && !isCounts) return fail(error, "unknown device setting '" + std::string(key) + "'");
+  if (std::string message = checkSetting(key, value); !message.empty()) return fail(error, message);
+  if (isCounts)
+    maxCountsPerReport = static_cast<int>(value);
+  else
+    this->*target = value;
+  return true;
+}
+
+bool DeviceSpec::isValid(std::string* error) const {
+  for (const Field& entry : kFields)
+    if (std::string message = checkSetting(entry.name, this->*entry.field); !message.empty())
+      return fail(error, message);
+  if (std::string message = checkSetting("maxCountsPerReport", maxCountsPerReport); !message.empty())
+    return fail(error, message);
+  if (minForceN > maxForceN) return fail(error, "minForceN is above maxForceN");
+  // The watchdog must not trip between two frames that arrive on time.
+  if (watchdogS < 2.0 * forceFramePeriodS) return fail(error, "watchdogS is shorter than two force frames");
+  return true;
 }
 
 }  // namespace kf

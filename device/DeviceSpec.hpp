@@ -2,6 +2,7 @@
 // shared by the device thread, the simulator, record/replay and the UGens.
 #pragma once
 
+#include <string>
 #include <string_view>
 
 #include "PaperProfile.hpp"
@@ -29,10 +30,12 @@ struct DeviceSpec {
   double updatePeriodS() const { return 1.0 / updateRateHz; }
 
   // Sets the field named `key` (the member name above) to `value`. Returns false, and
-  // changes nothing, for an unknown key or a value out of the field's domain.
-  bool applyOverride(std::string_view key, double value);
-  // True when all fields are usable together (positive rates, minForceN <= maxForceN...).
-  bool isValid() const;
+  // changes nothing, for an unknown key or a value outside the field's bounds
+  // (SettingBounds); `error`, if given, then names the field, the value and the range.
+  bool applyOverride(std::string_view key, double value, std::string* error = nullptr);
+  // True when every field is within its bounds and they fit together (minForceN <=
+  // maxForceN, a watchdog longer than two frames); `error` says what does not.
+  bool isValid(std::string* error = nullptr) const;
 };
 
 }  // namespace kf

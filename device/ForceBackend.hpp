@@ -11,6 +11,11 @@ class ForceBackend {
   virtual void commandForce(double timeS, float forceN) = 0;
   // Magnet off now (minimum friction): on close, watchdog trips, errors.
   virtual void driveOff() = 0;
+  // Magnet off from a signal handler (SIGTERM, a crash): async-signal-safe only — no lock,
+  // no allocation, no stdio. The default calls driveOff(), which suits backends whose
+  // driveOff() only stores values; a backend that talks to hardware through a library must
+  // override it (e.g. a write(2) of a prepared off command on its open descriptor).
+  virtual void driveOffFromSignal() noexcept { driveOff(); }
 };
 
 }  // namespace kf

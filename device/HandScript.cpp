@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "SettingBounds.hpp"
+
 namespace kf {
 
 HandScript HandScript::path(std::vector<std::pair<double, double>> timeAndPositionMm) {
@@ -26,12 +28,14 @@ HandScript HandScript::constantForce(double forceN) {
 }
 
 bool HandScript::isValid() const {
-  if (kind == Kind::kConstantForce) return std::isfinite(constantForceN);
+  auto within = [](const char* name, double value) { return isWithinBounds(*findSettingBounds(name), value); };
+  if (kind == Kind::kConstantForce) return within("handForceN", constantForceN);
+  // Bounded values keep the integrated speed path (at most 1e5 mm/s for 1e6 s) finite.
   for (size_t i = 0; i < points.size(); ++i) {
     const auto& [a, b] = points[i];
-    if (!std::isfinite(a) || !std::isfinite(b)) return false;
+    if (kind == Kind::kPath && (!within("handTimeS", a) || !within("handPositionMm", b))) return false;
+    if (kind == Kind::kSpeeds && (!within("handSpeedMmPerS", a) || !within("handDurationS", b))) return false;
     if (kind == Kind::kPath && i > 0 && a < points[i - 1].first) return false;
-    if (kind == Kind::kSpeeds && b < 0.0) return false;
   }
   return true;
 }

@@ -23,7 +23,8 @@ struct HandScript {
   static HandScript constantForce(double forceN);
   static HandScript none() { return {}; }
 
-  // True when the points are usable: finite, times ascending, durations >= 0.
+  // True when the points are usable: within their bounds (SettingBounds: handTimeS,
+  // handPositionMm, handSpeedMmPerS, handDurationS, handForceN), times ascending.
   bool isValid() const;
 };
 

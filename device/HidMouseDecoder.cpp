@@ -10,6 +10,7 @@ void HidMouseDecoder::noteExtent(Layout& layout, const Element& element) {
 
 bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& error) {
   layouts_.clear();
+  arrayUsages_.clear();
   usesReportIds_ = descriptor.usesReportIds;
   auto layoutFor = [this](uint8_t reportId) -> Layout& {
     for (Layout& layout : layouts_)
@@ -37,7 +38,8 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
           layout.y = element;
           layout.haveY = true;
           noteExtent(layout, element);
-        } else if (usage >> 16 == kHidPageButton && (usage & 0xFFFF) >= 1 && (usage & 0xFFFF) <= 32) {
+        } else if (usage >> 16 == kHidPageButton && (usage & 0xFFFF) >= 1 && (usage & 0xFFFF) <= 32 &&
+                   layout.buttonBits.size() < kMaxButtonElements) {
           layout.buttonBits.emplace_back(element, usage & 0xFFFF);
           noteExtent(layout, element);
         }
@@ -46,11 +48,12 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
       const bool anyButton =
           std::any_of(field.usages.begin(), field.usages.end(), [](HidUsage u) { return u >> 16 == kHidPageButton; });
       if (!anyButton) continue;
-      for (uint32_t i = 0; i < field.count; ++i) {
+      arrayUsages_.push_back(field.usages);
+      for (uint32_t i = 0; i < field.count && layout.buttonArrays.size() < kMaxButtonElements; ++i) {
         ButtonArray array;
         array.element = {field.bitOffset + i * field.bitSize, field.bitSize, field.isSigned()};
         array.logicalMin = field.logicalMin;
-        array.usages = field.usages;
+        array.usagesIndex = arrayUsages_.size() - 1;
         noteExtent(layout, array.element);
         layout.buttonArrays.push_back(std::move(array));
       }
@@ -98,9 +101,10 @@ bool HidMouseDecoder::decode(const uint8_t* bytes, size_t size, HidMouseDelta& o
   for (const ButtonArray& array : layout->buttonArrays) {
     if (!extractHidBits(bytes, size, array.element.bitOffset, array.element.bitSize, array.element.isSigned, value))
       continue;
+    const std::vector<HidUsage>& usages = arrayUsages_[array.usagesIndex];
     const int64_t index = value - array.logicalMin;
-    if (index < 0 || index >= static_cast<int64_t>(array.usages.size())) continue;  // none pressed
-    const HidUsage usage = array.usages[static_cast<size_t>(index)];
+    if (index < 0 || index >= static_cast<int64_t>(usages.size())) continue;  // none pressed
+    const HidUsage usage = usages[static_cast<size_t>(index)];
     const uint32_t button = usage & 0xFFFF;
     if (usage >> 16 == kHidPageButton && button >= 1 && button <= 32) out.buttons |= 1u << (button - 1);
   }

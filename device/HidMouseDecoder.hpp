@@ -20,6 +20,9 @@ struct HidMouseDelta {
 
 class HidMouseDecoder {
  public:
+  // Buttons are 1..32, so no report needs more button bits or array elements than this.
+  static constexpr size_t kMaxButtonElements = 32;
+
   // False (with a message) when no report carries a relative X or Y input.
   bool build(const HidReportDescriptor& descriptor, std::string& error);
 
@@ -37,10 +40,12 @@ class HidMouseDecoder {
     uint32_t bitSize = 0;
     bool isSigned = false;
   };
+  // One element of an array item; its selectable usages are shared by all elements of the
+  // item (arrayUsages_[usagesIndex]), never copied per element.
   struct ButtonArray {
     Element element;
     int64_t logicalMin = 0;
-    std::vector<HidUsage> usages;
+    size_t usagesIndex = 0;
   };
   struct Layout {
     uint8_t reportId = 0;
@@ -54,6 +59,7 @@ class HidMouseDecoder {
   void noteExtent(Layout& layout, const Element& element);
 
   std::vector<Layout> layouts_;
+  std::vector<std::vector<HidUsage>> arrayUsages_;
   bool usesReportIds_ = false;
 };
 

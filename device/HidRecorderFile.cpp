@@ -1,8 +1,11 @@
 #include "HidRecorderFile.hpp"
 
+#include <cctype>
+#include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
+
+#include "TextFileReader.hpp"
 
 namespace kf {
 
@@ -12,11 +15,11 @@ bool parseHexBytes(std::istringstream& fields, size_t count, std::vector<uint8_t
   out.clear();
   std::string token;
   while (fields >> token) {
-    if (token.size() != 2) return false;
-    char* end = nullptr;
-    const unsigned long value = std::strtoul(token.c_str(), &end, 16);
-    if (end != token.c_str() + 2) return false;
-    out.push_back(static_cast<uint8_t>(value));
+    if (token.size() != 2 || !std::isxdigit(static_cast<unsigned char>(token[0])) ||
+        !std::isxdigit(static_cast<unsigned char>(token[1])))
+      return false;
+    if (out.size() >= count) return false;
+    out.push_back(static_cast<uint8_t>(std::strtoul(token.c_str(), nullptr, 16)));
   }
   return out.size() == count;
 }
@@ -26,13 +29,15 @@ std::string lineError(const std::string& path, int lineNumber, const std::string
 }
 
 std::string firstRecordTag(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
+  TextFileReader reader;
+  std::string error, line;
+  if (!reader.open(path, error)) return {};
+  for (;;) {
+    const TextFileReader::Line status = reader.next(line, kMaxHidRecorderLineChars);
+    if (status != TextFileReader::Line::kOk && status != TextFileReader::Line::kCut) return {};
     if (line.empty() || line[0] == '#') continue;
     return line.substr(0, 2);
   }
-  return {};
 }
 
 }  // namespace
@@ -43,19 +48,30 @@ bool isHidRecorderFile(const std::string& path) {
 }
 
 bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string& error) {
-  std::ifstream in(path);
-  if (!in) {
-    error = "cannot read " + path;
-    return false;
-  }
   out = HidRecording{};
+  TextFileReader reader;
+  if (!reader.open(path, error)) return false;
   std::string line;
-  int lineNumber = 0;
   int device = 0;
   bool haveDescriptor = false;
-  while (std::getline(in, line)) {
-    ++lineNumber;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+  for (;;) {
+    const TextFileReader::Line status = reader.next(line, kMaxHidRecorderLineChars);
+    const int lineNumber = reader.lineNumber();
+    if (status == TextFileReader::Line::kEnd) break;
+    if (status == TextFileReader::Line::kError) {
+      error = lineError(path, lineNumber, "read error");
+      return false;
+    }
+    if (status == TextFileReader::Line::kTooLong) {
+      error =
+          lineError(path, lineNumber, "line longer than " + std::to_string(kMaxHidRecorderLineChars) + " characters");
+      return false;
+    }
+    if (status == TextFileReader::Line::kCut && haveDescriptor) {
+      out.warning = lineError(
+          path, lineNumber, "the last line was cut; loaded the " + std::to_string(lineNumber - 1) + " lines before it");
+      break;
+    }
     if (line.empty() || line[0] == '#') continue;
     if (line.size() < 2 || line[1] != ':') {
       error = lineError(path, lineNumber, "not a hid-recorder record");
@@ -99,7 +115,8 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
       }
       char* end = nullptr;
       event.timeS = std::strtod(timeToken.c_str(), &end);
-      if (end != timeToken.c_str() + timeToken.size() || !parseHexBytes(fields, length, event.bytes)) {
+      if (end != timeToken.c_str() + timeToken.size() || !std::isfinite(event.timeS) ||
+          !parseHexBytes(fields, length, event.bytes)) {
         error = lineError(path, lineNumber, "E: time, length or bytes malformed");
         return false;
       }

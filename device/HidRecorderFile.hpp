@@ -19,12 +19,19 @@ struct HidRecording {
   std::string physicalPath;
   uint32_t bus = 0, vendorId = 0, productId = 0;
   std::vector<HidRecordedEvent> events;
+  std::string warning;  // e.g. a last line cut mid-way (dropped); empty if none
 };
 
-// True if the first record of the file looks like hid-recorder output (R: or D: line).
+// hid-recorder writes a 4096-byte report as 3 characters a byte; anything longer is not one.
+constexpr size_t kMaxHidRecorderLineChars = 16384;
+
+// True if the first record of the file looks like hid-recorder output (R: or D: line); false
+// for anything that is not a regular file (it is never read).
 bool isHidRecorderFile(const std::string& path);
 // Reads the first device of the file (D: 0 or no D: lines). False with a message naming the
-// line on malformed records (lengths that do not match, bad hex, no descriptor).
+// line on malformed records (lengths that do not match, bad hex, no descriptor, non-finite
+// times, lines over kMaxHidRecorderLineChars). A last line without its newline (a recording
+// cut short) is dropped with out.warning.
 bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string& error);
 
 }  // namespace kf

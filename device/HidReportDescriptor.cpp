@@ -11,7 +11,9 @@ namespace {
 constexpr size_t kMaxPushDepth = 16;
 constexpr uint32_t kMaxReportSizeBits = 1024;
 constexpr uint64_t kMaxReportBits = 8u * 4096u;  // a HID report larger than 4 KiB is malformed
-constexpr uint32_t kMaxUsageRange = 65536;
+constexpr uint32_t kMaxUsageRange = 65536;       // one whole usage page
+constexpr size_t kMaxTotalUsages = 1u << 18;     // over all fields: 1 MiB of usages at most
+constexpr size_t kMaxDescriptorBytes = 65535;    // the USB descriptor length is 16 bits
 
 struct GlobalState {
   uint16_t usagePage = 0;
@@ -73,6 +75,12 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
   std::vector<int> openCollections;
   std::map<std::pair<int, int>, uint64_t> nextBit;  // (kind, report ID) -> bit offset
   bool haveFieldWithoutId = false;
+  size_t totalUsages = 0;
+  if (size > kMaxDescriptorBytes) {
+    error =
+        "HID report descriptor of " + std::to_string(size) + " bytes, more than " + std::to_string(kMaxDescriptorBytes);
+    return false;
+  }
 
   size_t pos = 0;
   while (pos < size) {
@@ -133,16 +141,25 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
           // A maximum is signed only when the minimum is negative (as the Linux parser does).
           field.logicalMax = field.logicalMin < 0 ? signExtend(global.logicalMaxRaw, global.logicalMaxBytes)
                                                   : int64_t(global.logicalMaxRaw);
-          for (const LocalUsage& usage : local.usages) field.usages.push_back(fullUsage(usage, global.usagePage));
+          uint64_t rangeCount = 0;
+          HidUsage first = 0;
           if (local.haveMin && local.haveMax) {
-            const HidUsage first = fullUsage(local.usageMin, global.usagePage);
+            first = fullUsage(local.usageMin, global.usagePage);
             const HidUsage last = fullUsage(local.usageMax, global.usagePage);
             if (last < first || last - first >= kMaxUsageRange) {
               error = at(itemStart, "bad usage minimum/maximum range");
               return false;
             }
-            for (HidUsage usage = first; usage <= last; ++usage) field.usages.push_back(usage);
+            rangeCount = uint64_t(last) - first + 1;
           }
+          totalUsages += local.usages.size() + rangeCount;
+          if (totalUsages > kMaxTotalUsages) {
+            error = at(itemStart, "more than " + std::to_string(kMaxTotalUsages) + " usages in all");
+            return false;
+          }
+          for (const LocalUsage& usage : local.usages) field.usages.push_back(fullUsage(usage, global.usagePage));
+          // Counted, not compared with `last`: a range ending at 0xFFFFFFFF must not wrap.
+          for (uint64_t i = 0; i < rangeCount; ++i) field.usages.push_back(static_cast<HidUsage>(first + i));
           field.collection = openCollections.empty() ? -1 : openCollections.back();
           out.fields.push_back(std::move(field));
         }
@@ -223,6 +240,10 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
     } else if (type == 2) {  // local
       const LocalUsage usage{data, dataBytes};
       if (tag == 0x0) {
+        if (local.usages.size() >= kMaxUsageRange) {
+          error = at(itemStart, "more than " + std::to_string(kMaxUsageRange) + " usages before one main item");
+          return false;
+        }
         local.usages.push_back(usage);
       } else if (tag == 0x1) {
         local.usageMin = usage;

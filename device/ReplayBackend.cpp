@@ -3,6 +3,7 @@
 #include "HidMouseDecoder.hpp"
 #include "HidRecorderFile.hpp"
 #include "HidReportDescriptor.hpp"
+#include "TextFileReader.hpp"
 
 namespace kf {
 
@@ -22,12 +23,18 @@ void CountingForceSink::commandForce(double timeS, float forceN) {
 void CountingForceSink::driveOff() { driveOffs_.fetch_add(1, std::memory_order_relaxed); }
 
 bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out, std::string& error,
-                       size_t* skippedEvents) {
+                       size_t* skippedEvents, std::string* warning) {
   out.clear();
   if (skippedEvents) *skippedEvents = 0;
+  if (warning) warning->clear();
+  {
+    TextFileReader probe;  // the file's own problem first, not "neither format"
+    if (!probe.open(path, error)) return false;
+  }
   if (isSessionFile(path)) {
     SessionData session;
     if (!readSessionFile(path, spec, session, error)) return false;
+    if (warning) *warning = session.warning;
     spec = session.spec;
     out = std::move(session.reports);
     return true;
@@ -38,6 +45,7 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
   }
   HidRecording recording;
   if (!readHidRecorderFile(path, recording, error)) return false;
+  if (warning) *warning = recording.warning;
   HidReportDescriptor descriptor;
   if (!parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(), descriptor, error))
     return false;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -30,8 +31,10 @@ struct SimParams {
 
   // Sets a numeric field by its member name (and "liftStartS"/"liftEndS" pairs: a
   // liftStartS appends an interval, the following liftEndS closes it). False on unknown keys
-  // or values out of range.
-  bool applyOverride(std::string_view key, double value);
+  // or values outside their bounds (SettingBounds); `error`, if given, says which.
+  bool applyOverride(std::string_view key, double value, std::string* error = nullptr);
+  // True when every field is within its bounds (SettingBounds); `error` says which is not.
+  bool isValid(std::string* error = nullptr) const;
 };
 
 }  // namespace kf

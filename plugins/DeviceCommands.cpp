@@ -15,72 +15,83 @@
 #include <string>
 
 #include "AudioClock.hpp"
+#include "CommandArgs.hpp"
 #include "DeviceFactory.hpp"
+#include "DeviceMessages.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
+#include "PostLimiter.hpp"
 
 namespace {
 
-constexpr int kMaxValues = 8192;
-constexpr int kMaxOverrides = 32;
-constexpr int kMaxKeyChars = 48;
-constexpr int kMaxPathChars = 1024;
+using kf::sc::CommandShape;
 
 struct CommandData {
   const char* name;
-  int index;
-  int kind;
-  int numValues;
-  int numOverrides;
-  char keys[kMaxOverrides][kMaxKeyChars];
-  double overrideValues[kMaxOverrides];
-  char path[kMaxPathChars];
-  kf::Device* device;    // opened by stage 2, or the target of record/status
-  kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
-  double* values;        // the hand script (kfOpenSim only), RTAlloc'd to its size
+  kf::sc::CommandArgs args;  // args.values: the hand script (kfOpenSim only), RTAlloc'd to its size
+  kf::Device* device;        // opened by stage 2, or the target of record/status
+  kf::Device* previous;      // swapped out of the slot, deleted in an NRT stage
 };
 
-void copyString(char* to, const char* from, size_t capacity) {
-  std::snprintf(to, capacity, "%s", from != nullptr ? from : "");
+double* allocValues(void* world, int count) {
+  return static_cast<double*>(RTAlloc(static_cast<World*>(world), sizeof(double) * static_cast<size_t>(count)));
 }
 
-CommandData* newCommand(World* world, const char* name, sc_msg_iter* args) {
+void freeCommand(World* world, void* raw) {
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->args.values != nullptr) RTFree(world, data->args.values);
+  RTFree(world, data);
+}
+
+// The arguments after the command name, bounded by the packet: scsynth's own iterator reads
+// strings to their terminator wherever it is.
+kf::sc::OscArgReader readerOf(sc_msg_iter* msg) {
+  if (msg->tags == nullptr || msg->rdpos > msg->endpos) return kf::sc::OscArgReader(nullptr, nullptr, nullptr, nullptr);
+  const char* tagsEnd = static_cast<const char*>(std::memchr(msg->tags, '\0', msg->endpos - msg->tags));
+  if (tagsEnd == nullptr || tagsEnd - msg->tags < msg->count)
+    return kf::sc::OscArgReader(nullptr, nullptr, nullptr, nullptr);
+  return kf::sc::OscArgReader(msg->tags + msg->count, msg->endpos, msg->rdpos, msg->endpos);
+}
+
+// Refused commands post one line each, and the same refusal at most once a second (a flood
+// of one bad command must not flood the post window; different problems all show).
+void postRefusal(World* world, const char* name, const char* error) {
+  constexpr int kCauses = 16;
+  static kf::sc::PostLimiter limiters[kCauses];
+  static uint32_t causes[kCauses] = {};
+  uint32_t hash = 2166136261u;  // FNV-1a of command and message: the cause
+  for (const char* c : {name, error})
+    for (; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
+  int slot = static_cast<int>(hash % kCauses);
+  if (causes[slot] != hash) {  // another cause had this slot: start afresh
+    causes[slot] = hash;
+    limiters[slot] = kf::sc::PostLimiter();
+  }
+  int suppressed = 0;
+  if (!limiters[slot].allow(kf::sc::blockStartTimeS(world), suppressed)) return;
+  if (suppressed > 0)
+    kf::sc::postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error, suppressed);
+  else
+    kf::sc::postFromRt(world, "%s: %s; refused\n", name, error);
+}
+
+CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_msg_iter* msg) {
   auto* data = static_cast<CommandData*>(RTAlloc(world, sizeof(CommandData)));
   if (data == nullptr) {
     kf::sc::postFromRt(world, "%s: RT memory allocation failed\n", name);
     return nullptr;
   }
   data->name = name;
-  data->index = args->geti(-1);
-  data->kind = -1;
-  data->numValues = data->numOverrides = 0;
-  data->path[0] = '\0';
   data->device = data->previous = nullptr;
-  data->values = nullptr;
-  return data;
-}
-
-// Trailing (key, value) pairs: device spec or simulation settings by name.
-void readOverrides(sc_msg_iter* args, CommandData* data) {
-  while (args->remain() > 0 && data->numOverrides < kMaxOverrides) {
-    const char* key = args->gets(nullptr);
-    if (key == nullptr) break;
-    copyString(data->keys[data->numOverrides], key, kMaxKeyChars);
-    data->overrideValues[data->numOverrides++] = args->getd(0.0);
+  kf::sc::OscArgReader reader = readerOf(msg);
+  char error[200];
+  if (!kf::sc::parseCommandArgs(shape, reader, kf::sc::kNumDeviceSlots, data->args, allocValues, world, error,
+                                sizeof error)) {
+    postRefusal(world, name, error);
+    freeCommand(world, data);
+    return nullptr;
   }
-}
-
-bool checkSlot(World* world, CommandData* data) {
-  if (kf::sc::isValidSlot(data->index)) return true;
-  kf::sc::postFromRt(world, "%s: device index %d is out of range 0..%d\n", data->name, data->index,
-                     kf::sc::kNumDeviceSlots - 1);
-  return false;
-}
-
-void freeCommand(World* world, void* raw) {
-  auto* data = static_cast<CommandData*>(raw);
-  if (data->values != nullptr) RTFree(world, data->values);
-  RTFree(world, data);
+  return data;
 }
 
 void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
@@ -90,31 +101,36 @@ void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, 
 
 // Applies the overrides to a spec and simulation settings; false (and a message) on a bad key.
 bool applyOverrides(const CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim) {
-  for (int i = 0; i < data->numOverrides; ++i) {
-    const char* key = data->keys[i];
-    const double value = data->overrideValues[i];
-    if (spec.applyOverride(key, value)) continue;
-    if (sim != nullptr && sim->applyOverride(key, value)) continue;
-    Print("%s: unknown setting or value out of range: %s = %g\n", data->name, key, value);
+  for (int i = 0; i < data->args.numOverrides; ++i) {
+    const char* key = data->args.keys[i];
+    const double value = data->args.overrideValues[i];
+    std::string error;
+    if (spec.applyOverride(key, value, &error)) continue;
+    // Not a device setting: perhaps a simulation one (a device setting out of range stays an error).
+    const bool unknown = error.rfind("unknown", 0) == 0;
+    if (unknown && sim != nullptr && sim->applyOverride(key, value, &error)) continue;
+    Print("%s: %s; not opened\n", data->name, error.c_str());
     return false;
   }
-  if (!spec.isValid()) {
-    Print("%s: the device settings do not fit together (check force range and rates)\n", data->name);
+  std::string error;
+  if (!spec.isValid(&error)) {
+    Print("%s: the device settings do not fit together: %s; not opened\n", data->name, error.c_str());
     return false;
   }
   return true;
 }
 
 kf::HandScript handScriptOf(const CommandData* data) {
+  const kf::sc::CommandArgs& args = data->args;
   std::vector<std::pair<double, double>> pairs;
-  for (int i = 0; i + 1 < data->numValues; i += 2) pairs.emplace_back(data->values[i], data->values[i + 1]);
-  switch (data->kind) {
+  for (int i = 0; i + 1 < args.numValues; i += 2) pairs.emplace_back(args.values[i], args.values[i + 1]);
+  switch (args.kind) {
     case 0:
       return kf::HandScript::path(std::move(pairs));
     case 1:
       return kf::HandScript::speeds(std::move(pairs));
     case 2:
-      return kf::HandScript::constantForce(data->numValues > 0 ? data->values[0] : 0.0);
+      return kf::HandScript::constantForce(args.numValues > 0 ? args.values[0] : 0.0);
     default:
       return kf::HandScript::none();
   }
@@ -127,7 +143,7 @@ bool publishStage(World* world, void* raw) {  // RT
   // A lockstep device's time starts with the next block, as a realtime one's starts at open.
   if (data->device != nullptr && data->device->isLockstep())
     data->device->setLockstepOriginS(kf::sc::blockStartTimeS(world));
-  data->previous = kf::sc::exchangeSlot(data->index, data->device);
+  data->previous = kf::sc::exchangeSlot(data->args.index, data->device);
   return true;
 }
 
@@ -144,8 +160,10 @@ bool openSimStage(World* world, void* raw) {  // NRT
   kf::SimParams sim;
   if (!applyOverrides(data, spec, &sim)) return false;
   const kf::HandScript hand = handScriptOf(data);
-  if (data->kind >= 0 && !hand.isValid()) {
-    Print("kfOpenSim: the hand script is not usable (times must ascend, values be finite)\n");
+  if (data->args.kind >= 0 && !hand.isValid()) {
+    Print(
+        "kfOpenSim: the hand script is not usable (times must ascend; times, positions and durations within "
+        "+-1e6 s/mm, speeds within +-1e5 mm/s, a force within +-100 N); not opened\n");
     return false;
   }
   std::string error;
@@ -155,22 +173,8 @@ bool openSimStage(World* world, void* raw) {  // NRT
 }
 
 void openSimCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfOpenSim", args);
-  if (data == nullptr) return;
-  data->kind = args->geti(-1);
-  const int count = std::min(args->geti(0), kMaxValues);
-  if (count > 0) {
-    data->values = static_cast<double*>(RTAlloc(world, sizeof(double) * count));
-    if (data->values == nullptr) {
-      kf::sc::postFromRt(world, "kfOpenSim: RT memory allocation failed for the hand script\n");
-      return freeCommand(world, data);
-    }
-  }
-  for (int i = 0; i < count && args->remain() > 0; ++i) data->values[data->numValues++] = args->getd(0.0);
-  if (count == kMaxValues) kf::sc::postFromRt(world, "kfOpenSim: hand script limited to %d values\n", kMaxValues);
-  readOverrides(args, data);
-  if (!checkSlot(world, data)) return freeCommand(world, data);
-  run(world, replyAddr, data, openSimStage, publishStage, deletePreviousStage);
+  CommandData* data = newCommand(world, "kfOpenSim", CommandShape::kOpenSim, args);
+  if (data != nullptr) run(world, replyAddr, data, openSimStage, publishStage, deletePreviousStage);
 }
 
 // --- kfOpenReplay --------------------------------------------------------------------------
@@ -179,19 +183,16 @@ bool openReplayStage(World* world, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   kf::DeviceSpec spec;
   if (!applyOverrides(data, spec, nullptr)) return false;
-  std::string error;
-  data->device = kf::openReplayDevice(data->path, spec, !world->mRealTime, error).release();
+  std::string error, warning;
+  data->device = kf::openReplayDevice(data->args.path, spec, !world->mRealTime, error, {}, &warning).release();
   if (data->device == nullptr) Print("kfOpenReplay: %s\n", error.c_str());
+  if (!warning.empty()) Print("kfOpenReplay: warning: %s\n", warning.c_str());
   return data->device != nullptr;
 }
 
 void openReplayCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfOpenReplay", args);
-  if (data == nullptr) return;
-  copyString(data->path, args->gets(""), kMaxPathChars);
-  readOverrides(args, data);
-  if (!checkSlot(world, data)) return freeCommand(world, data);
-  run(world, replyAddr, data, openReplayStage, publishStage, deletePreviousStage);
+  CommandData* data = newCommand(world, "kfOpenReplay", CommandShape::kOpenReplay, args);
+  if (data != nullptr) run(world, replyAddr, data, openReplayStage, publishStage, deletePreviousStage);
 }
 
 // --- kfRecord, kfStatus --------------------------------------------------------------------
@@ -202,28 +203,28 @@ bool nrtHop(World*, void*) { return true; }
 
 bool lookUpDeviceStage(World*, void* raw) {  // RT
   auto* data = static_cast<CommandData*>(raw);
-  data->device = kf::sc::peekSlot(data->index);
+  data->device = kf::sc::peekSlot(data->args.index);
   return true;
 }
 
 bool unpublishStage(World*, void* raw) {  // RT
   auto* data = static_cast<CommandData*>(raw);
-  data->previous = kf::sc::exchangeSlot(data->index, nullptr);
+  data->previous = kf::sc::exchangeSlot(data->args.index, nullptr);
   return true;
 }
 
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (data->device == nullptr) {
-    Print("kfRecord: no device is open at index %d\n", data->index);
+    Print("kfRecord: no device is open at index %d\n", data->args.index);
     return false;
   }
-  if (data->path[0] == '\0') {
+  if (data->args.path[0] == '\0') {
     data->device->stopRecording();
     return true;
   }
   std::string error;
-  if (!data->device->startRecording(data->path, error)) {
+  if (!data->device->startRecording(data->args.path, error)) {
     Print("kfRecord: %s\n", error.c_str());
     return false;
   }
@@ -231,51 +232,48 @@ bool recordStage(World*, void* raw) {  // NRT
 }
 
 void recordCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfRecord", args);
-  if (data == nullptr) return;
-  copyString(data->path, args->gets(""), kMaxPathChars);
-  if (!checkSlot(world, data)) return freeCommand(world, data);
-  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, recordStage);
+  CommandData* data = newCommand(world, "kfRecord", CommandShape::kRecord, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, recordStage);
 }
 
 bool statusStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (data->device == nullptr) {
-    Print("kfStatus %d: closed\n", data->index);
+    Print("kfStatus %d: closed\n", data->args.index);
     return true;
   }
   const kf::TelemetrySnapshot t = data->device->telemetry();
   Print(
       "kfStatus %d: %s, reports %llu (interval %.3f ms, jitter %.3f ms), frames %llu, "
       "last force %.4f N, watchdog trips %llu, queue overflows %llu/%llu\n",
-      data->index, data->device->isLockstep() ? "lockstep" : "realtime", static_cast<unsigned long long>(t.reports),
-      t.reportIntervalMeanS * 1e3, t.reportIntervalJitterS * 1e3, static_cast<unsigned long long>(t.frames),
-      t.lastCommandedForceN, static_cast<unsigned long long>(t.watchdogTrips),
-      static_cast<unsigned long long>(t.reportQueueOverflows), static_cast<unsigned long long>(t.frameQueueOverflows));
+      data->args.index, data->device->isLockstep() ? "lockstep" : "realtime",
+      static_cast<unsigned long long>(t.reports), t.reportIntervalMeanS * 1e3, t.reportIntervalJitterS * 1e3,
+      static_cast<unsigned long long>(t.frames), t.lastCommandedForceN,
+      static_cast<unsigned long long>(t.watchdogTrips), static_cast<unsigned long long>(t.reportQueueOverflows),
+      static_cast<unsigned long long>(t.frameQueueOverflows));
   auto line = [&](const char* what, const kf::LatencySummary& l) {
     if (l.count > 0)
-      Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu)\n", data->index, what, l.p50S * 1e3,
+      Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu)\n", data->args.index, what, l.p50S * 1e3,
             l.p99S * 1e3, l.maxS * 1e3, static_cast<unsigned long long>(l.count));
   };
   line("loop period", t.pumpPeriod);
   line("report to UGen", t.reportLatency);
   line("force to magnet", t.forceLatency);
+  const std::string recordingError = data->device->recordingError();
+  if (!recordingError.empty()) Print("kfStatus %d: recording failed: %s\n", data->args.index, recordingError.c_str());
   return true;
 }
 
 void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfStatus", args);
-  if (data == nullptr) return;
-  if (!checkSlot(world, data)) return freeCommand(world, data);
-  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, statusStage);
+  CommandData* data = newCommand(world, "kfStatus", CommandShape::kIndex, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, statusStage);
 }
 
 // --- kfClose -------------------------------------------------------------------------------
 
 void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfClose", args);
+  CommandData* data = newCommand(world, "kfClose", CommandShape::kIndex, args);
   if (data == nullptr) return;
-  if (!checkSlot(world, data)) return freeCommand(world, data);
   // Unpublished in the RT stage, between blocks (no UGen sees it from the next block on), after
   // an NRT hop so that an open sent just before is closed too; deleted in the last NRT stage.
   run(world, replyAddr, data, nrtHop, unpublishStage, deletePreviousStage);
@@ -284,6 +282,8 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 }  // namespace
 
 void registerDeviceCommands() {
+  // A recording that stops on a write error says so in the post window (device thread).
+  kf::setDeviceMessageSink([](const char* message) { Print("%s\n", message); });
   DefinePlugInCmd("kfOpenSim", openSimCmd, nullptr);
   DefinePlugInCmd("kfOpenReplay", openReplayCmd, nullptr);
   DefinePlugInCmd("kfRecord", recordCmd, nullptr);

@@ -42,4 +42,10 @@ Device* peekSlot(int index);
 
 bool isValidSlot(int index);
 
+// The slot a UGen's device input names, or -1 for NaN, infinities and anything outside
+// 0..kNumDeviceSlots-1 (a cast of those to int would be undefined).
+inline int slotIndexOf(float input) {
+  return input >= 0.f && input < static_cast<float>(kNumDeviceSlots) ? static_cast<int>(input) : -1;
+}
+
 }  // namespace kf::sc

@@ -2,6 +2,7 @@
 // rate from its timestamped 125 Hz reports.
 // Inputs: device (slot index), origin (mm, subtracted from x in double), interpolation
 // (0 hold, 1 linear as the paper, 2 predictive). Outputs: x mm, y mm, speedX, speedY mm/s.
+#include <cmath>
 #include <new>
 
 #include "AudioClock.hpp"
@@ -25,11 +26,14 @@ class FrictionMouseIn : public SCUnit {
 
  private:
   void next(int numSamples) {
-    const int index = static_cast<int>(in0(kDevice));
+    const int index = kf::sc::slotIndexOf(in0(kDevice));
     const double startS = kf::sc::blockStartTimeS(mWorld);
     const kf::sc::SlotView slot = kf::sc::viewSlot(index, mWorld->mBufCounter, startS + kf::sc::blockDurationS(mWorld));
     if (slot.device == nullptr) {
-      mSlot.closed(mWorld, "FrictionMouseIn", index, "position and speed are 0.");
+      if (index < 0)
+        mSlot.badIndex(mWorld, "FrictionMouseIn", in0(kDevice), kf::sc::kNumDeviceSlots, "position and speed are 0.");
+      else
+        mSlot.closed(mWorld, "FrictionMouseIn", index, "position and speed are 0.");
       for (int c = 0; c < 4; ++c) std::fill_n(out(c), numSamples, 0.f);
       return;
     }
@@ -45,7 +49,17 @@ class FrictionMouseIn : public SCUnit {
       mTrajectory.addReport(reportS, r.dxCounts * spec.countMm, r.dyCounts * spec.countMm, r.flags);
     }
     mTrajectory.setMode(kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation))));
-    mTrajectory.render(startS, 1.0 / sampleRate(), numSamples, in0(kOriginMm), out(0), out(1), out(2), out(3));
+    // A NaN or infinite origin would make every position NaN: 0 instead, said once.
+    double originMm = in0(kOriginMm);
+    if (!std::isfinite(originMm)) {
+      if (!mWarnedOrigin)
+        kf::sc::postFromRt(mWorld, "FrictionMouseIn: origin %g is not finite; 0 used.\n", kf::sc::shownValue(originMm));
+      mWarnedOrigin = true;
+      originMm = 0.0;
+    } else {
+      mWarnedOrigin = false;
+    }
+    mTrajectory.render(startS, 1.0 / sampleRate(), numSamples, originMm, out(0), out(1), out(2), out(3));
   }
 
   // A new device in the slot: start from its origin, with its update rate.
@@ -58,6 +72,7 @@ class FrictionMouseIn : public SCUnit {
   kf::TrajectoryReconstructor mTrajectory;
   kf::DeviceClockMapper mClock;
   kf::sc::SlotFollower mSlot;
+  bool mWarnedOrigin = false;
 };
 
 }  // namespace

@@ -23,12 +23,15 @@ class FrictionOut : public SCUnit {
 
  private:
   void next(int numSamples) {
-    const int index = static_cast<int>(in0(kDevice));
+    const int index = kf::sc::slotIndexOf(in0(kDevice));
     const double startS = kf::sc::blockStartTimeS(mWorld);
     uint32_t generation = 0;
     kf::Device* device = kf::sc::deviceOfSlot(index, startS + kf::sc::blockDurationS(mWorld), &generation);
     if (device == nullptr) {
-      mSlot.closed(mWorld, "FrictionOut", index, "no force is sent.");
+      if (index < 0)
+        mSlot.badIndex(mWorld, "FrictionOut", in0(kDevice), kf::sc::kNumDeviceSlots, "no force is sent.");
+      else
+        mSlot.closed(mWorld, "FrictionOut", index, "no force is sent.");
       std::fill_n(out(0), numSamples, mMinForceN);  // no device: its magnet is off
       return;
     }

@@ -3,9 +3,14 @@
 
 #include <SC_PlugIn.hpp>
 
+#include <cmath>
+
 extern InterfaceTable* ft;
 
 namespace kf::sc {
+
+// A value for a message: NaN without the sign printf would show ("-nan").
+inline double shownValue(double value) { return std::isnan(value) ? std::fabs(value) : value; }
 
 // Posts a message without doing I/O on the audio thread: the text is formatted into static
 // storage and printed by the NRT thread (directly when rendering a Score, where there is no
@@ -24,6 +29,14 @@ class SlotFollower {
     if (warned_) return;
     warned_ = true;
     postFromRt(world, "%s: no device is open at index %d; %s\n", ugenName, index, consequence);
+  }
+  // The device input is no slot number (NaN, inf, negative, 16 or more).
+  void badIndex(World* world, const char* ugenName, float input, int numSlots, const char* consequence) {
+    generation_ = 0;
+    if (warned_) return;
+    warned_ = true;
+    postFromRt(world, "%s: device %g is not a slot number 0..%d; %s\n", ugenName, shownValue(input), numSlots - 1,
+               consequence);
   }
   // True when the slot's device (by generation) is not the one followed so far.
   bool isNew(uint32_t generation) {
@@ -46,3 +59,5 @@ void registerLoudnessToFriction();
 void registerFrictionMouseIn();
 void registerFrictionOut();
 void registerDeviceCommands();
+// Signal handlers that drive every open device's magnet off on the way out (ExitSafety.cpp).
+void installExitSafety();

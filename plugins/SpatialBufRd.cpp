@@ -1,7 +1,12 @@
 // SpatialBufRd: plays a buffer laid out on the surface, read at the puck's position.
 // Inputs: bufnum, position (mm), samplesPerMm, origin (mm), interpolation (1, 2, 4).
 // samplesPerMm, origin and interpolation are read once per block.
+#include <cmath>
+#include <cstdio>
+
+#include "AudioClock.hpp"
 #include "PluginShared.hpp"
+#include "PostLimiter.hpp"
 #include "SpatialReader.hpp"
 
 namespace {
@@ -9,7 +14,7 @@ namespace {
 enum Input { kBufnum, kPositionMm, kSamplesPerMm, kOriginMm, kInterpolation };
 
 // Why a block came out silent; posted once each time it changes.
-enum class BufferProblem { None, NotAllocated, ChannelMismatch };
+enum class BufferProblem { None, BadBufnum, NotAllocated, ChannelMismatch };
 
 class SpatialBufRd : public SCUnit {
  public:
@@ -19,6 +24,7 @@ class SpatialBufRd : public SCUnit {
  private:
   void next(int numSamples) {
     const SndBuf* buf = lookupBuffer();
+    if (mBadBufnum) return silence(BufferProblem::BadBufnum, buf, numSamples);
     if (buf == nullptr) return silence(BufferProblem::NotAllocated, buf, numSamples);
     // Held for the block, as GET_BUF_SHARED does: under supernova another thread may reallocate
     // the buffer meanwhile (no-op in scsynth).
@@ -47,38 +53,50 @@ class SpatialBufRd : public SCUnit {
   // reallocated buffer shows in its fields at once.
   const SndBuf* lookupBuffer() {
     const float fbufnum = in0(kBufnum);
-    if (fbufnum == mFBufnum) return mBuf;
-    mFBufnum = fbufnum;
+    if (fbufnum == mBufnumIn) return mBuf;
+    mBufnumIn = fbufnum;
     mBuf = nullptr;
-    if (!(fbufnum >= 0.f)) return nullptr;
+    // Checked as a float first: 2^32, 1e30, inf and NaN are no buffer (a cast to an integer
+    // would be undefined, and read buffer 0).
+    const double numBufs = static_cast<double>(mWorld->mNumSndBufs) + mParent->localBufNum;
+    mBadBufnum = !(fbufnum >= 0.f) || !(static_cast<double>(fbufnum) < numBufs);
+    if (mBadBufnum) return nullptr;
     const auto bufnum = static_cast<uint32>(fbufnum);
     mBufnum = static_cast<int>(bufnum);
-    if (bufnum < mWorld->mNumSndBufs) {
-      mBuf = mWorld->mSndBufs + bufnum;
-    } else {
-      const int localBufnum = static_cast<int>(bufnum - mWorld->mNumSndBufs);
-      if (localBufnum < mParent->localBufNum) mBuf = mParent->mLocalSndBufs + localBufnum;
-    }
+    mBuf = bufnum < mWorld->mNumSndBufs ? mWorld->mSndBufs + bufnum
+                                        : mParent->mLocalSndBufs + (bufnum - mWorld->mNumSndBufs);
     return mBuf;
   }
 
-  // One message each time the problem changes, unless the server runs quiet (verbosity -2 and
-  // below, as for SC's own buffer UGens).
+  // One message per change of problem, and per kind of problem at most one a second: a buffer
+  // reallocated 300 times a second posts a line, not hundreds. None when the server runs quiet
+  // (verbosity -2 and below, as for SC's own buffer UGens).
   void report(BufferProblem problem, const SndBuf* buf) {
     if (problem == mProblem) return;
     mProblem = problem;
-    if (mWorld->mVerbosity <= -2) return;
-    if (problem == BufferProblem::NotAllocated)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.\n", mBufnum);
+    if (problem == BufferProblem::None || mWorld->mVerbosity <= -2) return;
+    int heldBack = 0;
+    if (!mLimits[static_cast<int>(problem)].allow(kf::sc::blockStartTimeS(mWorld), heldBack)) return;
+    char more[64] = "";
+    if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
+    if (problem == BufferProblem::BadBufnum)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
+                         kf::sc::shownValue(mBufnumIn),
+                         static_cast<int>(mWorld->mNumSndBufs) + mParent->localBufNum - 1, more);
+    else if (problem == BufferProblem::NotAllocated)
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.%s\n", mBufnum,
+                         more);
     else if (problem == BufferProblem::ChannelMismatch)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.\n",
-                         mBufnum, buf->channels, static_cast<int>(mNumOutputs));
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.%s\n",
+                         mBufnum, buf->channels, static_cast<int>(mNumOutputs), more);
   }
 
   BufferProblem mProblem = BufferProblem::None;
-  float mFBufnum = -1e9f;  // the bufnum input mBuf was found for
+  float mBufnumIn = -1e9f;  // the bufnum input mBuf was found for
   const SndBuf* mBuf = nullptr;
   int mBufnum = -1;
+  bool mBadBufnum = false;
+  kf::sc::PostLimiter mLimits[4];
 };
 
 }  // namespace

@@ -5,7 +5,8 @@
 #   no-sc      dsp/ and device/ build and pass their tests without SuperCollider (build-nosc/)
 #   sanitize   the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/);
 #              any finding fails
-# Usage: scripts/check.sh [format|pyflakes|no-sc|sanitize]...   (none: all, in this order)
+#   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh)
+# Usage: scripts/check.sh [format|pyflakes|no-sc|sanitize|fuzz]...   (none: all, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/env.sh
@@ -45,14 +46,20 @@ check_sanitize() {
     build_and_test build-asan 'dsp/|device/' -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined
 }
 
+check_fuzz() {
+  echo "== fuzzing (build-fuzz/)"
+  scripts/fuzz.sh "${KF_FUZZ_SECONDS:-20}"
+}
+
 checks=("$@")
-((${#checks[@]})) || checks=(format pyflakes no-sc sanitize)
+((${#checks[@]})) || checks=(format pyflakes no-sc sanitize fuzz)
 for check in "${checks[@]}"; do
   case "$check" in
     format) check_format ;;
     pyflakes) check_pyflakes ;;
     no-sc) check_no_sc ;;
     sanitize) check_sanitize ;;
-    *) echo "unknown check: $check (format, pyflakes, no-sc, sanitize)" >&2; exit 2 ;;
+    fuzz) check_fuzz ;;
+    *) echo "unknown check: $check (format, pyflakes, no-sc, sanitize, fuzz)" >&2; exit 2 ;;
   esac
 done

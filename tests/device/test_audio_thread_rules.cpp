@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdlib>
 #include <new>
 #include <thread>
@@ -36,13 +37,49 @@ struct AudioSection {
 
 }  // namespace
 
-void* operator new(std::size_t size) {
+// Every form of the global operators is replaced, all on malloc/free: replacing only some
+// (as before) pairs this file's new with the sanitizer runtime's delete[] or aligned forms,
+// which AddressSanitizer rightly reports as mismatched (the "clash with Catch2").
+namespace {
+void* countedAlloc(std::size_t size, std::size_t alignment = 0) {
   if (tInAudioCode) gAllocations.fetch_add(1);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  if (size == 0) size = 1;
+  if (alignment > alignof(std::max_align_t)) {
+    void* p = nullptr;
+    return ::posix_memalign(&p, alignment, size) == 0 ? p : nullptr;
+  }
+  return std::malloc(size);
+}
+void* countedAllocOrThrow(std::size_t size, std::size_t alignment = 0) {
+  if (void* p = countedAlloc(size, alignment)) return p;
   throw std::bad_alloc();
 }
+}  // namespace
+
+void* operator new(std::size_t size) { return countedAllocOrThrow(size); }
+void* operator new[](std::size_t size) { return countedAllocOrThrow(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return countedAlloc(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return countedAlloc(size); }
+void* operator new(std::size_t size, std::align_val_t a) { return countedAllocOrThrow(size, std::size_t(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) { return countedAllocOrThrow(size, std::size_t(a)); }
+void* operator new(std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept {
+  return countedAlloc(size, std::size_t(a));
+}
+void* operator new[](std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept {
+  return countedAlloc(size, std::size_t(a));
+}
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 
 extern "C" int pthread_mutex_lock(pthread_mutex_t* mutex) {
   using Lock = int (*)(pthread_mutex_t*);

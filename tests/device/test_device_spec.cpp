@@ -27,9 +27,10 @@ TEST_CASE("spec overrides by key", "[spec]") {
   CHECK_FALSE(spec.applyOverride("countMm", std::numeric_limits<double>::quiet_NaN()));
   CHECK_FALSE(spec.applyOverride("noSuchField", 1.0));
   CHECK(spec.updateRateHz == 125.0);
-  for (const char* key : {"updateRateHz", "minForceN", "maxForceN", "audioLatencyS", "tactileLatencyS",
-                          "forceFramePeriodS", "maxForceSlewNPerS"})
+  for (const char* key :
+       {"updateRateHz", "minForceN", "maxForceN", "audioLatencyS", "tactileLatencyS", "maxForceSlewNPerS"})
     CHECK(spec.applyOverride(key, 1.0));
+  CHECK(spec.applyOverride("forceFramePeriodS", 0.01));
   CHECK(spec.isValid());
   spec.minForceN = 2.0;
   CHECK_FALSE(spec.isValid());

@@ -1,0 +1,62 @@
+// ExitSafety: the magnet goes off however scsynth leaves. /quit runs the static destructors
+// (DeviceSlots' exit hook closes every device); a signal does not, so at plugin load this
+// installs handlers for the signals that end the process — SIGTERM, SIGINT, SIGHUP, SIGQUIT,
+// and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a thread
+// aborts). Each handler drives every open device's force backend off with async-signal-safe
+// work only (atomic slot loads, stores, write(2) of an off record to a recording), then hands
+// the signal on: to the handler installed before ours if there was one, else the original
+// disposition is restored and the signal raised again, so the exit status is the signal's.
+// A signal ignored when the plugin loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be
+// caught: the device thread dies with the process and a real magnet's own watchdog must act.
+#include <signal.h>
+
+#include <atomic>
+
+#include "DeviceSlots.hpp"
+
+namespace {
+
+constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+
+struct sigaction gPrevious[NSIG];
+std::atomic<bool> gInstalled[NSIG];
+std::atomic<bool> gDrivenOff{false};
+
+void driveAllOff() {
+  for (int index = 0; index < kf::sc::kNumDeviceSlots; ++index)
+    if (kf::Device* device = kf::sc::peekSlot(index)) device->emergencyOff();
+}
+
+void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
+  // Once: a second signal (or a crash inside the first handler) goes straight on.
+  if (!gDrivenOff.exchange(true)) driveAllOff();
+  const struct sigaction& previous = gPrevious[signalNumber];
+  if (previous.sa_flags & SA_SIGINFO) {
+    if (previous.sa_sigaction != nullptr) return previous.sa_sigaction(signalNumber, info, context);
+  } else if (previous.sa_handler != SIG_DFL && previous.sa_handler != SIG_IGN) {
+    // The host's own handler (it may shut down gracefully; the devices' next frames and the
+    // watchdog take over again if the process lives on).
+    gDrivenOff.store(false);
+    return previous.sa_handler(signalNumber);
+  }
+  ::sigaction(signalNumber, &previous, nullptr);
+  ::raise(signalNumber);  // delivered when this handler returns (the signal is blocked in it)
+}
+
+}  // namespace
+
+void installExitSafety() {
+  for (const int signalNumber : kSignals) {
+    if (gInstalled[signalNumber].load()) continue;
+    struct sigaction previous {};
+    if (::sigaction(signalNumber, nullptr, &previous) != 0) continue;
+    if (!(previous.sa_flags & SA_SIGINFO) && previous.sa_handler == SIG_IGN) continue;
+    gPrevious[signalNumber] = previous;
+    struct sigaction action {};
+    action.sa_sigaction = onExitSignal;
+    action.sa_flags = SA_SIGINFO | SA_RESTART | SA_ONSTACK;
+    sigemptyset(&action.sa_mask);
+    for (const int other : kSignals) sigaddset(&action.sa_mask, other);  // no handler inside another
+    if (::sigaction(signalNumber, &action, nullptr) == 0) gInstalled[signalNumber].store(true);
+  }
+}

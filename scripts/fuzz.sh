@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (AddressSanitizer + UndefinedBehaviorSanitizer) in
+# build-fuzz/ and runs each for a bounded time on seeds made from the real recordings.
+# Usage: scripts/fuzz.sh [seconds per target, default 20] [target...]
+# Exit status 1 if any target found a crash, leak, timeout or out-of-memory; its input is left
+# in build-fuzz/artifacts/<target>/ (make it a regression test).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET="${1:-20}"
+shift || true
+TARGETS=("$@")
+((${#TARGETS[@]})) || TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args)
+
+# clang and its libFuzzer runtime, installed when missing (as scripts/setup.sh does its packages).
+missing=()
+for p in clang libclang-rt-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "== installing: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+BUILD=build-fuzz
+echo "== configuring and building the fuzz targets ($BUILD/)"
+CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
+  -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
+rm -f "$BUILD.configure.log"
+nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
+
+SEEDS="$BUILD/seeds"
+rm -rf "$SEEDS"
+"$BUILD/tests/fuzz/make_fuzz_seeds" "$SEEDS" tests/data/hid/*.hid
+
+declare -A SEED_DIR=([fuzz_hid_descriptor]=hid_descriptor [fuzz_hid_recorder]=hid_recorder
+                     [fuzz_session_file]=session_file [fuzz_command_args]=command_args)
+declare -A MAX_LEN=([fuzz_hid_descriptor]=4096 [fuzz_hid_recorder]=16384
+                    [fuzz_session_file]=16384 [fuzz_command_args]=4096)
+failed=()
+for target in "${TARGETS[@]}"; do
+  corpus="$BUILD/corpus/$target"
+  artifacts="$BUILD/artifacts/$target"
+  mkdir -p "$corpus" "$artifacts"
+  echo "== $target: ${SECONDS_PER_TARGET} s"
+  # -rss_limit_mb and -timeout: unbounded memory or work is a finding, not a hang of the run.
+  if ! "$BUILD/tests/fuzz/$target" "$corpus" "$SEEDS/${SEED_DIR[$target]}" \
+      -max_total_time="$SECONDS_PER_TARGET" -max_len="${MAX_LEN[$target]}" -timeout=10 -rss_limit_mb=1024 \
+      -artifact_prefix="$artifacts/" -print_final_stats=1 > "$BUILD/$target.log" 2>&1; then
+    failed+=("$target")
+    tail -40 "$BUILD/$target.log"
+  fi
+  grep -E "^stat::(number_of_executed_units|peak_rss_mb)" "$BUILD/$target.log" | tr -s ' \n' '  '
+  echo
+done
+if ((${#failed[@]})); then
+  echo "fuzz.sh: findings in ${failed[*]} (inputs in $BUILD/artifacts/)"
+  exit 1
+fi
+echo "fuzz.sh: no findings"

@@ -1,0 +1,26 @@
+// The file readers take paths: each fuzz input is written to one scratch file per process.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+namespace kf::fuzz {
+
+inline const std::string& scratchPath() {
+  static const std::string path = "/tmp/kf-fuzz-input-" + std::to_string(::getpid());
+  return path;
+}
+
+inline const std::string& writeScratch(const uint8_t* data, size_t size) {
+  std::FILE* file = std::fopen(scratchPath().c_str(), "wb");
+  if (file != nullptr) {
+    if (size > 0) std::fwrite(data, 1, size, file);
+    std::fclose(file);
+  }
+  return scratchPath();
+}
+
+}  // namespace kf::fuzz
