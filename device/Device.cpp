@@ -16,8 +16,11 @@ Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std:
       reportQueue_(options.reportQueueCapacity),
       frameQueue_(options.frameQueueCapacity),
       safety_(spec),
+      pending_(std::max<size_t>(options.frameQueueCapacity, 1)),
+      releaseLatencyS_(options.forceLatencyS),
       startTime_(std::chrono::steady_clock::now()) {
   telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
+  telemetry_.setReleaseLatency(releaseLatencyS_);
 }
 
 Device::~Device() { close(); }
@@ -55,26 +58,82 @@ void Device::pump(double nowS) {
   pumpLocked(nowS - lockstepOriginS_);
 }
 
+void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double nowS) {
+  const float commandedN = safety_.applyFrame(frame, nowS);
+  if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
+  force_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  telemetry_.countFrame(commandedN);
+  recorder_.writeFrame(nowS, frame, commandedN);
+}
+
+void Device::applyLockstepFrameLocked(const ForceFrame& frame, double nowS) {
+  // Device and audio time are one clock, so the frame is stamped with its own time (never
+  // before an earlier command, never in the future); a backend that has already passed that
+  // time (the sim, pumped to the end of the block) applies it at once, as a realtime device
+  // would.
+  double commandS = nowS;
+  if (std::isfinite(frame.timeS)) commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
+  lastCommandS_ = commandS;
+  applyFrameLocked(frame, commandS, nowS);
+}
+
+void Device::takeFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  ForceFrame frame;
+  while (frameQueue_.pop(frame)) {
+    double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
+    if (!std::isfinite(startS)) startS = nowS;
+    // A frame later than the latency allows raises it, so the frames after it keep their
+    // spacing instead of going out in a burst (a long audio period).
+    const double latenessS = nowS - startS;
+    if (latenessS > releaseLatencyS_) releaseLatencyS_ = std::min(latenessS + 0.5 * periodS, options_.maxForceLatencyS);
+    if (pendingCount_ == pending_.size()) {
+      // Full: the oldest goes out now rather than being lost.
+      applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);
+      telemetry_.countLateFrame();
+      pendingHead_ = (pendingHead_ + 1) % pending_.size();
+      --pendingCount_;
+    }
+    pending_[(pendingHead_ + pendingCount_) % pending_.size()] = PendingFrame{frame, startS};
+    ++pendingCount_;
+  }
+}
+
+int Device::releaseFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  int released = 0;
+  while (pendingCount_ > 0) {
+    const PendingFrame& pending = pending_[pendingHead_];
+    const double dueS = pending.startS + releaseLatencyS_;
+    if (dueS > nowS) break;
+    telemetry_.frameOffset.record(nowS - dueS);
+    if (nowS - dueS > periodS) telemetry_.countLateFrame();
+    applyFrameLocked(pending.frame, nowS, nowS);
+    pendingHead_ = (pendingHead_ + 1) % pending_.size();
+    --pendingCount_;
+    ++released;
+  }
+  return released;
+}
+
 void Device::pumpLocked(double nowS) {
   if (!(nowS > lastPumpS_)) return;
 
-  ForceFrame frame;
-  while (frameQueue_.pop(frame)) {
-    const float commandedN = safety_.applyFrame(frame, nowS);
-    if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
-    // Lockstep: device and audio time are one clock, so the frame is stamped with its own time
-    // (never before an earlier command, never in the future); a backend that has already
-    // passed that time (the sim, one block on) applies it at once, as a realtime device would.
-    // Realtime: now.
-    double commandS = nowS;
-    if (lockstep_ && std::isfinite(frame.timeS))
-      commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
-    lastCommandS_ = commandS;
-    force_->commandForce(commandS, commandedN);
-    telemetry_.countFrame(commandedN);
-    recorder_.writeFrame(nowS, frame, commandedN);
+  if (lockstep_) {
+    ForceFrame frame;  // only frames whose push found the state busy
+    while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
+  } else {
+    takeFramesLocked(nowS);
+    const int released = releaseFramesLocked(nowS);
+    if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
+    // Back towards the configured latency, slowly: 0.1 ms per second.
+    if (lastPumpS_ >= 0.0 && releaseLatencyS_ > options_.forceLatencyS)
+      releaseLatencyS_ = std::max(options_.forceLatencyS, releaseLatencyS_ - 0.1 * (nowS - lastPumpS_));
+    telemetry_.setReleaseLatency(releaseLatencyS_);
   }
-  if (safety_.checkWatchdog(nowS)) {
+  // Frames still waiting in the jitter buffer are coming: no trip while there are any, so a
+  // long audio period does not make the watchdog chatter.
+  if (pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
     force_->driveOff();
     telemetry_.countWatchdogTrip();
     telemetry_.setCommandedForce(safety_.commandedForceN());
@@ -105,6 +164,7 @@ void Device::close() {
   std::lock_guard<std::mutex> lock(stateMutex_);
   force_->driveOff();
   safety_.resetToOff();
+  pendingCount_ = 0;
   telemetry_.setCommandedForce(safety_.commandedForceN());
   recorder_.writeOff(std::max(lastPumpS_, 0.0));
   recorder_.close();
@@ -125,7 +185,34 @@ double Device::nowS() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - startTime_).count();
 }
 
-bool Device::pushForceFrame(const ForceFrame& frame) { return frameQueue_.push(frame); }
+bool Device::pushForceFrame(const ForceFrame& frame) {
+  if (lockstep_ && !isClosed()) {
+    std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+    if (lock.owns_lock() && lastPumpS_ >= 0.0) {
+      // Lockstep has one thread for both ends of the queue: earlier frames first.
+      ForceFrame queued;
+      while (frameQueue_.pop(queued)) applyLockstepFrameLocked(queued, lastPumpS_);
+      applyLockstepFrameLocked(frame, lastPumpS_);
+      return true;
+    }
+  }
+  return frameQueue_.push(frame);
+}
+
+void Device::setCalibration(const CalibrationTable& table) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  safety_.setCalibration(table);
+}
+
+uint64_t Device::driveLimitedFrames() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.driveLimitedFrames();
+}
+
+double Device::heatEstimate() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.heat();
+}
 
 TelemetrySnapshot Device::telemetry() const {
   TelemetrySnapshot snapshot = telemetry_.snapshot();

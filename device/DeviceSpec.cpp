@@ -7,6 +7,7 @@ namespace kf {
 namespace {
 bool isPositive(double value) { return std::isfinite(value) && value > 0.0; }
 bool isNonNegative(double value) { return std::isfinite(value) && value >= 0.0; }
+bool isFraction(double value) { return std::isfinite(value) && value > 0.0 && value <= 1.0; }
 }  // namespace
 
 bool DeviceSpec::applyOverride(std::string_view key, double value) {
@@ -27,6 +28,9 @@ bool DeviceSpec::applyOverride(std::string_view key, double value) {
       {"maxForceSlewNPerS", &DeviceSpec::maxForceSlewNPerS, isPositive},
       {"watchdogS", &DeviceSpec::watchdogS, isPositive},
       {"magnetLagS", &DeviceSpec::magnetLagS, isNonNegative},
+      {"maxDriveLevel", &DeviceSpec::maxDriveLevel, isFraction},
+      {"heatTimeConstantS", &DeviceSpec::heatTimeConstantS, isPositive},
+      {"heatRatedDuty", &DeviceSpec::heatRatedDuty, isFraction},
   };
   for (const Entry& entry : entries) {
     if (entry.name == key) {
@@ -47,7 +51,8 @@ bool DeviceSpec::isValid() const {
   return isPositive(countMm) && isPositive(updateRateHz) && maxCountsPerReport >= 1 && isNonNegative(minForceN) &&
          isNonNegative(maxForceN) && minForceN <= maxForceN && isNonNegative(audioLatencyS) &&
          isNonNegative(tactileLatencyS) && isPositive(forceFramePeriodS) && isPositive(maxForceSlewNPerS) &&
-         isPositive(watchdogS) && isNonNegative(magnetLagS);
+         isPositive(watchdogS) && isNonNegative(magnetLagS) && isFraction(maxDriveLevel) &&
+         isPositive(heatTimeConstantS) && isFraction(heatRatedDuty);
 }
 
 }  // namespace kf

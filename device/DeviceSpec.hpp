@@ -16,8 +16,14 @@ struct DeviceSpec {
   double tactileLatencyS = 0.0024;
   double forceFramePeriodS = 0.001;   // 1 kHz force frames
   double maxForceSlewNPerS = 2000.0;  // 1.26 N in 0.63 ms
-  double watchdogS = 0.05;            // no frame for this long -> magnet off (minForceN)
+  double watchdogS = 0.01;            // no frame for this long -> magnet off (minForceN)
   double magnetLagS = 0.0024;         // sim: first-order lag of the magnet's force
+  // The coil: a hard limit on the drive level (0..1 of full-scale current), and a first-order
+  // heat estimate (mean of drive^2 over heatTimeConstantS) that derates the drive towards
+  // sqrt(heatRatedDuty) when it reaches heatRatedDuty, the drive^2 the coil takes for ever.
+  double maxDriveLevel = 1.0;
+  double heatTimeConstantS = 30.0;
+  double heatRatedDuty = 0.5;
 
   // maxCounts * countMm * updateRate: 334 mm/s for the paper profile.
   double maxSpeedMmPerS() const { return maxCountsPerReport * countMm * updateRateHz; }
