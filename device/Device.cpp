@@ -105,8 +105,10 @@ int Device::releaseFramesLocked(double nowS) {
   while (pendingCount_ > 0) {
     const PendingFrame& pending = pending_[pendingHead_];
     const double dueS = pending.startS + releaseLatencyS_;
-    if (dueS > nowS) break;
-    telemetry_.frameOffset.record(nowS - dueS);
+    // The pump nearest the due time releases it: due times on the pump grid would otherwise
+    // split between two pumps at the slightest wake-up jitter.
+    if (dueS > nowS + 0.5 * options_.pumpPeriodS) break;
+    telemetry_.frameOffset.record(std::abs(nowS - dueS));
     if (nowS - dueS > periodS) telemetry_.countLateFrame();
     applyFrameLocked(pending.frame, nowS, nowS);
     pendingHead_ = (pendingHead_ + 1) % pending_.size();

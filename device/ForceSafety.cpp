@@ -26,6 +26,10 @@ float ForceSafety::applyFrame(const ForceFrame& frame, double arrivalS) {
   double targetN = frame.forceN;
   if (!std::isfinite(targetN)) targetN = minN;
   targetN = std::clamp(targetN, minN, maxN);
+  // The float forms of the limits are the limits (0.14f is a little more than 0.14): so the
+  // minimum is drive 0 exactly, the maximum full drive.
+  if (targetN <= static_cast<float>(minN)) targetN = minN;
+  if (targetN >= static_cast<float>(maxN)) targetN = maxN;
 
   // 3: slew.
   double elapsedS = spec_.forceFramePeriodS;

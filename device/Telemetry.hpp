@@ -25,7 +25,7 @@ struct TelemetrySnapshot {
   LatencySummary reportLatency;  // realtime: device thread takes a report -> a UGen takes it
   LatencySummary forceLatency;   // realtime: a frame's millisecond ends -> the magnet is told
   // Realtime jitter buffer: pumps, while frames flow, that released 0, 1, 2 or 3+ frames (one
-  // per 1 ms pump is the goal); how long after its due time (start + latency) each frame went
+  // per 1 ms pump is the goal); how far from its due time (start + latency) each frame went
   // out; the release latency now; frames released later than one period after due.
   uint64_t framesPerPump[4] = {0, 0, 0, 0};
   LatencySummary frameOffset;
