@@ -132,7 +132,7 @@ bool publishStage(World* world, void* raw) {  // RT
 }
 
 bool deletePreviousStage(World*, void* raw) {  // NRT
-  delete static_cast<CommandData*>(raw)->previous;
+  kf::sc::deleteRetired(static_cast<CommandData*>(raw)->previous);
   return true;
 }
 
