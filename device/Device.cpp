@@ -62,6 +62,7 @@ void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double n
   const float commandedN = safety_.applyFrame(frame, nowS);
   if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
   force_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  if (board_) board_->commandDrive(commandS, commandedN, safety_.driveLevel());
   telemetry_.countFrame(commandedN);
   recorder_.writeFrame(nowS, frame, commandedN);
 }
@@ -137,6 +138,7 @@ void Device::pumpLocked(double nowS) {
   // long audio period does not make the watchdog chatter.
   if (pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
     force_->driveOff();
+    if (board_) board_->driveOff();
     telemetry_.countWatchdogTrip();
     telemetry_.setCommandedForce(safety_.commandedForceN());
     recorder_.writeOff(nowS);
@@ -165,6 +167,7 @@ void Device::close() {
   if (thread_.joinable()) thread_.join();
   std::lock_guard<std::mutex> lock(stateMutex_);
   force_->driveOff();
+  if (board_) board_->driveOff();
   safety_.resetToOff();
   pendingCount_ = 0;
   telemetry_.setCommandedForce(safety_.commandedForceN());
@@ -199,6 +202,19 @@ bool Device::pushForceFrame(const ForceFrame& frame) {
     }
   }
   return frameQueue_.push(frame);
+}
+
+std::shared_ptr<ForceBackend> Device::attachBoard(std::shared_ptr<ForceBackend> board) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  if (board_) board_->driveOff();
+  if (board && !isClosed()) board->driveOff();  // from off; the next frame drives it
+  std::swap(board_, board);
+  return board;
+}
+
+std::shared_ptr<ForceBackend> Device::board() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return board_;
 }
 
 void Device::setCalibration(const CalibrationTable& table) {

@@ -82,6 +82,11 @@ class Device {
   // From a non-realtime thread. Starts a kf-session file with the spec in its header.
   bool startRecording(const std::string& path, std::string& error);
   void stopRecording();
+  // From a non-realtime thread: an extra force backend (the friction board) that gets every
+  // command and drive-off the device's own backend gets, from the next frame on. Null
+  // detaches the board, after driving it off. Returns the board attached before.
+  std::shared_ptr<ForceBackend> attachBoard(std::shared_ptr<ForceBackend> board);
+  std::shared_ptr<ForceBackend> board();
   // From a non-realtime thread: the board's calibration table for the force path.
   void setCalibration(const CalibrationTable& table);
   // Frames the hard drive limit or the heat estimate lowered, and the heat estimate now.
@@ -114,6 +119,7 @@ class Device {
   const DeviceOptions options_;
   std::shared_ptr<MouseBackend> mouse_;
   std::shared_ptr<ForceBackend> force_;
+  std::shared_ptr<ForceBackend> board_;  // under stateMutex_
   SpscQueue<MouseReport> reportQueue_;
   SpscQueue<ForceFrame> frameQueue_;
   Telemetry telemetry_;

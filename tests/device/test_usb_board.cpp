@@ -7,6 +7,8 @@
 
 #include "BoardEmulator.hpp"
 #include "EmulatedUsb.hpp"
+#include "Device.hpp"
+#include "ReplayBackend.hpp"
 #include "UsbBoardBackend.hpp"
 
 using namespace kf;
@@ -261,4 +263,45 @@ TEST_CASE("the real libusb opens, finds no board and says so", "[board][libusb]"
   std::printf("real libusb: %s\n", error.c_str());
   backend.close();
   CHECK_FALSE(backend.telemetry().connected);
+}
+
+TEST_CASE("a device with the board: frames drive it, the watchdog and close turn it off", "[board]") {
+  auto bus = EmulatedUsb::create();
+  std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
+  std::string error;
+  REQUIRE(board->arm(error));
+  const DeviceSpec spec;
+  auto device = std::make_unique<Device>(spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
+                                         std::make_shared<CountingForceSink>(), false);
+  device->start();
+  REQUIRE(device->attachBoard(board) == nullptr);
+  // 200 ms of 1.4 N frames at 1 kHz, as FrictionOut stamps them.
+  const double startS = device->nowS();
+  for (int i = 0; i < 200; ++i) {
+    const double frameS = startS + i * 0.001;
+    while (device->nowS() < frameS + 0.001) std::this_thread::sleep_for(100us);
+    device->pushForceFrame({frameS, 1.4f, frameS + 0.001});
+  }
+  const double lastPushBusS = bus->nowS();
+  CHECK(waitFor([&] { return bus->drive() == kDriveFull; }));
+  // Frames stop: the device's 10 ms watchdog drives the board off (before the board's own 20 ms).
+  REQUIRE(waitFor([&] { return bus->drive() == 0; }));
+  const auto timeline = bus->timeline();
+  const double offS = bus->timeline().back().timeS;
+  std::printf("device + board: current off %.2f ms after the last frame was pushed (%s)\n",
+              (offS - lastPushBusS) * 1e3, timeline.back().why);
+  CHECK(std::string(timeline.back().why) == "set-point");  // a zero set-point, not the board's watchdog
+  CHECK(offS - lastPushBusS < 0.030);
+  CHECK(device->telemetry().watchdogTrips == 1);
+  // Close: the board is driven off, disarmed, released when the device lets go of it.
+  device->pushForceFrame({device->nowS(), 1.4f, device->nowS()});
+  CHECK(waitFor([&] { return bus->drive() == kDriveFull; }));
+  board.reset();
+  const double closeS = bus->nowS();
+  device->close();
+  CHECK(waitFor([&] { return bus->drive() == 0; }));  // with the next set-point
+  CHECK(bus->timeline().back().timeS - closeS < 0.010);
+  device.reset();
+  CHECK(bus->state() == BoardState::kDisarmed);
+  CHECK_FALSE(bus->isOpen());
 }
