@@ -15,6 +15,7 @@
 #include <string>
 
 #include "AudioClock.hpp"
+#include "BoardStatus.hpp"
 #include "DeviceFactory.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
@@ -260,6 +261,16 @@ bool statusStage(World*, void* raw) {  // NRT
   line("loop period", t.pumpPeriod);
   line("report to UGen", t.reportLatency);
   line("force to magnet", t.forceLatency);
+  const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
+  if (pumps > 0)
+    Print(
+        "kfStatus %d: frames per 1 ms pump 0/1/2/3+: %.3f/%.3f/%.3f/%.3f, from due time p50 %.3f ms p99 %.3f ms max "
+        "%.3f ms, release latency %.2f ms, late %llu\n",
+        data->index, t.framesPerPump[0] / double(pumps), t.framesPerPump[1] / double(pumps),
+        t.framesPerPump[2] / double(pumps), t.framesPerPump[3] / double(pumps), t.frameOffset.p50S * 1e3,
+        t.frameOffset.p99S * 1e3, t.frameOffset.maxS * 1e3, t.releaseLatencyS * 1e3,
+        static_cast<unsigned long long>(t.lateFrames));
+  kf::sc::postBoardStatus(data->index, *data->device);
   return true;
 }
 

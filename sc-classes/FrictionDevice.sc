@@ -12,12 +12,13 @@ FrictionDevice {
 			countMm: \countMm, updateRate: \updateRateHz, maxCountsPerReport: \maxCountsPerReport,
 			minForce: \minForceN, maxForce: \maxForceN, audioLatency: \audioLatencyS,
 			tactileLatency: \tactileLatencyS, forceFramePeriod: \forceFramePeriodS,
-			maxForceSlew: \maxForceSlewNPerS, watchdog: \watchdogS, magnetLag: \magnetLagS
+			maxForceSlew: \maxForceSlewNPerS, watchdog: \watchdogS, magnetLag: \magnetLagS,
+			maxDrive: \maxDriveLevel, heatTimeConstant: \heatTimeConstantS, heatRatedDuty: \heatRatedDuty
 		);
 		paperSpecs = (
 			countMm: 0.021, updateRate: 125, maxCountsPerReport: 127, minForce: 0.14, maxForce: 1.4,
 			audioLatency: 0.0014, tactileLatency: 0.0024, forceFramePeriod: 0.001, maxForceSlew: 2000,
-			watchdog: 0.05, magnetLag: 0.0024
+			watchdog: 0.01, magnetLag: 0.0024, maxDrive: 1, heatTimeConstant: 30, heatRatedDuty: 0.5
 		);
 		paperSpecs[\maxSpeed] = this.maxSpeedOf(paperSpecs);
 	}
@@ -64,6 +65,41 @@ FrictionDevice {
 	// Posts the device thread's telemetry in the server's output.
 	status { this.prSend(this.statusMsg) }
 	statusMsg { ^['/cmd', \kfStatus, index] }
+
+	// The friction board (device/PROTOCOL.md), added to this device: every force frame goes to
+	// it too, through the calibration. serial: nil for the first board found; emulate: true for
+	// the board emulator (no hardware needed). The board starts disarmed.
+	addBoard { |serial, emulate = false, inFlight = 2| this.prSend(this.addBoardMsg(serial, emulate, inFlight)) }
+	addBoardMsg { |serial, emulate = false, inFlight = 2|
+		if(serial.notNil and: { serial.isString.not and: { serial.isKindOf(Symbol).not } }) {
+			Error("FrictionDevice.addBoard: serial must be a String or nil, got %".format(serial)).throw
+		};
+		if(inFlight.isInteger.not or: { inFlight < 1 or: { inFlight > 4 } }) {
+			Error("FrictionDevice.addBoard: inFlight must be an Integer from 1 to 4, got %".format(inFlight)).throw
+		};
+		^['/cmd', \kfBoardOpen, index, (serial ? "").asString, emulate.binaryValue, inFlight]
+	}
+	// The magnet is driven only while the board is armed.
+	arm { this.prSend(this.armMsg) }
+	armMsg { ^['/cmd', \kfBoardArm, index, 1] }
+	disarm { this.prSend(this.disarmMsg) }
+	disarmMsg { ^['/cmd', \kfBoardArm, index, 0] }
+	// calibration: a FrictionCalibration (written to a file first) or a path; nil: linear.
+	calibrate { |calibration| this.prSend(this.calibrateMsg(calibration)) }
+	calibrateMsg { |calibration|
+		var path = calibration;
+		if(calibration.isKindOf(FrictionCalibration)) {
+			path = calibration.path ?? {
+				Error("FrictionDevice.calibrate: write the FrictionCalibration to a file first").throw
+			}
+		};
+		if(path.notNil and: { path.isString.not }) {
+			Error("FrictionDevice.calibrate: give a FrictionCalibration, a path or nil, got %".format(calibration)).throw
+		};
+		^['/cmd', \kfBoardCalibrate, index, path !? { path.standardizePath } ? ""]
+	}
+	removeBoard { this.prSend(this.removeBoardMsg) }
+	removeBoardMsg { ^['/cmd', \kfBoardClose, index] }
 
 	close { this.prSend(this.closeMsg) }
 	closeMsg { ^['/cmd', \kfClose, index] }
