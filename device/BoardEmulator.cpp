@@ -81,8 +81,8 @@ Status BoardEmulator::status(double nowS) {
   return status;
 }
 
-usb::Result BoardEmulator::control(uint8_t requestType, uint8_t request, uint16_t value, uint8_t* data,
-                                   uint16_t length, int* transferred, double nowS) {
+usb::Result BoardEmulator::control(uint8_t requestType, uint8_t request, uint16_t value, uint8_t* data, uint16_t length,
+                                   int* transferred, double nowS) {
   advance(nowS);
   if (transferred != nullptr) *transferred = 0;
   const bool in = (requestType & 0x80) != 0;

@@ -17,7 +17,7 @@ constexpr uint16_t kProductId = 0x0001;
 constexpr uint8_t kProtocolMajor = 1;  // a host refuses a board of another major version
 constexpr uint8_t kProtocolMinor = 0;
 
-constexpr int kInterfaceNumber = 0;      // bInterfaceClass 0xFF (vendor specific)
+constexpr int kInterfaceNumber = 0;          // bInterfaceClass 0xFF (vendor specific)
 constexpr uint8_t kSetPointEndpoint = 0x01;  // interrupt OUT, bInterval 1 (1 ms, full speed)
 constexpr uint8_t kStatusEndpoint = 0x81;    // interrupt IN, bInterval 1
 constexpr double kBoardWatchdogS = 0.020;    // the board: no valid set-point this long -> off
@@ -38,14 +38,14 @@ enum class BoardState : uint8_t { kDisarmed = 0, kArmed = 1, kFault = 2 };
 
 // Error flags of the status frame; latched until kClearErrors, except the live ones noted.
 enum ErrorFlag : uint16_t {
-  kErrWatchdog = 1u << 0,        // no valid set-point for kBoardWatchdogS: current was turned off
-  kErrBadFrame = 1u << 1,        // a set-point failed its length, type or CRC check
-  kErrStaleSequence = 1u << 2,   // a set-point's sequence was not newer than the last one
-  kErrOverTemperature = 1u << 3, // live: coil or driver too hot; drive limited to 0 until cool
-  kErrOverCurrent = 1u << 4,     // the current exceeded its limit; board went to kFault
-  kErrSupply = 1u << 5,          // coil supply below its minimum
-  kErrUsbReset = 1u << 6,        // a bus reset or suspend disarmed the board
-  kErrSequenceGap = 1u << 7,     // set-points were lost (a sequence jumped by more than 1)
+  kErrWatchdog = 1u << 0,         // no valid set-point for kBoardWatchdogS: current was turned off
+  kErrBadFrame = 1u << 1,         // a set-point failed its length, type or CRC check
+  kErrStaleSequence = 1u << 2,    // a set-point's sequence was not newer than the last one
+  kErrOverTemperature = 1u << 3,  // live: coil or driver too hot; drive limited to 0 until cool
+  kErrOverCurrent = 1u << 4,      // the current exceeded its limit; board went to kFault
+  kErrSupply = 1u << 5,           // coil supply below its minimum
+  kErrUsbReset = 1u << 6,         // a bus reset or suspend disarmed the board
+  kErrSequenceGap = 1u << 7,      // set-points were lost (a sequence jumped by more than 1)
 };
 
 constexpr size_t kSetPointSize = 8;
@@ -61,13 +61,13 @@ struct SetPoint {
 
 struct Status {
   BoardState state = BoardState::kDisarmed;
-  uint16_t lastSequence = 0;    // of the last set-point the board applied
-  uint16_t currentDrive = 0;    // measured coil current, in drive units
+  uint16_t lastSequence = 0;      // of the last set-point the board applied
+  uint16_t currentDrive = 0;      // measured coil current, in drive units
   int16_t temperatureCentiC = 0;  // driver/coil temperature, 0.01 degC
-  uint16_t errors = 0;          // ErrorFlag bits
-  uint16_t framesReceived = 0;  // valid set-points, wraps
-  uint8_t framesRejected = 0;   // bad or stale set-points, wraps
-  uint8_t tickMs = 0;           // the board's 1 ms counter, wraps: orders status frames
+  uint16_t errors = 0;            // ErrorFlag bits
+  uint16_t framesReceived = 0;    // valid set-points, wraps
+  uint8_t framesRejected = 0;     // bad or stale set-points, wraps
+  uint8_t tickMs = 0;             // the board's 1 ms counter, wraps: orders status frames
 };
 
 struct VersionReply {

@@ -44,9 +44,8 @@ bool CalibrationTable::fromPoints(std::vector<CalibrationPoint> points, Calibrat
       return false;
     }
     if (i > 0 && p.forceN < points[i - 1].forceN) {
-      std::snprintf(message, sizeof message,
-                    "not monotone: point %zu has %g N at drive %g, less than %g N at drive %g", i + 1, p.forceN,
-                    p.drive, points[i - 1].forceN, points[i - 1].drive);
+      std::snprintf(message, sizeof message, "not monotone: point %zu has %g N at drive %g, less than %g N at drive %g",
+                    i + 1, p.forceN, p.drive, points[i - 1].forceN, points[i - 1].drive);
       error = message;
       return false;
     }

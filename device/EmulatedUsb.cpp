@@ -7,9 +7,7 @@
 namespace kf::board {
 
 namespace {
-double steadyS() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 constexpr double kFrameS = 0.001;
 }  // namespace
 

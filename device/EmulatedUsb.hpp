@@ -29,10 +29,10 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void replug();
   void setDenyAccess(bool deny);
   void setRefuseArm(bool refuse);
-  void timeOutNextOut(int count);   // these OUT transfers are never taken: kTimedOut
-  void partialNextOut(int count);   // only 4 of 8 bytes arrive (the board rejects them)
-  void partialNextIn(int count);    // short status transfers
-  void stallOut();                  // EP 0x01 halts until the host clears it
+  void timeOutNextOut(int count);  // these OUT transfers are never taken: kTimedOut
+  void partialNextOut(int count);  // only 4 of 8 bytes arrive (the board rejects them)
+  void partialNextIn(int count);   // short status transfers
+  void stallOut();                 // EP 0x01 halts until the host clears it
 
   // What the board did (copies, under the lock).
   std::vector<BoardEmulator::Change> timeline();

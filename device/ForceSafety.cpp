@@ -59,8 +59,7 @@ float ForceSafety::applyFrame(const ForceFrame& frame, double arrivalS) {
   }
   driveLevel_ = static_cast<float>(std::clamp(limitedDrive, 0.0, 1.0));
   // The float rounding of a clamped value must not leave the range.
-  commandedForceN_ =
-      std::clamp(static_cast<float>(commandedN), static_cast<float>(minN), static_cast<float>(maxN));
+  commandedForceN_ = std::clamp(static_cast<float>(commandedN), static_cast<float>(minN), static_cast<float>(maxN));
 
   if (std::isfinite(frame.timeS)) lastFrameTimeS_ = frame.timeS;
   lastArrivalS_ = arrivalS;

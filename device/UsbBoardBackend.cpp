@@ -13,9 +13,7 @@ constexpr uint8_t kVendorOut = 0x41;  // vendor, interface, host to device
 constexpr uint8_t kVendorIn = 0xC1;
 constexpr unsigned kControlTimeoutMs = 200;
 
-double steadyS() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 std::string idsText(const usb::DeviceIds& ids) {
   char text[80];
@@ -35,8 +33,8 @@ UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions o
   zeroTransfer_.length = board::kSetPointSize;
   statusTransfer_.endpoint = board::kStatusEndpoint;
   statusTransfer_.length = board::kStatusSize;
-  for (usb::Transfer* transfer : {&outTransfers_[0], &outTransfers_[1], &outTransfers_[2], &outTransfers_[3],
-                                  &statusTransfer_, &zeroTransfer_}) {
+  for (usb::Transfer* transfer :
+       {&outTransfers_[0], &outTransfers_[1], &outTransfers_[2], &outTransfers_[3], &statusTransfer_, &zeroTransfer_}) {
     transfer->timeoutMs = options_.transferTimeoutMs;
     transfer->callback = &UsbBoardBackend::onTransfer;
     transfer->user = this;

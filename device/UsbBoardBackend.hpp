@@ -27,7 +27,7 @@ struct BoardOptions {
   usb::DeviceIds ids{board::kVendorId, board::kProductId, ""};
   int transfersInFlight = 2;  // set-points queued on EP 0x01 (1..4): each ~1 ms of latency
   unsigned transferTimeoutMs = 20;
-  double reopenPeriodS = 0.25;  // after an unplug, how often to look for the board
+  double reopenPeriodS = 0.25;   // after an unplug, how often to look for the board
   double lateTransferS = 0.002;  // a set-point completing later than this after the previous
   // commandForce (no drive given): the linear map of an uncalibrated board.
   double minForceN = 0.14;
@@ -44,9 +44,9 @@ struct BoardTelemetry {
   std::string lastError;
   uint16_t lastSequenceSent = 0;
   uint16_t lastDriveSent = 0;
-  uint64_t setPointsSent = 0;   // completed OUT transfers
-  uint64_t lateTransfers = 0;   // completed later than lateTransferS after the previous one
-  uint64_t lostTransfers = 0;   // timed out, partial or failed
+  uint64_t setPointsSent = 0;  // completed OUT transfers
+  uint64_t lateTransfers = 0;  // completed later than lateTransferS after the previous one
+  uint64_t lostTransfers = 0;  // timed out, partial or failed
   uint64_t timeouts = 0;
   uint64_t partials = 0;
   uint64_t stalls = 0;

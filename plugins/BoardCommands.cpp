@@ -25,8 +25,8 @@ constexpr int kMaxTextChars = 1024;
 struct BoardCommand {
   const char* name;
   int index;
-  int flag;       // emulate (open), arm (arm)
-  int inFlight;   // open
+  int flag;                  // emulate (open), arm (arm)
+  int inFlight;              // open
   char text[kMaxTextChars];  // serial or path
   kf::Device* device;
 };
@@ -69,8 +69,7 @@ bool lookUpDeviceStage(World*, void* raw) {  // RT
 }
 
 void run(World* world, void* replyAddr, BoardCommand* data, AsyncStageFn stage4) {
-  DoAsynchronousCommand(world, replyAddr, data->name, data, nrtHop, lookUpDeviceStage, stage4, freeCommand, 0,
-                        nullptr);
+  DoAsynchronousCommand(world, replyAddr, data->name, data, nrtHop, lookUpDeviceStage, stage4, freeCommand, 0, nullptr);
 }
 
 bool haveDevice(const BoardCommand* data) {
@@ -198,8 +197,8 @@ void postBoardStatus(int index, Device& device) {
   const BoardTelemetry t = board->telemetry();
   const board::Status& s = t.status;
   auto count = [](uint64_t value) { return static_cast<unsigned long long>(value); };
-  Print("kfStatus %d: board %s %s, %s; board state %s, current %.3f of full scale, %.2f degC, errors 0x%04x%s\n",
-        index, t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED", t.armed ? "armed" : "disarmed",
+  Print("kfStatus %d: board %s %s, %s; board state %s, current %.3f of full scale, %.2f degC, errors 0x%04x%s\n", index,
+        t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED", t.armed ? "armed" : "disarmed",
         !t.haveStatus                             ? "unknown"
         : s.state == board::BoardState::kArmed    ? "armed"
         : s.state == board::BoardState::kDisarmed ? "disarmed"

@@ -47,7 +47,7 @@ TEST_CASE("server exit closes open devices and those whose close has not finishe
     kf::sc::exchangeSlot(6, nullptr);  // kfClose's RT stage ran, its NRT stage (delete) did not
     kf::sc::exchangeSlot(7, newDevice(fds[1], 'c'));
     kf::sc::deleteRetired(kf::sc::exchangeSlot(7, nullptr));  // a close that finished: 'c' now
-    std::exit(0);  // static destructors: the exit hook
+    std::exit(0);                                             // static destructors: the exit hook
   }
   close(fds[1]);
   std::string offs;

@@ -58,8 +58,8 @@ double median(std::vector<double> values) {
 
 void print(const char* name, const StreamResult& r) {
   const TelemetrySnapshot& t = r.telemetry;
-  const double pumps = static_cast<double>(t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] +
-                                           t.framesPerPump[3]);
+  const double pumps =
+      static_cast<double>(t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3]);
   std::printf(
       "%s: %d frames; pumps releasing 0/1/2/3+ frames: %.3f/%.3f/%.3f/%.3f; offset from due p50 %.3f ms p99 %.3f ms "
       "max %.3f ms; release latency %.2f ms; late %llu; watchdog trips %llu\n",
@@ -86,8 +86,8 @@ TEST_CASE("realtime frames leave one per ms at their own time with 64-sample blo
   for (size_t j = 1; j < commands.size(); ++j) gaps.push_back(commands[j].timeS - commands[j - 1].timeS);
   CHECK(median(gaps) == Approx(0.001).margin(0.0002));
   const TelemetrySnapshot& t = r.telemetry;
-  const double pumps = static_cast<double>(t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] +
-                                           t.framesPerPump[3]);
+  const double pumps =
+      static_cast<double>(t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3]);
   CHECK(t.framesPerPump[1] / pumps > 0.7);
   // Each left within a pump period of its due time (start + latency), mostly.
   CHECK(t.frameOffset.p50S < 0.001);

@@ -6,8 +6,8 @@
 #include <thread>
 
 #include "BoardEmulator.hpp"
-#include "EmulatedUsb.hpp"
 #include "Device.hpp"
+#include "EmulatedUsb.hpp"
 #include "ReplayBackend.hpp"
 #include "UsbBoardBackend.hpp"
 
@@ -288,8 +288,8 @@ TEST_CASE("a device with the board: frames drive it, the watchdog and close turn
   REQUIRE(waitFor([&] { return bus->drive() == 0; }));
   const auto timeline = bus->timeline();
   const double offS = bus->timeline().back().timeS;
-  std::printf("device + board: current off %.2f ms after the last frame was pushed (%s)\n",
-              (offS - lastPushBusS) * 1e3, timeline.back().why);
+  std::printf("device + board: current off %.2f ms after the last frame was pushed (%s)\n", (offS - lastPushBusS) * 1e3,
+              timeline.back().why);
   CHECK(std::string(timeline.back().why) == "set-point");  // a zero set-point, not the board's watchdog
   CHECK(offS - lastPushBusS < 0.030);
   CHECK(device->telemetry().watchdogTrips == 1);
