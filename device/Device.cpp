@@ -26,7 +26,7 @@ Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std:
 Device::~Device() { close(); }
 
 void Device::start() {
-  if (lockstep_ || thread_.joinable() || isClosed()) return;
+  if (lockstep_ || options_.externalPump || thread_.joinable() || isClosed()) return;
   stopRequested_.store(false);
   startTime_ = std::chrono::steady_clock::now();
   thread_ = std::thread([this] { threadMain(); });
@@ -51,6 +51,11 @@ void Device::threadMain() {
 }
 
 void Device::pump(double nowS) {
+  if (options_.externalPump && !lockstep_ && !isClosed()) {
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    pumpLocked(nowS);
+    return;
+  }
   if (!lockstep_ || isClosed()) return;
   // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
   std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
@@ -87,7 +92,7 @@ void Device::takeFramesLocked(double nowS) {
     // A frame later than the latency allows raises it, so the frames after it keep their
     // spacing instead of going out in a burst (a long audio period).
     const double latenessS = nowS - startS;
-    if (latenessS > releaseLatencyS_) releaseLatencyS_ = std::min(latenessS + 0.5 * periodS, options_.maxForceLatencyS);
+    if (latenessS > releaseLatencyS_) releaseLatencyS_ = std::min(latenessS, options_.maxForceLatencyS);
     if (pendingCount_ == pending_.size()) {
       // Full: the oldest goes out now rather than being lost.
       applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);
@@ -129,9 +134,6 @@ void Device::pumpLocked(double nowS) {
     takeFramesLocked(nowS);
     const int released = releaseFramesLocked(nowS);
     if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
-    // Back towards the configured latency, slowly: 0.1 ms per second.
-    if (lastPumpS_ >= 0.0 && releaseLatencyS_ > options_.forceLatencyS)
-      releaseLatencyS_ = std::max(options_.forceLatencyS, releaseLatencyS_ - 0.1 * (nowS - lastPumpS_));
     telemetry_.setReleaseLatency(releaseLatencyS_);
   }
   // Frames still waiting in the jitter buffer are coming: no trip while there are any, so a
@@ -186,7 +188,7 @@ int Device::popReports(MouseReport* out, int capacity) {
 }
 
 double Device::nowS() const {
-  if (lockstep_) return lastPumpAtomicS_.load(std::memory_order_relaxed);
+  if (lockstep_ || options_.externalPump) return lastPumpAtomicS_.load(std::memory_order_relaxed);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - startTime_).count();
 }
 

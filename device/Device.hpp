@@ -30,10 +30,14 @@ struct DeviceOptions {
   double pumpPeriodS = 0.001;         // realtime: how often the thread pumps
   // Realtime: each force frame goes to the magnet at its own device time, its start plus this
   // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
-  // them. Frames that arrive later than that (a long audio period) raise the latency to their
-  // lateness, up to maxForceLatencyS; it then falls back by 0.1 ms a second.
+  // them. A frame that arrives later than that (a long audio period, a late audio thread)
+  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS, as long as
+  // the device is open: the frames after it keep their spacing instead of coming in bursts.
   double forceLatencyS = 0.002;
   double maxForceLatencyS = 0.1;
+  // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
+  // caller through pump(nowS) on a clock of its own (nowS() is the last pumped time).
+  bool externalPump = false;
 };
 
 class Device {
