@@ -7,6 +7,9 @@
 //   kfBoardArm       index arm                       1 arms, 0 disarms
 //   kfBoardCalibrate index path                      a kf-calibration file; "" = linear
 //   kfBoardClose     index                           drive 0, disarm, release, close
+//   kfBoardStatus    index                           replies /kfBoardStatus (to /notify clients):
+//                    index, then kBoardStatusFields values (BoardStatusField order)
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -22,6 +25,29 @@ namespace {
 
 constexpr int kMaxTextChars = 1024;
 
+// The values of a /kfBoardStatus reply, in order (sclang: FrictionDevice.boardStatusOf).
+enum BoardStatusField {
+  kHasBoard,
+  kConnected,
+  kArmed,
+  kBoardState,
+  kCurrent,
+  kTemperatureC,
+  kErrors,
+  kSetPointsSent,
+  kLate,
+  kLost,
+  kTimeouts,
+  kPartials,
+  kStalls,
+  kBadStatus,
+  kUnplugs,
+  kReopens,
+  kOnePerPump,
+  kOffsetP50S,
+  kBoardStatusFields
+};
+
 struct BoardCommand {
   const char* name;
   int index;
@@ -29,6 +55,7 @@ struct BoardCommand {
   int inFlight;              // open
   char text[kMaxTextChars];  // serial or path
   kf::Device* device;
+  float values[kBoardStatusFields];  // kfBoardStatus
 };
 
 BoardCommand* newCommand(World* world, const char* name, sc_msg_iter* args) {
@@ -43,6 +70,7 @@ BoardCommand* newCommand(World* world, const char* name, sc_msg_iter* args) {
   data->inFlight = 2;
   data->text[0] = '\0';
   data->device = nullptr;
+  std::fill_n(data->values, static_cast<int>(kBoardStatusFields), 0.0f);
   if (!kf::sc::isValidSlot(data->index)) {
     kf::sc::postFromRt(world, "%s: device index %d is out of range 0..%d\n", name, data->index,
                        kf::sc::kNumDeviceSlots - 1);
@@ -186,6 +214,57 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   run(world, replyAddr, data, closeStage);
 }
 
+// --- kfBoardStatus -------------------------------------------------------------------------
+
+bool collectStatusStage(World*, void* raw) {  // NRT
+  auto* data = static_cast<BoardCommand*>(raw);
+  std::fill_n(data->values, static_cast<int>(kBoardStatusFields), 0.0f);
+  if (data->device == nullptr) return true;  // replies all zeros: no device, no board
+  const kf::TelemetrySnapshot t = data->device->telemetry();
+  const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
+  data->values[kOnePerPump] = pumps > 0 ? static_cast<float>(t.framesPerPump[1] / double(pumps)) : 0.0f;
+  data->values[kOffsetP50S] = static_cast<float>(t.frameOffset.p50S);
+  const std::shared_ptr<kf::ForceBackend> holder = data->device->board();
+  const auto* board = dynamic_cast<const kf::UsbBoardBackend*>(holder.get());
+  if (board == nullptr) return true;
+  const kf::BoardTelemetry b = board->telemetry();
+  float* v = data->values;
+  v[kHasBoard] = 1.0f;
+  v[kConnected] = b.connected ? 1.0f : 0.0f;
+  v[kArmed] = b.armed ? 1.0f : 0.0f;
+  v[kBoardState] = b.haveStatus ? static_cast<float>(b.status.state) : -1.0f;
+  v[kCurrent] = static_cast<float>(b.status.currentDrive / double(kf::board::kDriveFull));
+  v[kTemperatureC] = static_cast<float>(b.status.temperatureCentiC / 100.0);
+  v[kErrors] = static_cast<float>(b.status.errors);
+  v[kSetPointsSent] = static_cast<float>(b.setPointsSent);
+  v[kLate] = static_cast<float>(b.lateTransfers);
+  v[kLost] = static_cast<float>(b.lostTransfers);
+  v[kTimeouts] = static_cast<float>(b.timeouts);
+  v[kPartials] = static_cast<float>(b.partials);
+  v[kStalls] = static_cast<float>(b.stalls);
+  v[kBadStatus] = static_cast<float>(b.badStatus);
+  v[kUnplugs] = static_cast<float>(b.unplugs);
+  v[kReopens] = static_cast<float>(b.reopens);
+  return true;
+}
+
+// RT, the last stage: the reply goes from the root group to every client that asked for
+// notifications (sclang's default), then the command is freed.
+void replyStatusAndFree(World* world, void* raw) {
+  auto* data = static_cast<BoardCommand*>(raw);
+  // The plugin headers do not define Group; the server's starts with its Node (SC_Group.h).
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->index, "/kfBoardStatus", kBoardStatusFields,
+                data->values);
+  RTFree(world, raw);
+}
+
+void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  BoardCommand* data = newCommand(world, "kfBoardStatus", args);
+  if (data == nullptr) return;
+  DoAsynchronousCommand(world, replyAddr, data->name, data, nrtHop, lookUpDeviceStage, collectStatusStage,
+                        replyStatusAndFree, 0, nullptr);
+}
+
 }  // namespace
 
 namespace kf::sc {
@@ -220,4 +299,5 @@ void registerBoardCommands() {
   DefinePlugInCmd("kfBoardArm", armCmd, nullptr);
   DefinePlugInCmd("kfBoardCalibrate", calibrateCmd, nullptr);
   DefinePlugInCmd("kfBoardClose", closeCmd, nullptr);
+  DefinePlugInCmd("kfBoardStatus", statusCmd, nullptr);
 }

@@ -98,6 +98,24 @@ FrictionDevice {
 		};
 		^['/cmd', \kfBoardCalibrate, index, path !? { path.standardizePath } ? ""]
 	}
+	// The board's and the frame timing's telemetry as an Event, passed to action (the reply
+	// goes to clients registered with /notify, as sclang is by default).
+	boardStatus { |action|
+		if(server.isNil) { ^this };
+		OSCFunc({ |msg| action.value(this.class.boardStatusOf(msg[3..])) }, '/kfBoardStatus', server.addr,
+			argTemplate: [nil, index]).oneShot;
+		this.prSend(this.boardStatusMsg)
+	}
+	boardStatusMsg { ^['/cmd', \kfBoardStatus, index] }
+	*boardStatusOf { |values|
+		var names = #[hasBoard, connected, armed, boardState, current, temperature, errors, setPointsSent, late,
+			lost, timeouts, partials, stalls, badStatus, unplugs, reopens, onePerPump, offsetP50];
+		var event = ();
+		names.do { |name, i| event[name] = values[i] };
+		#[hasBoard, connected, armed].do { |name| event[name] = event[name] == 1 };
+		event[\boardState] = [\disarmed, \armed, \fault][event[\boardState]] ? \unknown;
+		^event
+	}
 	removeBoard { this.prSend(this.removeBoardMsg) }
 	removeBoardMsg { ^['/cmd', \kfBoardClose, index] }
 

@@ -37,6 +37,11 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         dev.arm;
         0.3.wait;
         phase.(\\armed);
+        dev.boardStatus {{ |e|
+            ("KF-BOARD-STATUS " ++ [e.hasBoard, e.connected, e.armed, e.boardState, e.current.round(0.001),
+                                    e.setPointsSent > 100]).postln
+        }};
+        0.2.wait;
         FrictionCalibration([[0, 0.14], [0.25, 0.77], [1, 1.4]], "KF-EMU-0001").write({rt.sc_string(table)});
         dev.calibrate({rt.sc_string(table)});
         0.3.wait;
@@ -83,6 +88,11 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
     assert max(currents("calibrated")) == pytest.approx(0.25, abs=0.001)  # exact at a table point
     assert currents("freed") == [0.0] * 3, "synth freed: the device's watchdog drove the board off"
     assert got["removed"] == [], "no board after removeBoard"
+    # The same through the reply sclang gets (FrictionDevice.boardStatus).
+    replies = [l for l in lines if l.startswith("KF-BOARD-STATUS ")]
+    assert len(replies) == 1, run.output[-3000:]
+    assert replies[0].startswith("KF-BOARD-STATUS [ true, true, true, armed, "), replies
+    assert replies[0].endswith(", true ]") and (" 0.5," in replies[0] or " 0.0," in replies[0]), replies
     timing = [TIMING_LINE.match(l) for l in lines if TIMING_LINE.match(l)]
     assert timing, "kfStatus reports the frames per pump"
     print("\n".join(l for l in lines if l.startswith("kfStatus 5:")))
