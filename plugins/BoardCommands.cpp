@@ -270,6 +270,13 @@ void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 namespace kf::sc {
 
 void postBoardStatus(int index, Device& device) {
+  const uint64_t limited = device.driveLimitedFrames();
+  const double heat = device.heatEstimate();
+  if (limited > 0 || heat > 0.0)
+    Print(
+        "kfStatus %d: force path: drive-limited frames %llu, coil heat estimate at the last frame %.3f (derating from "
+        "%.3f)\n",
+        index, static_cast<unsigned long long>(limited), heat, 0.9 * device.spec().heatRatedDuty);
   const std::shared_ptr<ForceBackend> holder = device.board();
   const auto* board = dynamic_cast<const UsbBoardBackend*>(holder.get());
   if (board == nullptr) return;

@@ -7,7 +7,8 @@ class Device;
 
 namespace kf::sc {
 
-// NRT stage: posts the board's telemetry when the device has a board; nothing otherwise.
+// NRT stage: posts the force path's drive limiting and heat estimate (once there is any) and
+// the board's telemetry when the device has a board.
 void postBoardStatus(int index, Device& device);
 
 }  // namespace kf::sc

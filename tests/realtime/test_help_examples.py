@@ -82,6 +82,7 @@ files.do { |path|
 			if(code.stripWhiteSpace.beginsWith("// needs hardware")) {
 				"KF-HELP-SKIPPED-HARDWARE %% %%".format(path, b).postln;
 				pieces = [];
+				start = start - %(block_time)f;  // no time to wait for
 			};
 			pieces.do { |piece, p|
 				var fn = piece.compile;
