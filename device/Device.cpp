@@ -22,14 +22,17 @@ Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std:
       reportQueue_(options.reportQueueCapacity),
       frameQueue_(options.frameQueueCapacity),
       safety_(spec),
+      pending_(std::max<size_t>(options.frameQueueCapacity, 1)),
+      releaseLatencyS_(options.forceLatencyS),
       startTime_(std::chrono::steady_clock::now()) {
   telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
+  telemetry_.setReleaseLatency(releaseLatencyS_);
 }
 
 Device::~Device() { close(); }
 
 void Device::start() {
-  if (lockstep_ || thread_.joinable() || isClosed()) return;
+  if (lockstep_ || options_.externalPump || thread_.joinable() || isClosed()) return;
   stopRequested_.store(false);
   startTime_ = std::chrono::steady_clock::now();
   thread_ = std::thread([this] { threadMain(); });
@@ -65,8 +68,10 @@ void Device::failThread(const char* what) noexcept {
   // A backend threw: nothing pumps this device any more, so its magnet goes off now.
   try {
     force_->driveOff();
+    if (board_) board_->driveOff();
   } catch (...) {
     force_->driveOffFromSignal();
+    if (ForceBackend* board = board_.get()) board->driveOffFromSignal();
   }
   safety_.resetToOff();
   telemetry_.setCommandedForce(safety_.commandedForceN());
@@ -79,11 +84,77 @@ void Device::failThread(const char* what) noexcept {
 }
 
 void Device::pump(double nowS) {
+  if (options_.externalPump && !lockstep_ && !isClosed()) {
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    pumpLocked(nowS);
+    return;
+  }
   if (!lockstep_ || isClosed()) return;
   // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
   std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
   pumpLocked(nowS - lockstepOriginS_);
+}
+
+void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double nowS) {
+  const float commandedN = safety_.applyFrame(frame, nowS);
+  if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
+  force_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  if (board_) board_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  telemetry_.countFrame(commandedN);
+  recorder_.writeFrame(nowS, frame, commandedN);
+}
+
+void Device::applyLockstepFrameLocked(const ForceFrame& frame, double nowS) {
+  // Device and audio time are one clock, so the frame is stamped with its own time (never
+  // before an earlier command, never in the future); a backend that has already passed that
+  // time (the sim, pumped to the end of the block) applies it at once, as a realtime device
+  // would.
+  double commandS = nowS;
+  if (std::isfinite(frame.timeS)) commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
+  lastCommandS_ = commandS;
+  applyFrameLocked(frame, commandS, nowS);
+}
+
+void Device::takeFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  ForceFrame frame;
+  while (frameQueue_.pop(frame)) {
+    double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
+    if (!std::isfinite(startS)) startS = nowS;
+    // A frame later than the latency allows raises it, so the frames after it keep their
+    // spacing instead of going out in a burst (a long audio period).
+    const double latenessS = nowS - startS;
+    if (latenessS > releaseLatencyS_) releaseLatencyS_ = std::min(latenessS, options_.maxForceLatencyS);
+    if (pendingCount_ == pending_.size()) {
+      // Full: the oldest goes out now rather than being lost.
+      applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);
+      telemetry_.countLateFrame();
+      pendingHead_ = (pendingHead_ + 1) % pending_.size();
+      --pendingCount_;
+    }
+    pending_[(pendingHead_ + pendingCount_) % pending_.size()] = PendingFrame{frame, startS};
+    ++pendingCount_;
+  }
+}
+
+int Device::releaseFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  int released = 0;
+  while (pendingCount_ > 0) {
+    const PendingFrame& pending = pending_[pendingHead_];
+    const double dueS = pending.startS + releaseLatencyS_;
+    // The pump nearest the due time releases it: due times on the pump grid would otherwise
+    // split between two pumps at the slightest wake-up jitter.
+    if (dueS > nowS + 0.5 * options_.pumpPeriodS) break;
+    telemetry_.frameOffset.record(std::abs(nowS - dueS));
+    if (nowS - dueS > periodS) telemetry_.countLateFrame();
+    applyFrameLocked(pending.frame, nowS, nowS);
+    pendingHead_ = (pendingHead_ + 1) % pending_.size();
+    --pendingCount_;
+    ++released;
+  }
+  return released;
 }
 
 void Device::pumpLocked(double nowS) {
@@ -97,24 +168,20 @@ void Device::pumpLocked(double nowS) {
   if (halted_.load()) return;
   if (!(nowS > lastPumpS_)) return;
 
-  ForceFrame frame;
-  while (frameQueue_.pop(frame)) {
-    const float commandedN = safety_.applyFrame(frame, nowS);
-    if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
-    // Lockstep: device and audio time are one clock, so the frame is stamped with its own time
-    // (never before an earlier command, never in the future); a backend that has already
-    // passed that time (the sim, one block on) applies it at once, as a realtime device would.
-    // Realtime: now.
-    double commandS = nowS;
-    if (lockstep_ && std::isfinite(frame.timeS))
-      commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
-    lastCommandS_ = commandS;
-    force_->commandForce(commandS, commandedN);
-    telemetry_.countFrame(commandedN);
-    recorder_.writeFrame(nowS, frame, commandedN);
+  if (lockstep_) {
+    ForceFrame frame;  // only frames whose push found the state busy
+    while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
+  } else {
+    takeFramesLocked(nowS);
+    const int released = releaseFramesLocked(nowS);
+    if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
+    telemetry_.setReleaseLatency(releaseLatencyS_);
   }
-  if (safety_.checkWatchdog(nowS)) {
+  // Frames still waiting in the jitter buffer are coming: no trip while there are any, so a
+  // long audio period does not make the watchdog chatter.
+  if (pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
     force_->driveOff();
+    if (board_) board_->driveOff();
     telemetry_.countWatchdogTrip();
     telemetry_.setCommandedForce(safety_.commandedForceN());
     recorder_.writeOff(nowS);
@@ -143,7 +210,9 @@ void Device::close() {
   if (thread_.joinable()) thread_.join();
   std::lock_guard<std::mutex> lock(stateMutex_);
   force_->driveOff();
+  if (board_) board_->driveOff();
   safety_.resetToOff();
+  pendingCount_ = 0;
   telemetry_.setCommandedForce(safety_.commandedForceN());
   recorder_.writeOff(std::max(lastPumpS_, 0.0));
   recorder_.close();
@@ -160,11 +229,51 @@ int Device::popReports(MouseReport* out, int capacity) {
 }
 
 double Device::nowS() const {
-  if (lockstep_) return lastPumpAtomicS_.load(std::memory_order_relaxed);
+  if (lockstep_ || options_.externalPump) return lastPumpAtomicS_.load(std::memory_order_relaxed);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - startTime_).count();
 }
 
-bool Device::pushForceFrame(const ForceFrame& frame) { return frameQueue_.push(frame); }
+bool Device::pushForceFrame(const ForceFrame& frame) {
+  if (lockstep_ && !isClosed()) {
+    std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+    if (lock.owns_lock() && lastPumpS_ >= 0.0) {
+      // Lockstep has one thread for both ends of the queue: earlier frames first.
+      ForceFrame queued;
+      while (frameQueue_.pop(queued)) applyLockstepFrameLocked(queued, lastPumpS_);
+      applyLockstepFrameLocked(frame, lastPumpS_);
+      return true;
+    }
+  }
+  return frameQueue_.push(frame);
+}
+
+std::shared_ptr<ForceBackend> Device::attachBoard(std::shared_ptr<ForceBackend> board) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  if (board_) board_->driveOff();
+  if (board && !isClosed()) board->driveOff();  // from off; the next frame drives it
+  std::swap(board_, board);
+  return board;
+}
+
+std::shared_ptr<ForceBackend> Device::board() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return board_;
+}
+
+void Device::setCalibration(const CalibrationTable& table) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  safety_.setCalibration(table);
+}
+
+uint64_t Device::driveLimitedFrames() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.driveLimitedFrames();
+}
+
+double Device::heatEstimate() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.heat();
+}
 
 TelemetrySnapshot Device::telemetry() const {
   TelemetrySnapshot snapshot = telemetry_.snapshot();
@@ -204,6 +313,9 @@ void Device::emergencyOff() noexcept {
     if ((now.tv_sec - start.tv_sec) * 1e9 + (now.tv_nsec - start.tv_nsec) > 50e6) break;
   }
   force_->driveOffFromSignal();
+  // The board's off set-point is queued for its event thread; if the process dies first, the
+  // board's own watchdog turns the current off 20 ms after the last frame (PROTOCOL.md).
+  if (ForceBackend* board = board_.get()) board->driveOffFromSignal();
   telemetry_.setCommandedForce(static_cast<float>(spec_.minForceN));
   recorder_.appendOffFromSignal(nowS());
 }

@@ -10,7 +10,9 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include "CalibrationTable.hpp"
 #include "DeviceSpec.hpp"
 #include "ForceBackend.hpp"
 #include "ForceSafety.hpp"
@@ -26,6 +28,16 @@ struct DeviceOptions {
   size_t reportQueueCapacity = 1024;  // 8 s of 125 Hz reports
   size_t frameQueueCapacity = 1024;   // 1 s of 1 kHz frames
   double pumpPeriodS = 0.001;         // realtime: how often the thread pumps
+  // Realtime: each force frame goes to the magnet at its own device time, its start plus this
+  // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
+  // them. A frame that arrives later than that (a long audio period, a late audio thread)
+  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS, as long as
+  // the device is open: the frames after it keep their spacing instead of coming in bursts.
+  double forceLatencyS = 0.002;
+  double maxForceLatencyS = 0.1;
+  // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
+  // caller through pump(nowS) on a clock of its own (nowS() is the last pumped time).
+  bool externalPump = false;
 };
 
 class Device {
@@ -52,7 +64,12 @@ class Device {
   // Audio side (one consumer / one producer thread): never allocate, lock or wait.
   // popReports also measures, in realtime, how long each report waited in the queue.
   int popReports(MouseReport* out, int capacity);
+  // Realtime: queued for the device thread. Lockstep: the audio thread is the pumper, so the
+  // frame goes through the safety path at once (try_lock; queued when that fails), and
+  // commandedForceN() tells at once what it became.
   bool pushForceFrame(const ForceFrame& frame);
+  // The force last sent to the magnet after the safety path (watchdog trips and close too).
+  float commandedForceN() const { return telemetry_.commandedForceN(); }
   // The device clock: seconds since start() in realtime (steady clock, any thread, no lock);
   // in lockstep the last pumped time.
   double nowS() const;
@@ -78,16 +95,38 @@ class Device {
   // way out; nothing else is cleaned up.
   void emergencyOff() noexcept;
 
+  // From a non-realtime thread: an extra force backend (the friction board) that gets every
+  // command and drive-off the device's own backend gets, from the next frame on. Null
+  // detaches the board, after driving it off. Returns the board attached before.
+  std::shared_ptr<ForceBackend> attachBoard(std::shared_ptr<ForceBackend> board);
+  std::shared_ptr<ForceBackend> board();
+  // From a non-realtime thread: the board's calibration table for the force path.
+  void setCalibration(const CalibrationTable& table);
+  // Frames the hard drive limit or the heat estimate lowered, and the heat estimate now.
+  uint64_t driveLimitedFrames();
+  double heatEstimate();
+
   MouseBackend& mouseBackend() { return *mouse_; }
   ForceBackend& forceBackend() { return *force_; }
 
  private:
   static constexpr int kPollBatch = 64;
 
+  struct PendingFrame {
+    ForceFrame frame;
+    double startS;  // the frame's start on the device clock
+  };
+
   void pumpLocked(double nowS);
   void threadMain();
   // The device thread caught an exception from a backend: magnet off, recording closed.
   void failThread(const char* what) noexcept;
+  // One frame through ForceSafety to the backend, telemetry and recording.
+  void applyFrameLocked(const ForceFrame& frame, double commandS, double nowS);
+  void applyLockstepFrameLocked(const ForceFrame& frame, double nowS);
+  // Realtime jitter buffer: queue -> pending (with release times), then the due ones out.
+  void takeFramesLocked(double nowS);
+  int releaseFramesLocked(double nowS);
 
   const DeviceSpec spec_;
   const bool lockstep_;
@@ -95,6 +134,7 @@ class Device {
   const DeviceOptions options_;
   std::shared_ptr<MouseBackend> mouse_;
   std::shared_ptr<ForceBackend> force_;
+  std::shared_ptr<ForceBackend> board_;  // under stateMutex_
   SpscQueue<MouseReport> reportQueue_;
   SpscQueue<ForceFrame> frameQueue_;
   Telemetry telemetry_;
@@ -106,6 +146,10 @@ class Device {
   double lastPumpS_ = -1.0;
   double lastCommandS_ = 0.0;
   MouseReport pollBuffer_[kPollBatch];
+  std::vector<PendingFrame> pending_;  // ring, frameQueueCapacity
+  size_t pendingHead_ = 0;
+  size_t pendingCount_ = 0;
+  double releaseLatencyS_;
 
   std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
   std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads

@@ -23,6 +23,9 @@ constexpr Field kFields[] = {
     {"maxForceSlewNPerS", &DeviceSpec::maxForceSlewNPerS},
     {"watchdogS", &DeviceSpec::watchdogS},
     {"magnetLagS", &DeviceSpec::magnetLagS},
+    {"maxDriveLevel", &DeviceSpec::maxDriveLevel},
+    {"heatTimeConstantS", &DeviceSpec::heatTimeConstantS},
+    {"heatRatedDuty", &DeviceSpec::heatRatedDuty},
 };
 
 bool fail(std::string* error, std::string message) {

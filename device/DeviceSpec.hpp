@@ -22,6 +22,12 @@ struct DeviceSpec {
   double maxForceSlewNPerS = paper::device::maxForceSlewNPerS;  // 1.26 N in 0.63 ms
   double watchdogS = paper::device::watchdogS;                  // no frame for this long -> magnet off (minForceN)
   double magnetLagS = paper::device::magnetLagS;                // sim: first-order lag of the magnet's force
+  // The coil: a hard limit on the drive level (0..1 of full-scale current), and a first-order
+  // heat estimate (mean of drive^2 over heatTimeConstantS) that derates the drive towards
+  // sqrt(heatRatedDuty) when it reaches heatRatedDuty, the drive^2 the coil takes for ever.
+  double maxDriveLevel = paper::device::maxDriveLevel;
+  double heatTimeConstantS = paper::device::heatTimeConstantS;
+  double heatRatedDuty = paper::device::heatRatedDuty;
 
   // maxCounts * countMm * updateRate: 334 mm/s for the paper profile.
   double maxSpeedMmPerS() const { return maxCountsPerReport * countMm * updateRateHz; }

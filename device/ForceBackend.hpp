@@ -9,6 +9,9 @@ class ForceBackend {
   virtual ~ForceBackend() = default;
   // From device time `timeS` on, the magnet should produce `forceN` of kinetic friction.
   virtual void commandForce(double timeS, float forceN) = 0;
+  // The same command with its drive level (0..1 of full-scale current) after calibration and
+  // the drive limits: hardware uses the drive, models the force.
+  virtual void commandDrive(double timeS, float forceN, float /*driveLevel*/) { commandForce(timeS, forceN); }
   // Magnet off now (minimum friction): on close, watchdog trips, errors.
   virtual void driveOff() = 0;
   // Magnet off from a signal handler (SIGTERM, a crash): async-signal-safe only — no lock,

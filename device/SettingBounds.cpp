@@ -23,6 +23,9 @@ constexpr SettingBounds kBounds[] = {
     {"maxForceSlewNPerS", 0.01, 1e6, false, "N/s"},
     {"watchdogS", 0.002, 10.0, false, "s"},
     {"magnetLagS", 0.0, 1.0, false, "s"},
+    {"maxDriveLevel", 1e-3, 1.0, false, "of full-scale drive"},
+    {"heatTimeConstantS", 0.01, 1e5, false, "s"},
+    {"heatRatedDuty", 1e-3, 1.0, false, "of full-scale drive squared"},
     // SimParams
     {"handStiffnessNPerM", 0.0, 1e4, false, "N/m"},
     {"handDampingNSPerM", 0.0, 1e3, false, "N s/m"},

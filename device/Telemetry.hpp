@@ -24,6 +24,13 @@ struct TelemetrySnapshot {
   LatencySummary pumpPeriod;     // realtime: the 1 kHz loop's period
   LatencySummary reportLatency;  // realtime: device thread takes a report -> a UGen takes it
   LatencySummary forceLatency;   // realtime: a frame's millisecond ends -> the magnet is told
+  // Realtime jitter buffer: pumps, while frames flow, that released 0, 1, 2 or 3+ frames (one
+  // per 1 ms pump is the goal); how far from its due time (start + latency) each frame went
+  // out; the release latency now; frames released later than one period after due.
+  uint64_t framesPerPump[4] = {0, 0, 0, 0};
+  LatencySummary frameOffset;
+  double releaseLatencyS = 0.0;
+  uint64_t lateFrames = 0;
 };
 
 class Telemetry {
@@ -39,6 +46,13 @@ class Telemetry {
   LatencyHistogram pumpPeriod;
   LatencyHistogram reportLatency;
   LatencyHistogram forceLatency;
+  LatencyHistogram frameOffset;
+
+  // Device thread: one pump released `count` frames while frames were flowing.
+  void countReleases(int count) { framesPerPump_[count < 3 ? count : 3].fetch_add(1, std::memory_order_relaxed); }
+  void countLateFrame() { lateFrames_.fetch_add(1, std::memory_order_relaxed); }
+  void setReleaseLatency(double latencyS) { releaseLatencyS_.store(latencyS, std::memory_order_relaxed); }
+  float commandedForceN() const { return lastCommandedForceN_.load(std::memory_order_relaxed); }
 
   // Queue overflow counts live in the queues; Device fills them in.
   TelemetrySnapshot snapshot() const;
@@ -57,6 +71,9 @@ class Telemetry {
   std::atomic<uint64_t> watchdogTrips_{0};
   std::atomic<float> lastCommandedForceN_{0.0f};
   std::atomic<uint64_t> pumps_{0};
+  std::atomic<uint64_t> framesPerPump_[4] = {};
+  std::atomic<uint64_t> lateFrames_{0};
+  std::atomic<double> releaseLatencyS_{0.0};
 };
 
 inline void Telemetry::countReport(double deviceTimeS) {
@@ -90,6 +107,10 @@ inline TelemetrySnapshot Telemetry::snapshot() const {
   s.pumpPeriod = LatencySummary::of(pumpPeriod);
   s.reportLatency = LatencySummary::of(reportLatency);
   s.forceLatency = LatencySummary::of(forceLatency);
+  for (int i = 0; i < 4; ++i) s.framesPerPump[i] = framesPerPump_[i].load(std::memory_order_relaxed);
+  s.frameOffset = LatencySummary::of(frameOffset);
+  s.releaseLatencyS = releaseLatencyS_.load(std::memory_order_relaxed);
+  s.lateFrames = lateFrames_.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -44,6 +44,10 @@ class ForceFramer {
     return process(blockStartTimeS, sampleDurS, forceN, numSamples, commandedN, &ForceFramer::callSink<Sink>, &sink);
   }
 
+  // From inside a sink: the value shown in commandedN from the completing sample on is
+  // `forceN` (what the device really commanded) instead of the frame's mean.
+  void showCommanded(float forceN) { lastCommandedN_ = forceN; }
+
   double framePeriodS() const { return framePeriodS_; }
   float lastCommandedN() const { return lastCommandedN_; }
   int64_t framesEmitted() const { return framesEmitted_; }

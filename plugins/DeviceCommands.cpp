@@ -15,6 +15,7 @@
 #include <string>
 
 #include "AudioClock.hpp"
+#include "BoardStatus.hpp"
 #include "CommandArgs.hpp"
 #include "DeviceFactory.hpp"
 #include "DeviceMessages.hpp"
@@ -148,7 +149,7 @@ bool publishStage(World* world, void* raw) {  // RT
 }
 
 bool deletePreviousStage(World*, void* raw) {  // NRT
-  delete static_cast<CommandData*>(raw)->previous;
+  kf::sc::deleteRetired(static_cast<CommandData*>(raw)->previous);
   return true;
 }
 
@@ -261,6 +262,16 @@ bool statusStage(World*, void* raw) {  // NRT
   line("force to magnet", t.forceLatency);
   const std::string recordingError = data->device->recordingError();
   if (!recordingError.empty()) Print("kfStatus %d: recording failed: %s\n", data->args.index, recordingError.c_str());
+  const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
+  if (pumps > 0)
+    Print(
+        "kfStatus %d: frames per 1 ms pump 0/1/2/3+: %.3f/%.3f/%.3f/%.3f, from due time p50 %.3f ms p99 %.3f ms max "
+        "%.3f ms, release latency %.2f ms, late %llu\n",
+        data->args.index, t.framesPerPump[0] / double(pumps), t.framesPerPump[1] / double(pumps),
+        t.framesPerPump[2] / double(pumps), t.framesPerPump[3] / double(pumps), t.frameOffset.p50S * 1e3,
+        t.frameOffset.p99S * 1e3, t.frameOffset.maxS * 1e3, t.releaseLatencyS * 1e3,
+        static_cast<unsigned long long>(t.lateFrames));
+  kf::sc::postBoardStatus(data->args.index, *data->device);
   return true;
 }
 

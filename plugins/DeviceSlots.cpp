@@ -18,11 +18,28 @@ Slot gSlots[kNumDeviceSlots];
 // moved to another slot sees a new generation even if both slots were opened equally often.
 std::atomic<uint32_t> gNextGeneration{1};
 
+// Devices out of their slot and not deleted yet (see exchangeSlot). Whoever exchanges an entry
+// to null owns the device: the NRT stage or the exit hook, never both. With more in flight
+// than entries, a device goes untracked (and is only deleted by its NRT stage).
+constexpr int kRetiredCapacity = 64;
+std::atomic<Device*> gRetired[kRetiredCapacity];
+std::atomic<bool> gExiting{false};
+
+void retire(Device* device) {
+  if (device == nullptr) return;
+  for (std::atomic<Device*>& entry : gRetired) {
+    Device* expected = nullptr;
+    if (entry.compare_exchange_strong(expected, device, std::memory_order_acq_rel)) return;
+  }
+}
+
 // Closes every device left open when scsynth exits, so no magnet stays on: joins the device
-// threads and drives the magnets off.
+// threads and drives the magnets off. Also the devices whose close has not finished.
 struct CloseAllAtExit {
   ~CloseAllAtExit() {
+    gExiting.store(true);
     for (Slot& slot : gSlots) delete slot.device.exchange(nullptr);
+    for (std::atomic<Device*>& entry : gRetired) delete entry.exchange(nullptr);
   }
 } gCloseAllAtExit;
 
@@ -59,7 +76,23 @@ Device* exchangeSlot(int index, Device* device) {
   slot.generation.store(gNextGeneration.fetch_add(1, std::memory_order_relaxed), std::memory_order_release);
   slot.reportsBlock = -1;
   slot.numReports = 0;
-  return slot.device.exchange(device, std::memory_order_acq_rel);
+  Device* previous = slot.device.exchange(device, std::memory_order_acq_rel);
+  retire(previous);
+  return previous;
+}
+
+void deleteRetired(Device* device) {
+  if (device == nullptr) return;
+  for (std::atomic<Device*>& entry : gRetired) {
+    Device* expected = device;
+    if (entry.compare_exchange_strong(expected, nullptr, std::memory_order_acq_rel)) {
+      delete device;
+      return;
+    }
+  }
+  // Not found: taken by the exit hook (which set gExiting before taking any), or never tracked
+  // (the table was full), then this stage owns it alone.
+  if (!gExiting.load()) delete device;
 }
 
 Device* peekSlot(int index) {

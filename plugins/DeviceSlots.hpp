@@ -33,8 +33,13 @@ SlotView viewSlot(int index, int64_t blockCounter, double lockstepTimeS);
 Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation);
 
 // RT stage of the commands: publishes `device` (may be null) in the slot and returns the
-// previous one, for the NRT stage to close and delete.
+// previous one, for the NRT stage to close and delete with deleteRetired. Until then the
+// previous device is "retired": should the server exit first (a close followed at once by
+// /quit), the exit hook closes it, so its magnet goes off.
 Device* exchangeSlot(int index, Device* device);
+
+// NRT stage: deletes a device exchangeSlot returned, unless the exit hook already has.
+void deleteRetired(Device* device);
 
 // Any thread: the device for a status query (NRT stages only: the device stays alive because
 // it is only ever deleted in a later NRT stage).

@@ -1,6 +1,6 @@
 // FrictionOut: sends an audio-rate force (N) to a device slot as 1 ms frames, each the mean
 // over its millisecond, clamped to the device's range, NaN/Inf as the minimum. Outputs the
-// force actually commanded, so it can be scoped and recorded.
+// force the device actually commanded after its safety path, so it can be scoped and recorded.
 // Inputs: device (slot index), force (N).
 #include <new>
 
@@ -47,6 +47,9 @@ class FrictionOut : public SCUnit {
       const double deviceFrameS = device->isLockstep() ? frameTimeS - device->lockstepOriginS() : frameTimeS;
       device->pushForceFrame(
           kf::ForceFrame{deviceFrameS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
+      // The output shows what the device commanded after its safety path (slew, drive limits,
+      // watchdog): in lockstep this frame's result, in realtime the latest sent to the magnet.
+      mFramer.showCommanded(device->commandedForceN());
     };
     const double sampleDurS = 1.0 / sampleRate();
     if (isAudioRateIn(kForceN)) {

@@ -66,5 +66,6 @@ PluginLoad(KineticFriction) {
   registerFrictionMouseIn();
   registerFrictionOut();
   registerDeviceCommands();
+  registerBoardCommands();
   installExitSafety();
 }

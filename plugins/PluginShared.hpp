@@ -59,5 +59,6 @@ void registerLoudnessToFriction();
 void registerFrictionMouseIn();
 void registerFrictionOut();
 void registerDeviceCommands();
+void registerBoardCommands();
 // Signal handlers that drive every open device's magnet off on the way out (ExitSafety.cpp).
 void installExitSafety();

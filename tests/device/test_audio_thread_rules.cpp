@@ -150,9 +150,10 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
     }
     std::this_thread::sleep_for(std::chrono::microseconds(1333));  // a block of real time
   }
-  kf::sc::exchangeSlot(2, nullptr);
+  kf::Device* retired = kf::sc::exchangeSlot(2, nullptr);
   const kf::TelemetrySnapshot telemetry = device->telemetry();
-  device.reset();
+  device.release();
+  kf::sc::deleteRetired(retired);
 
   CHECK(reportsSeen > 20);  // the device thread really delivered while we watched
   CHECK(gAllocations == 0);

@@ -7,6 +7,8 @@ short pause after each; a block gets ~1.5 s. Blocks of a file run in order, so l
 ~variables and synths of earlier ones; after the last block of a file, s.freeAll and every device
 slot is closed (FREE_EACH_BLOCK = True frees nodes after every block instead).
 
+A block whose first line is "// needs hardware" (the friction board, a real mouse) is skipped.
+
 The test fails on any sclang error (thrown by a piece, or posted as ERROR from a routine or a
 responder it started), on a piece that does not compile, and when scsynth exits.
 GUI examples (.plot, .scope, Window) run headless with QT_QPA_PLATFORM=offscreen.
@@ -76,6 +78,11 @@ files.do { |path|
 		"KF-HELP-FILE %% (%% blocks)".format(path, blocks.size).postln;
 		blocks.do { |code, b|
 			var pieces = piecesOf.(code), start = Main.elapsedTime;
+			if(code.stripWhiteSpace.beginsWith("// needs hardware")) {
+				"KF-HELP-SKIPPED-HARDWARE %% %%".format(path, b).postln;
+				pieces = [];
+				start = start - %(block_time)f;  // no time to wait for
+			};
 			pieces.do { |piece, p|
 				var fn = piece.compile;
 				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
@@ -115,6 +122,7 @@ PROBLEM_PATTERNS = [
     (re.compile(r"^(Segmentation fault|Aborted|terminate called)"), "a crash"),
     # Every line the device commands post, but kfStatus, reports a failed command.
     (re.compile(r"^kf(OpenSim|OpenReplay|Record|Close)\b.*: "), "a device command failed"),
+    (re.compile(r"^kfBoard\w+: "), "a board command failed"),
     (re.compile(r"RT memory allocation failed"), "RT memory allocation failed"),
 ]
 NOTE_PATTERNS = [re.compile(p) for p in (r"^FAILURE IN SERVER", r"^WARNING", r"^KF-HELP-NOTE",

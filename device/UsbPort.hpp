@@ -1,0 +1,68 @@
+// UsbPort: the little of libusb the board driver needs, behind our own interface, so the
+// driver runs against the real libusb (makeLibusbPort) or the board emulator (tests): a
+// context, open by IDs and serial, claim/release, synchronous control requests, asynchronous
+// interrupt transfers (submit, cancel, callbacks run by handleEvents), clear halt, close.
+// Thread rules are libusb's: handleEvents on one thread; control, submit and cancel from any.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace kf::usb {
+
+// The outcomes the driver tells apart (libusb's error codes, reduced).
+enum class Result { kOk, kIo, kInvalid, kAccess, kNoDevice, kNotFound, kBusy, kTimeout, kPipe, kOther };
+const char* describe(Result result);
+
+enum class TransferStatus { kCompleted, kError, kTimedOut, kCancelled, kStall, kNoDevice, kOverflow };
+const char* describe(TransferStatus status);
+
+// One asynchronous interrupt transfer, owned by the caller and reused: fill endpoint, length,
+// buffer (OUT), timeout and callback; submit; the callback runs on the handleEvents thread
+// with status and actualLength set. Its storage must outlive the port's close().
+struct Transfer {
+  static constexpr int kCapacity = 64;
+  uint8_t endpoint = 0;  // bit 7 set: IN
+  int length = 0;        // bytes to send, or room to receive
+  unsigned timeoutMs = 0;
+  uint8_t buffer[kCapacity] = {};
+  void (*callback)(Transfer& transfer) = nullptr;
+  void* user = nullptr;
+  // Set before the callback runs.
+  TransferStatus status = TransferStatus::kCompleted;
+  int actualLength = 0;
+  void* impl = nullptr;  // the port's own (libusb_transfer*)
+};
+
+struct DeviceIds {
+  uint16_t vendorId = 0;
+  uint16_t productId = 0;
+  std::string serial;  // empty: the first device with the IDs
+};
+
+class Port {
+ public:
+  virtual ~Port() = default;
+  virtual Result init() = 0;  // an own context, not libusb's default one
+  virtual void exit() = 0;
+  // Opens the device with these IDs (and serial). kNotFound when none matches.
+  virtual Result open(const DeviceIds& ids) = 0;
+  virtual std::string openSerial() const = 0;  // of the open device
+  virtual Result claimInterface(int number) = 0;
+  virtual void releaseInterface(int number) = 0;
+  virtual void close() = 0;  // every transfer must be back first
+  // Synchronous control request; *transferred gets the data bytes moved.
+  virtual Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data,
+                         uint16_t length, unsigned timeoutMs, int* transferred) = 0;
+  virtual Result clearHalt(uint8_t endpoint) = 0;
+  virtual Result submit(Transfer& transfer) = 0;
+  virtual Result cancel(Transfer& transfer) = 0;
+  // Waits up to timeoutMs for transfer events and runs the callbacks of finished transfers.
+  virtual Result handleEvents(int timeoutMs) = 0;
+};
+
+// libusb-1.0.
+std::unique_ptr<Port> makeLibusbPort();
+
+}  // namespace kf::usb
