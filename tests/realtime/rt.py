@@ -252,11 +252,12 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 """
 
 
-def run_sclang(code, jack, timeout=120, name="script", port=None):
+def run_sclang(code, jack, timeout=120, name="script", port=None, extra_env=None):
     """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync`
     and GUI work) with
     `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang processes are gone
-    when it returns, whatever happened."""
+    when it returns, whatever happened. extra_env: variables set last (e.g. DISPLAY and
+    QT_QPA_PLATFORM=xcb for a virtual display instead of offscreen)."""
     assert jack.alive(), "jackd is not running"
     port = port or free_udp_port()
     key = f"{name}-{os.getpid()}-{random.randrange(16 ** 6):06x}"
@@ -271,6 +272,7 @@ def run_sclang(code, jack, timeout=120, name="script", port=None):
     runtime.mkdir(mode=0o700, parents=True, exist_ok=True)
     env.update(QT_QPA_PLATFORM="offscreen", QTWEBENGINE_DISABLE_SANDBOX="1",
                XDG_RUNTIME_DIR=str(runtime), SC_JACK_DEFAULT_INPUTS="", SC_JACK_DEFAULT_OUTPUTS="")
+    env.update(extra_env or {})
     proc = None
     scsynth_pid = None
     known_children = set()

@@ -1,0 +1,282 @@
+"""FrictionView as a user sees it: a FrictionPilot on a realtime server (JACK dummy) with a
+simulated device whose hand pushes the puck across the pilot's fragment, the view opened with
+`pilot.view` on a virtual X display (Xvfb, Qt's xcb platform), two screenshots taken with
+Image.fromWindow, and the pixels checked: the puck marker is where the device's position is,
+it moved as the position moved, the signal spans the fragment, and the requested force trace is
+above the floor exactly where the puck was on the fragment.
+
+The screenshots are kept in $KF_TEST_ARTEFACTS_DIR/friction_view (default
+build/test-artefacts/friction_view) and their paths printed.
+"""
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rt
+
+# --- harness: a virtual display, screenshots as arrays -----------------------------------------
+
+
+class Xvfb:
+    """Xvfb on the first free display number from 50, stopped by its pid."""
+
+    def __init__(self, first=50):
+        self.first = first
+        self.proc = None
+        self.display = None
+
+    def start(self, timeout_s=15.0):
+        for number in range(self.first, self.first + 50):
+            if Path(f"/tmp/.X{number}-lock").exists() or Path(f"/tmp/.X11-unix/X{number}").exists():
+                continue
+            proc = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "1280x800x24", "-dpi", "96", "-nolisten", "tcp"],
+                                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            deadline = time.monotonic() + timeout_s
+            while time.monotonic() < deadline and proc.poll() is None:
+                if Path(f"/tmp/.X11-unix/X{number}").exists():
+                    self.proc, self.display = proc, f":{number}"
+                    return self
+                time.sleep(0.1)
+            rt.stop_pid(proc.pid)  # lost a race for the number, or did not come up: try the next
+            proc.wait()
+        raise RuntimeError("Xvfb did not start on any display :50..:99")
+
+    def stop(self):
+        if self.proc is not None:
+            rt.stop_pid(self.proc.pid)
+            self.proc.wait()
+            self.proc = None
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+def read_rgb(path):
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image.convert("RGB")).astype(int)
+
+
+def color_mask(rgb, color, tol=12):
+    return np.all(np.abs(rgb - np.array(color)) <= tol, axis=-1)
+
+
+# --- the test ----------------------------------------------------------------------------------
+
+ARTEFACTS = Path(os.environ.get("KF_TEST_ARTEFACTS_DIR") or rt.REPO_DIR / "build" / "test-artefacts") / "friction_view"
+
+MARKER = (220, 20, 60)      # FrictionView.markerColor
+REQUESTED = (30, 110, 230)  # FrictionView.requestedColor
+COMMANDED = (240, 140, 0)   # FrictionView.commandedColor
+SIGNAL = (60, 60, 100)      # FrictionView.signalColor
+
+ORIGIN_MM = 10.0            # the fragment: 24000 samples at mapping 2 (500/mm) = 10 .. 58 mm
+# The hand holds at -10 mm, then pulls the puck across the fragment at 40 mm/s to 110 mm. It is a
+# spring of 20 N/m: at most 0.5 N of friction keeps the puck up to 25 mm behind the target.
+HAND = [[0, -10], [1.5, -10], [4.5, 110], [10, 110]]
+
+SCRIPT = r"""
+var dev, pilot, v, shot, waitFor;
+dev = FrictionDevice.sim(s, 0, FrictionHand.path(@HAND@));
+pilot = FrictionPilot(dev, \mapping2, origin: @ORIGIN@).play;
+s.sync;
+v = pilot.view(bounds: Rect(40, 40, 1000, 700));
+v.rangeMm = [-20, 120];  // as a user zooms out to see the whole path
+waitFor = { |test, timeoutS| var t0 = Main.elapsedTime; while { test.value.not and: { Main.elapsedTime - t0 < timeoutS } } { 0.02.wait } };
+shot = { |name|
+	var path = @DIR@ +/+ name ++ ".png", win = v.window, image, before, after, u, w, sr, fr, d;
+	// The window shows the latest picture drawn: pause the view (as a user would to look), let
+	// the last picture reach the display, and grab it. The device's position (the pilot's bus,
+	// shared memory) is read when the picture stops and again at the grab.
+	before = pilot.monitorBus.getnSynchronous(2);
+	v.paused = true;
+	0.3.wait;
+	image = Image.fromWindow(win);
+	after = pilot.monitorBus.getnSynchronous(2);
+	image.write(path);
+	d = v.drawn;
+	"KF-STATE % % % % %".format(name, d.positionMm, v.speedMmPerS, d.timeS, v.frameCount).postln;
+	"KF-MAP % % % % % %".format(name, d.rangeMm[0], d.rangeMm[1], d.forceRangeN[0], d.forceRangeN[1], v.historyS).postln;
+	u = v.userView.absoluteBounds; w = win.view.absoluteBounds; sr = d.surfaceRect; fr = d.forceRect;
+	"KF-SHOT % % % % % % % % % %".format(name, path, image.width, image.height, u.left - w.left, u.top - w.top, u.width, u.height, w.width, w.height).postln;
+	image.free;
+	"KF-BUS % % % % %".format(name, before[0], before[1], after[0], after[1]).postln;
+	"KF-RECTS % % % % % % % % % %".format(name, sr.left, sr.top, sr.width, sr.height, fr.left, fr.top, fr.width, fr.height, v.minForceN).postln;
+	"KF-FRAGMENT % % %".format(name, *v.fragmentMm).postln;
+	v.history.do { |row| ("KF-HIST " ++ name ++ " " ++ row.collect { |x| x.asStringPrec(9) }.join(" ")).postln };
+	v.paused = false;
+};
+// Shot 1: the puck on the fragment (or the time is up); shot 2: after it left the fragment.
+waitFor.({ v.positionMm > (@ORIGIN@ + 20) }, 15);
+shot.("shot1");
+waitFor.({ v.positionMm > (@ORIGIN@ + 60) }, 15);
+0.3.wait;
+shot.("shot2");
+v.free;
+pilot.free;
+dev.close;
+s.sync;
+"KF-VIEW-FREED % %".format(v.isFree, v.synth).postln;
+"""
+
+
+def script():
+    return (SCRIPT.replace("@HAND@", str(HAND)).replace("@ORIGIN@", repr(ORIGIN_MM))
+            .replace("@DIR@", rt.sc_string(ARTEFACTS)))
+
+
+def fields(run, tag, name):
+    rows = [r[1:] for r in run.lines(tag + " ") if r and r[0] == name]
+    assert rows, f"no {tag} {name} line in the log {run.log_path}"
+    return rows
+
+
+def shot_info(run, name):
+    state = [float(v) for v in fields(run, "KF-STATE", name)[0]]
+    mapping = [float(v) for v in fields(run, "KF-MAP", name)[0]]
+    shot = fields(run, "KF-SHOT", name)[0]
+    bus = [float(v) for v in fields(run, "KF-BUS", name)[0]]
+    rects = [float(v) for v in fields(run, "KF-RECTS", name)[0]]
+    fragment = [float(v) for v in fields(run, "KF-FRAGMENT", name)[0]]
+    hist = np.array([[float(v) for v in r] for r in fields(run, "KF-HIST", name)])
+    ox, oy = float(shot[3]), float(shot[4])
+    # Qt may grab at a device pixel ratio other than 1 (Xvfb's DPI): image pixels per view pixel.
+    scale = int(shot[1]) / float(shot[7])
+    assert scale == pytest.approx(int(shot[2]) / float(shot[8]), rel=0.01), shot
+    assert ox >= 0 and oy >= 0 and ox + float(shot[5]) <= float(shot[7]) and oy + float(shot[6]) <= float(shot[8]), shot
+    to_image = lambda r: tuple(v * scale for v in (r[0] + ox, r[1] + oy, r[2], r[3]))  # noqa: E731
+    return dict(
+        position_mm=state[0], speed=state[1], time_s=state[2], frames=state[3],
+        range_mm=mapping[0:2], force_range=mapping[2:4], history_s=mapping[4],
+        path=shot[0], size=(int(shot[1]), int(shot[2])),
+        bus_before=bus[0:2], bus_after=bus[2:4],
+        # rects in window (= image) pixels
+        surface=to_image(rects[0:4]), force=to_image(rects[4:8]), scale=scale,
+        min_force=rects[8], fragment=fragment, history=hist)
+
+
+def marker_mm(rgb, info):
+    """The puck marker's centre in the surface panel, converted to mm by the view's mapping."""
+    left, top, width, height = info["surface"]
+    rows = rgb[int(top) + 3:int(top + height) - 3, int(left):int(left + width)]
+    full = color_mask(rows, MARKER).mean(axis=0) > 0.9  # a bar across the whole panel
+    cols = np.nonzero(full)[0]
+    assert 1 <= len(cols) <= 4 and cols.max() - cols.min() <= 3, f"marker columns {cols + int(left)}"
+    x = int(left) + cols.mean()
+    lo, hi = info["range_mm"]
+    return lo + (x - left) / width * (hi - lo), (hi - lo) / width
+
+
+def force_trace(rgb, info):
+    """(column x, force N) of the requested force trace in the force panel."""
+    left, top, width, height = info["force"]
+    xs, forces = [], []
+    f_lo, f_hi = info["force_range"]
+    for x in range(int(left) + 2, int(left + width) - 2):
+        column = rgb[int(top) + 1:int(top + height), x]
+        hit = np.nonzero(color_mask(column, REQUESTED))[0]
+        if len(hit):
+            y = int(top) + 1 + hit.mean()
+            xs.append(x)
+            forces.append(f_lo + (top + height - y) / height * (f_hi - f_lo))
+    return np.array(xs), np.array(forces)
+
+
+@pytest.fixture
+def display():
+    if shutil.which("Xvfb") is None:
+        pytest.fail("Xvfb is not installed (scripts/setup.sh installs the package xvfb)")
+    with Xvfb() as xvfb:
+        yield xvfb
+
+
+def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display):
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    for old in ARTEFACTS.glob("shot*.png"):
+        old.unlink()
+    with rt.JackServer() as jack:
+        run = rt.run_sclang(script(), jack,
+                            name="view", timeout=120,
+                            extra_env=dict(DISPLAY=display.display, QT_QPA_PLATFORM="xcb"))
+    print(f"log {run.log_path}\nscreenshots {ARTEFACTS}/shot1.png {ARTEFACTS}/shot2.png")
+    rt.require_ok(run, "the view session")
+    assert not run.error_lines(), run.error_lines()
+    one, two = shot_info(run, "shot1"), shot_info(run, "shot2")
+    start_mm, end_mm = two["fragment"]
+    assert start_mm == pytest.approx(ORIGIN_MM) and end_mm == pytest.approx(ORIGIN_MM + 23999 / 500, abs=1e-3)
+
+    marks = []
+    for info in (one, two):
+        rgb = read_rgb(info["path"])
+        assert rgb.shape[1::-1] == info["size"], "the PNG is not the window's size"
+        mm, mm_per_px = marker_mm(rgb, info)
+        marks.append(mm)
+        # The marker is drawn at the view's latest position, to the pixel.
+        assert abs(mm - info["position_mm"]) <= 1.5 * mm_per_px, (mm, info["position_mm"])
+        # The picture shows the device's position (the pilot's FrictionMouseIn, read from its bus
+        # when the picture stopped), a few frames old at most: the puck's speed x 0.3 s.
+        bus_mm = info["bus_before"][0]
+        speed = max(abs(info["bus_before"][1]), abs(info["speed"]))
+        tolerance = speed * 0.3 + 2 * mm_per_px
+        assert abs(mm - bus_mm) <= tolerance, f"marker {mm:.2f} mm, device {bus_mm:.2f} mm (+-{tolerance:.2f})"
+        hist = info["history"]
+        rate = (len(hist) - 1) / (hist[-1, 0] - hist[0, 0])
+        print(f"{Path(info['path']).name}: marker {mm:.2f} mm, view {info['position_mm']:.2f} mm, "
+              f"device {bus_mm:.2f} mm; {len(hist)} frames at {rate:.1f} per s (server time)")
+        assert 25 <= rate <= 35, f"{rate} frames per s"
+    # Shot 1 on the fragment, shot 2 past it; the marker moved as the device's position did.
+    assert start_mm + 15 < marks[0] < end_mm, f"shot 1: marker at {marks[0]:.2f} mm"
+    assert marks[1] > end_mm + 10, f"shot 2: marker at {marks[1]:.2f} mm"
+    bus_moved = two["bus_before"][0] - one["bus_before"][0]
+    speeds = [abs(one["bus_before"][1]), abs(two["bus_before"][1])]
+    assert marks[1] - marks[0] == pytest.approx(bus_moved, abs=0.3 * sum(speeds) + 1), (marks, bus_moved)
+
+    # The signal fills the fragment and nothing else.
+    rgb = read_rgb(two["path"])
+    left, top, width, height = two["surface"]
+    panel = rgb[int(top) + 20:int(top + height) - 2, int(left) + 2:int(left + width) - 2]
+    signal_cols = np.nonzero(color_mask(panel, SIGNAL, tol=6).any(axis=0))[0] + int(left) + 2
+    lo, hi = two["range_mm"]
+    to_x = lambda mm: left + (mm - lo) / (hi - lo) * width  # noqa: E731
+    assert abs(signal_cols.min() - to_x(start_mm)) <= 2 and abs(signal_cols.max() - to_x(end_mm)) <= 2, \
+        (signal_cols.min(), signal_cols.max(), to_x(start_mm), to_x(end_mm))
+
+    # The requested force: the floor (the device's minimum, magnet off) off the fragment, well
+    # above it on the fragment. Each column is a time; the view's history (what it received)
+    # gives the puck's position and speed at that time.
+    hist = two["history"]
+    latest = two["time_s"]  # the time of the picture's newest frame
+    xs, forces = force_trace(rgb, two)
+    f_left, _, f_width, f_height = two["force"]
+    times = latest - (f_left + f_width - xs) / f_width * two["history_s"]
+    keep = times >= hist[0, 0]
+    xs, forces, times = xs[keep], forces[keep], times[keep]
+    position = np.interp(times, hist[:, 0], hist[:, 1])
+    speed = np.abs(np.interp(times, hist[:, 0], hist[:, 2]))
+    # Margins: the force of a frame is its mean over 1/30 s, plus a column's width in time, at the
+    # puck's speed; never under 2 mm.
+    margin = np.maximum(2.0, speed * (1 / 30 + 2 * two["history_s"] / f_width) + 0.5)
+    inside = (position > start_mm + margin) & (position < end_mm - margin)
+    outside = (position < start_mm - margin) | (position > end_mm + margin)
+    px_n = (two["force_range"][1] - two["force_range"][0]) / f_height
+    floor = two["min_force"]
+    print(f"force trace: {len(xs)} columns, {inside.sum()} on the fragment (median {np.median(forces[inside]):.3f} N), "
+          f"{outside.sum()} off it (median {np.median(forces[outside]):.3f} N); {px_n * 1000:.1f} mN per pixel")
+    assert inside.sum() >= 30 and outside.sum() >= 30, (inside.sum(), outside.sum())
+    assert np.all(np.abs(forces[outside] - floor) <= 3 * px_n + 0.005), forces[outside]
+    assert np.median(forces[inside]) >= floor + 0.15
+    assert np.mean(forces[inside] >= floor + 0.05) >= 0.95, forces[inside]
+    # The commanded force is drawn as well (on top of the requested one).
+    f_top = two["force"][1]
+    assert color_mask(rgb[int(f_top):int(f_top + f_height), int(f_left):int(f_left + f_width)], COMMANDED).sum() >= 100
+
+    # Closing frees the monitor synth.
+    assert run.lines("KF-VIEW-FREED ")[0] == ["true", "nil"]
