@@ -168,7 +168,8 @@ FrictionView {
 	// After Cmd-. (which frees every node): start the monitor again.
 	doOnServerTree { if(isFree.not) { this.prStartSynth } }
 
-	cmdPeriod { synth = nil; fetching = false }
+	// Cmd-. also drops what was deferred or forked: a pending refresh or buffer fetch.
+	cmdPeriod { synth = nil; fetching = false; refreshPending = false }
 
 	printOn { |stream| stream << this.class.name << "(" << (pilot ? device) << ")" }
 

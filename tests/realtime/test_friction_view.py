@@ -280,3 +280,67 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
 
     # Closing frees the monitor synth.
     assert run.lines("KF-VIEW-FREED ")[0] == ["true", "nil"]
+
+
+HID_FILE = rt.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
+
+# Any device and any player: a replayed real mouse on slot 2 and the user's own synth writing
+# its requested and commanded force into a control bus; then Cmd-. and closing the view.
+ANY_PLAYER = r"""
+var dev, bus, buf, mine, v, info = List.new, queried, frames;
+bus = Bus.control(s, 2);
+buf = Buffer.sendCollection(s, Signal.sineFill(1000, [1]), 1);
+SynthDef(\kfMine, { |force = 0.3|
+	var m = FrictionMouseIn.kr(2);
+	Out.kr(bus, [force, FrictionOut.kr(2, force)]);
+}).add;
+s.sync;
+dev = FrictionDevice.replay(s, @HID@, 2);
+mine = Synth(\kfMine);
+s.sync;
+v = FrictionView(dev, buf, 100, 5, bus);
+2.wait;
+"KF-BEFORE % % % % % %".format(v.frameCount, v.forceN, v.commandedForceN, v.signalFrames, v.timeS, v.fragmentMm).postln;
+v.history.do { |row| "KF-ROW % %".format(row[1], row[2]).postln };
+// Cmd-. frees every node (the view's monitor too) and drops deferred functions: the view starts
+// its monitor again and keeps drawing. (The harness runs this code in a routine, which a real
+// Cmd-. would stop: the clocks are left alone here.)
+frames = v.frameCount;
+CmdPeriod.clearClocks = false;
+CmdPeriod.run;
+CmdPeriod.clearClocks = true;
+1.5.wait;
+"KF-AFTER-CMDPERIOD % %".format(v.frameCount - frames, v.synth.notNil).postln;
+queried = v.synth.nodeID;
+OSCdef(\kfViewInfo, { |msg| info.add(msg[1]) }, '/n_info');
+s.sendMsg('/n_query', queried);
+s.sync;
+v.close;
+0.5.wait;
+s.sendMsg('/n_query', queried);
+s.sync;
+0.2.wait;
+"KF-QUERIES % % %".format(info.size, info.includes(queried), v.isFree).postln;
+"KF-WINDOWS %".format(Window.allWindows.size).postln;
+dev.close; buf.free; bus.free;
+"""
+
+
+def test_any_device_and_player_cmd_period_and_close():
+    with rt.JackServer() as jack:
+        run = rt.require_ok(rt.run_sclang(ANY_PLAYER.replace("@HID@", rt.sc_string(HID_FILE)), jack,
+                                          name="view-any", timeout=90))
+    print(f"log {run.log_path}")
+    frames, force, commanded, signal_frames, time_s = (float(v) for v in run.lines("KF-BEFORE ")[0][:5])
+    # The monitor started (late on a loaded machine) and sends 30 frames per s of server time
+    # (frame n at n / 30 s), none lost; the user's forces come through the bus; the buffer is fetched.
+    assert time_s >= 0.8 and frames >= 0.9 * (time_s * 30 + 1), (frames, time_s)
+    assert force == pytest.approx(0.3, abs=1e-6) and commanded == pytest.approx(0.3, abs=1e-6)
+    assert signal_frames == 1000
+    rows = np.array([[float(v) for v in r] for r in run.lines("KF-ROW ")])
+    assert np.ptp(rows[:, 0]) > 0.1 and np.abs(rows[:, 1]).max() > 1, "the replayed mouse did not move the view's puck"
+    after, has_synth = run.lines("KF-AFTER-CMDPERIOD ")[0]
+    assert int(after) >= 25 and has_synth == "true", f"{after} frames in 1.5 s after Cmd-."
+    # The monitor answered /n_query before close and not after; the window is gone.
+    assert run.lines("KF-QUERIES ")[0] == ["1", "true", "true"]
+    assert run.lines("KF-WINDOWS ")[0] == ["0"]
