@@ -14,7 +14,7 @@ FrictionView {
 	var <signalFrames = 0, pyramidMin, pyramidMax, signalPeak = 1, signalBufnum, fetching = false;
 	var history, historyHead = 0, <historyCount = 0;
 	var <synth, defName, replyID, oscFunc, <isFree = false, refreshPending = false, lastSpm;
-	var drag, columnCache, columnKey, pilotRunning = 0, <paused = false, <drawn, rangeSet = false;
+	var drag, columnCache, columnKey, pilotRunning = 0, <paused = false, <drawn, rangeSet = false, forceChannels = 0, monitorDef;
 
 	*initClass {
 		// Distinct colours (drawn without antialiasing) so a test can find them in a screenshot.
@@ -199,6 +199,8 @@ FrictionView {
 		samplesPerMm = FrictionPilot.samplesPerMmOf(argSpm);
 		origin = FrictionPilot.prCheckFinite(argOrigin, "origin", "FrictionView");
 		forceBus = argForceBus;
+		// Fixed now: the bus may be freed before the view.
+		forceChannels = if(pilot.notNil) { 2 } { forceBus !? { forceBus.numChannels.min(2) } ? 0 };
 		positionBus = argPositionBus;
 		frameRate = argFrameRate;
 		historyS = argHistoryS;
@@ -212,6 +214,8 @@ FrictionView {
 		replyID = nextReplyID;
 		nextReplyID = nextReplyID + 1;
 		defName = ("frictionView" ++ replyID).asSymbol;
+		// Built once, from the buses as they are now (they may be freed before the view).
+		monitorDef = this.prMonitorDef;
 		this.prMakeGui(parent, bounds);
 		oscFunc = OSCFunc({ |msg| this.prFrame(msg) }, '/frictionView', server.addr, argTemplate: [nil, replyID]);
 		oscFunc.permanent = true;  // survives Cmd-.; the synth is restarted by doOnServerTree
@@ -297,8 +301,7 @@ FrictionView {
 	prStartSynth {
 		var def;
 		if(isFree or: { server.serverRunning.not }) { ^this };
-		if(pilot.notNil) { pilot.monitorBus };  // allocated before the def reads its index
-		def = this.prMonitorDef;
+		def = monitorDef;
 		synth = Synth.basicNew(defName, server);
 		// The def travels with its node, so a rebooted server (no defs) works as well.
 		server.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(server), [], \addToTail));
@@ -306,13 +309,14 @@ FrictionView {
 
 	prFrame { |msg|
 		var count = msg[3], values = msg[4..8], row, spm, ratio;
+		if(isFree) { ^this };
 		// A pilot that is not playing (yet, or any more) writes nothing: keep its last picture.
 		if(pilot.notNil and: { values[4] < 0.5 }) { pilotRunning = 0; ^this };
 		frameCount = frameCount + 1;
 		timeS = count / frameRate;
 		positionMm = values[0]; speedMmPerS = values[1];
-		forceN = if(pilot.notNil or: { forceBus.notNil }) { values[2] };
-		commandedForceN = if(pilot.notNil or: { forceBus.notNil and: { forceBus.numChannels > 1 } }) { values[3] };
+		forceN = if(forceChannels > 0) { values[2] };
+		commandedForceN = if(forceChannels > 1) { values[3] };
 		row = history[historyHead % history.size];
 		row[0] = timeS; row[1] = positionMm; row[2] = speedMmPerS; row[3] = values[2]; row[4] = values[3];
 		historyHead = (historyHead + 1) % history.size;
