@@ -9,54 +9,15 @@ The screenshots are kept in $KF_TEST_ARTEFACTS_DIR/friction_view (default
 build/test-artefacts/friction_view) and their paths printed.
 """
 import os
-import shutil
-import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rt
+from xvfb import Xvfb
 
-# --- harness: a virtual display, screenshots as arrays -----------------------------------------
-
-
-class Xvfb:
-    """Xvfb on the first free display number from 50, stopped by its pid."""
-
-    def __init__(self, first=50):
-        self.first = first
-        self.proc = None
-        self.display = None
-
-    def start(self, timeout_s=15.0):
-        for number in range(self.first, self.first + 50):
-            if Path(f"/tmp/.X{number}-lock").exists() or Path(f"/tmp/.X11-unix/X{number}").exists():
-                continue
-            proc = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "1280x800x24", "-dpi", "96", "-nolisten", "tcp"],
-                                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-            deadline = time.monotonic() + timeout_s
-            while time.monotonic() < deadline and proc.poll() is None:
-                if Path(f"/tmp/.X11-unix/X{number}").exists():
-                    self.proc, self.display = proc, f":{number}"
-                    return self
-                time.sleep(0.1)
-            rt.stop_pid(proc.pid)  # lost a race for the number, or did not come up: try the next
-            proc.wait()
-        raise RuntimeError("Xvfb did not start on any display :50..:99")
-
-    def stop(self):
-        if self.proc is not None:
-            rt.stop_pid(self.proc.pid)
-            self.proc.wait()
-            self.proc = None
-
-    def __enter__(self):
-        return self.start()
-
-    def __exit__(self, *exc):
-        self.stop()
+# --- screenshots as arrays ---------------------------------------------------------------------
 
 
 def read_rgb(path):
@@ -192,7 +153,7 @@ def force_trace(rgb, info):
 
 @pytest.fixture
 def display():
-    if shutil.which("Xvfb") is None:
+    if not Xvfb.available():
         pytest.fail("Xvfb is not installed (scripts/setup.sh installs the package xvfb)")
     with Xvfb() as xvfb:
         yield xvfb
@@ -205,7 +166,7 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
     with rt.JackServer() as jack:
         run = rt.run_sclang(script(), jack,
                             name="view", timeout=120,
-                            extra_env=dict(DISPLAY=display.display, QT_QPA_PLATFORM="xcb"))
+                            extra_env=display.env())
     print(f"log {run.log_path}\nscreenshots {ARTEFACTS}/shot1.png {ARTEFACTS}/shot2.png")
     rt.require_ok(run, "the view session")
     assert not run.error_lines(), run.error_lines()
