@@ -341,33 +341,43 @@ FrictionView {
 		fetching = true;
 		fork {
 			var store = { |array|
-				fetching = false;
-				if(array.notNil) { defer { this.prSetSignal(array, buf.bufnum) } }
+				var channels = buf.numChannels ? 1;
+				// A Routine on AppClock: a long signal is reduced without freezing the GUI.
+				if(array.notNil) {
+					Routine {
+						this.prSetSignal(if(channels > 1) { array[0, channels ..] } { array }, buf.bufnum);
+						fetching = false;
+					}.play(AppClock)
+				} { fetching = false }
 			};
-			server.sync;
-			if(server.isLocal) {
-				buf.loadToFloatArray(action: store)
-			} {
-				buf.getToFloatArray(action: store)
+			try {
+				server.sync;
+				if(server.isLocal) { buf.loadToFloatArray(action: store) } { buf.getToFloatArray(action: store) }
+			} { |error|
+				fetching = false;
+				"FrictionView: could not fetch buffer %: %".format(buf.bufnum, error.errorString).warn;
 			}
 		}
 	}
 
 	// A min/max pyramid: level k holds min and max over blocks of 2^k samples, so any pixel
-	// column is reduced from a few blocks, whatever the zoom.
+	// column is reduced from a few blocks, whatever the zoom. Runs in a Routine (yields).
 	prSetSignal { |array, bufnum|
-		var mins = array.as(FloatArray), maxs = mins;
-		pyramidMin = [mins]; pyramidMax = [maxs];
+		var mins = array.as(FloatArray), maxs = mins, levelsMin = [mins], levelsMax = [maxs];
+		if(mins.isEmpty) { "FrictionView: buffer % is empty".format(bufnum).warn; ^this };
 		while { mins.size > 1 } {
 			var n = (mins.size + 1) div: 2, lo = FloatArray.newClear(n), hi = FloatArray.newClear(n);
 			n.do { |i|
 				var j = min(2 * i + 1, mins.size - 1);
 				lo[i] = min(mins[2 * i], mins[j]);
 				hi[i] = max(maxs[2 * i], maxs[j]);
+				if(i % 65536 == 65535) { 0.wait };
 			};
 			mins = lo; maxs = hi;
-			pyramidMin = pyramidMin.add(mins); pyramidMax = pyramidMax.add(maxs);
+			levelsMin = levelsMin.add(mins); levelsMax = levelsMax.add(maxs);
 		};
+		if(isFree) { ^this };
+		pyramidMin = levelsMin; pyramidMax = levelsMax;
 		signalFrames = array.size;
 		signalPeak = max(max(mins[0].abs, maxs[0].abs), 1e-9);
 		signalBufnum = bufnum;

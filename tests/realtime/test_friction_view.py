@@ -58,6 +58,7 @@ shot = { |name|
 	// the last picture reach the display, and grab it. The device's position (the pilot's bus,
 	// shared memory) is read when the picture stops and again at the grab.
 	before = pilot.monitorBus.getnSynchronous(2);
+	"KF-NOW % %".format(name, v.timeS).postln;  // the latest frame's time when the bus is read
 	v.paused = true;
 	0.3.wait;
 	image = Image.fromWindow(win);
@@ -107,6 +108,7 @@ def shot_info(run, name):
     bus = [float(v) for v in fields(run, "KF-BUS", name)[0]]
     rects = [float(v) for v in fields(run, "KF-RECTS", name)[0]]
     fragment = [float(v) for v in fields(run, "KF-FRAGMENT", name)[0]]
+    now_s = float(fields(run, "KF-NOW", name)[0][0])
     hist = np.array([[float(v) for v in r] for r in fields(run, "KF-HIST", name)])
     ox, oy = float(shot[3]), float(shot[4])
     # Qt may grab at a device pixel ratio other than 1 (Xvfb's DPI): image pixels per view pixel.
@@ -121,7 +123,7 @@ def shot_info(run, name):
         bus_before=bus[0:2], bus_after=bus[2:4],
         # rects in window (= image) pixels
         surface=to_image(rects[0:4]), force=to_image(rects[4:8]), scale=scale,
-        min_force=rects[8], fragment=fragment, history=hist)
+        min_force=rects[8], fragment=fragment, history=hist, now_s=now_s)
 
 
 def marker_mm(rgb, info):
@@ -174,31 +176,38 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
     start_mm, end_mm = two["fragment"]
     assert start_mm == pytest.approx(ORIGIN_MM) and end_mm == pytest.approx(ORIGIN_MM + 23999 / 500, abs=1e-3)
 
-    marks = []
+    marks, tolerances = [], []
     for info in (one, two):
         rgb = read_rgb(info["path"])
         assert rgb.shape[1::-1] == info["size"], "the PNG is not the window's size"
         mm, mm_per_px = marker_mm(rgb, info)
         marks.append(mm)
-        # The marker is drawn at the view's latest position, to the pixel.
+        # The marker is drawn at the picture's position, to the pixel.
         assert abs(mm - info["position_mm"]) <= 1.5 * mm_per_px, (mm, info["position_mm"])
         # The picture shows the device's position (the pilot's FrictionMouseIn, read from its bus
-        # when the picture stopped), a few frames old at most: the puck's speed x 0.3 s.
+        # when the picture stopped) as it was when the picture was drawn: the puck may have
+        # moved since, by its speed times the picture's age (the frames the view received in
+        # between; a repaint already asked for may also draw a frame or two newer) plus 0.25 s
+        # for the latest frame's way to the view (sclang, drawing on a loaded machine, may read
+        # its replies a few frames late).
         bus_mm = info["bus_before"][0]
-        speed = max(abs(info["bus_before"][1]), abs(info["speed"]))
-        tolerance = speed * 0.3 + 2 * mm_per_px
-        assert abs(mm - bus_mm) <= tolerance, f"marker {mm:.2f} mm, device {bus_mm:.2f} mm (+-{tolerance:.2f})"
         hist = info["history"]
+        age_s = abs(info["now_s"] - info["time_s"])
+        window = (hist[:, 0] >= min(info["time_s"], info["now_s"]) - 0.1) & (hist[:, 0] <= max(info["time_s"], info["now_s"]) + 0.1)
+        speed = max(np.abs(hist[window, 2]).max(initial=0), abs(info["bus_before"][1]))
+        tolerance = speed * (age_s + 0.25) + 2 * mm_per_px
+        assert age_s <= 1.0, f"the picture is {age_s} s old"
+        tolerances.append(tolerance)
+        assert abs(mm - bus_mm) <= tolerance, f"marker {mm:.2f} mm, device {bus_mm:.2f} mm (+-{tolerance:.2f})"
         rate = (len(hist) - 1) / (hist[-1, 0] - hist[0, 0])
         print(f"{Path(info['path']).name}: marker {mm:.2f} mm, view {info['position_mm']:.2f} mm, "
-              f"device {bus_mm:.2f} mm; {len(hist)} frames at {rate:.1f} per s (server time)")
+              f"device {bus_mm:.2f} mm, picture {age_s:.3f} s old; {len(hist)} frames at {rate:.1f} per s (server time)")
         assert 25 <= rate <= 35, f"{rate} frames per s"
     # Shot 1 on the fragment, shot 2 past it; the marker moved as the device's position did.
     assert start_mm + 15 < marks[0] < end_mm, f"shot 1: marker at {marks[0]:.2f} mm"
     assert marks[1] > end_mm + 10, f"shot 2: marker at {marks[1]:.2f} mm"
     bus_moved = two["bus_before"][0] - one["bus_before"][0]
-    speeds = [abs(one["bus_before"][1]), abs(two["bus_before"][1])]
-    assert marks[1] - marks[0] == pytest.approx(bus_moved, abs=0.3 * sum(speeds) + 1), (marks, bus_moved)
+    assert marks[1] - marks[0] == pytest.approx(bus_moved, abs=tolerances[0] + tolerances[1]), (marks, bus_moved)
 
     # The signal fills the fragment and nothing else.
     rgb = read_rgb(two["path"])
@@ -221,10 +230,14 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
     keep = times >= hist[0, 0]
     xs, forces, times = xs[keep], forces[keep], times[keep]
     position = np.interp(times, hist[:, 0], hist[:, 1])
-    speed = np.abs(np.interp(times, hist[:, 0], hist[:, 2]))
-    # Margins: the force of a frame is its mean over 1/30 s, plus a column's width in time, at the
-    # puck's speed; never under 2 mm.
-    margin = np.maximum(2.0, speed * (1 / 30 + 2 * two["history_s"] / f_width) + 0.5)
+    # Margins in mm: a frame's force is its mean over the 1/30 s before it, and the trace is drawn
+    # straight from frame to frame, so a column shows forces up to 2 frames (and a column) older
+    # than its time. At the fastest speed near it (the puck jumps forward when it leaves the
+    # fragment and friction drops), that is the distance it may still be off; never under 2 mm.
+    lag_s = 2 / 30 + 2 * two["history_s"] / f_width
+    near_speed = np.array([np.abs(hist[(hist[:, 0] >= t - 0.1) & (hist[:, 0] <= t + 0.05), 2]).max(initial=0)
+                           for t in times])
+    margin = np.maximum(2.0, near_speed * lag_s + 0.5)
     inside = (position > start_mm + margin) & (position < end_mm - margin)
     outside = (position < start_mm - margin) | (position > end_mm + margin)
     px_n = (two["force_range"][1] - two["force_range"][0]) / f_height
@@ -232,7 +245,8 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
     print(f"force trace: {len(xs)} columns, {inside.sum()} on the fragment (median {np.median(forces[inside]):.3f} N), "
           f"{outside.sum()} off it (median {np.median(forces[outside]):.3f} N); {px_n * 1000:.1f} mN per pixel")
     assert inside.sum() >= 30 and outside.sum() >= 30, (inside.sum(), outside.sum())
-    assert np.all(np.abs(forces[outside] - floor) <= 3 * px_n + 0.005), forces[outside]
+    off = outside & (np.abs(forces - floor) > 3 * px_n + 0.005)
+    assert not off.any(), f"off the fragment but not at the floor: {list(zip(times[off], position[off], forces[off]))}"
     assert np.median(forces[inside]) >= floor + 0.15
     assert np.mean(forces[inside] >= floor + 0.05) >= 0.95, forces[inside]
     # The commanded force is drawn as well (on top of the requested one).
@@ -248,7 +262,7 @@ HID_FILE = rt.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 # Any device and any player: a replayed real mouse on slot 2 and the user's own synth writing
 # its requested and commanded force into a control bus; then Cmd-. and closing the view.
 ANY_PLAYER = r"""
-var dev, bus, buf, mine, v, info = List.new, queried, frames;
+var dev, bus, buf, mine, v, info = List.new, queried, frames, t0;
 bus = Bus.control(s, 2);
 buf = Buffer.sendCollection(s, Signal.sineFill(1000, [1]), 1);
 SynthDef(\kfMine, { |force = 0.3|
@@ -270,8 +284,9 @@ frames = v.frameCount;
 CmdPeriod.clearClocks = false;
 CmdPeriod.run;
 CmdPeriod.clearClocks = true;
-1.5.wait;
-"KF-AFTER-CMDPERIOD % %".format(v.frameCount - frames, v.synth.notNil).postln;
+t0 = Main.elapsedTime;
+while { v.frameCount - frames < 30 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
+"KF-AFTER-CMDPERIOD % % % %".format(v.frameCount - frames, v.synth.notNil, v.timeS, Main.elapsedTime - t0).postln;
 queried = v.synth.nodeID;
 OSCdef(\kfViewInfo, { |msg| info.add(msg[1]) }, '/n_info');
 s.sendMsg('/n_query', queried);
@@ -300,8 +315,11 @@ def test_any_device_and_player_cmd_period_and_close():
     assert signal_frames == 1000
     rows = np.array([[float(v) for v in r] for r in run.lines("KF-ROW ")])
     assert np.ptp(rows[:, 0]) > 0.1 and np.abs(rows[:, 1]).max() > 1, "the replayed mouse did not move the view's puck"
-    after, has_synth = run.lines("KF-AFTER-CMDPERIOD ")[0]
-    assert int(after) >= 25 and has_synth == "true", f"{after} frames in 1.5 s after Cmd-."
+    after, has_synth, time_s, wall_s = run.lines("KF-AFTER-CMDPERIOD ")[0]
+    # A new monitor (its frame count starts again) sends 30 frames per s of server time.
+    print(f"after Cmd-.: {after} frames in {float(wall_s):.2f} s, the new monitor's time {float(time_s):.2f} s")
+    assert int(after) >= 30 and has_synth == "true", f"{after} frames in {wall_s} s after Cmd-."
+    assert float(time_s) < float(wall_s) + 0.5 and int(after) >= 0.9 * (float(time_s) * 30 + 1)
     # The monitor answered /n_query before close and not after; the window is gone.
     assert run.lines("KF-QUERIES ")[0] == ["1", "true", "true"]
     assert run.lines("KF-WINDOWS ")[0] == ["0"]

@@ -1,0 +1,62 @@
+"""What FrictionView costs: CPU of scsynth and of sclang (which draws) with a playing pilot, for
+PHASE_S seconds without the view, then PHASE_S seconds with it (its own window on Xvfb, 30
+frames/s), measured from /proc/<pid>/stat (user + system time) and scsynth's own average load.
+
+Usage: bench/view_cost.py   (after the build; needs jackd, sclang, Xvfb). Not part of
+bench/run.py: a machine shared with other work makes these numbers noisy; run it alone.
+"""
+import os
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests" / "realtime"))
+import rt  # noqa: E402
+from xvfb import Xvfb  # noqa: E402
+
+PHASE_S = 10
+
+SCRIPT = r"""
+var dev, pilot, v, cpu, measure, hand;
+cpu = { |pid|
+	var fields = File.readAllString("/proc/%/stat".format(pid)).split($)).last.split($ );
+	(fields[12].asInteger + fields[13].asInteger) / 100  // utime + stime (fields 14, 15), in s
+};
+measure = { |name|
+	var t0 = Main.elapsedTime, s0 = cpu.(s.pid), l0 = cpu.(thisProcess.pid), loads = List.new;
+	@PHASE@.do { 1.wait; loads.add(s.avgCPU) };
+	"KF-COST % % % % %".format(name, Main.elapsedTime - t0, cpu.(s.pid) - s0, cpu.(thisProcess.pid) - l0, loads.mean).postln;
+};
+// Back and forth across the fragment (10 .. 58 mm) for 60 s.
+hand = FrictionHand.speeds(([[40, 1.5], [-40, 1.5]] ! 20).flatten(1));
+dev = FrictionDevice.sim(s, 0, hand);
+pilot = FrictionPilot(dev, \mapping2, origin: 10).play;
+s.sync;
+2.wait;
+measure.("pilot");
+v = pilot.view(bounds: Rect(40, 40, 1000, 700));
+v.rangeMm = [-20, 120];
+2.wait;
+measure.("pilot+view");
+"KF-FRAMES % %".format(v.frameCount, v.timeS).postln;
+v.free; pilot.free; dev.close; s.sync;
+"""
+
+
+def main():
+    os.environ.setdefault("KF_TEST_WORK_DIR", "/tmp/kf-view-cost")
+    with Xvfb() as display, rt.JackServer() as jack:
+        run = rt.require_ok(rt.run_sclang(SCRIPT.replace("@PHASE@", str(PHASE_S)), jack, name="view-cost",
+                                          timeout=120, extra_env=display.env()))
+    rows = {r[0]: [float(v) for v in r[1:]] for r in run.lines("KF-COST ")}
+    print(f"{'':12} {'wall s':>7} {'scsynth cpu s':>14} {'sclang cpu s':>13} {'scsynth avgCPU %':>17}")
+    for name, (wall, synth, lang, load) in rows.items():
+        print(f"{name:12} {wall:7.1f} {synth:14.2f} {lang:13.2f} {load:17.2f}")
+    a, b = rows["pilot"], rows["pilot+view"]
+    print(f"the view adds: scsynth {100 * (b[1] / b[0] - a[1] / a[0]):+.2f} % of a core, "
+          f"sclang {100 * (b[2] / b[0] - a[2] / a[0]):+.1f} % of a core "
+          f"(frames {run.lines('KF-FRAMES ')[0]})")
+
+
+if __name__ == "__main__":
+    main()
