@@ -165,8 +165,14 @@ FrictionView {
 
 	front { window !? { window.front } }
 
-	// After Cmd-. (which frees every node): start the monitor again.
-	doOnServerTree { if(isFree.not) { this.prStartSynth } }
+	// After Cmd-. (which frees every node) or a boot: start the monitor again. A pilot's synth is
+	// gone too: clear what it left on its bus, so the view waits for it to play again.
+	doOnServerTree {
+		if(isFree.not) {
+			if(pilot.notNil) { pilot.monitorBus.setn(0 ! 5) };
+			this.prStartSynth
+		}
+	}
 
 	// Cmd-. also drops what was deferred or forked: a pending refresh or buffer fetch.
 	cmdPeriod { synth = nil; fetching = false; refreshPending = false }
@@ -427,6 +433,7 @@ FrictionView {
 		var text = "puck % mm   speed % mm/s".format(this.prFormat(positionMm, 2), this.prFormat(speedMmPerS, 1));
 		if(forceN.notNil) { text = text ++ "   force % N requested".format(this.prFormat(forceN, 3)) };
 		if(commandedForceN.notNil) { text = text ++ ", % N commanded".format(this.prFormat(commandedForceN, 3)) };
+		if(pilot.notNil and: { pilotRunning < 0.5 }) { text = text ++ "   (the pilot is not playing)" };
 		text = text ++ "   % samples/mm, origin % mm".format(this.prFormat(this.samplesPerMm, if(this.samplesPerMm.frac == 0) { 0 } { 3 }),
 			this.prFormat(this.origin, 2));
 		Pen.stringInRect(text, r, font, Color.black, \left);
@@ -435,6 +442,9 @@ FrictionView {
 	prDrawSurface { |r, font|
 		var spm = this.samplesPerMm, org = this.origin, mid = (r.top + 8 + (r.height / 2)).round, yScale = (r.height - 20) * 0.48 / signalPeak;
 		var startMm, endMm, x0, x1, key, px;
+		// The mapping of this picture, local: mmToX/xToMm would lay the panels out on every call.
+		var mmPerPx = (rangeMm[1] - rangeMm[0]) / r.width;
+		var toX = { |mm| r.left + ((mm - rangeMm[0]) / mmPerPx) }, toMm = { |x| rangeMm[0] + ((x - r.left) * mmPerPx) };
 		Pen.fillColor = Color.gray(0.97); Pen.fillRect(r);
 		this.prAxisX(r, rangeMm, font, "position on the surface (mm)");
 		Pen.strokeColor = Color.gray(0.85); Pen.width = 1;
@@ -444,11 +454,11 @@ FrictionView {
 			// The signal: min and max of the samples under each pixel column.
 			key = [rangeMm, r, spm, org, signalBufnum];
 			if(key != columnKey) {
-				x0 = this.mmToX(startMm).floor.max(r.left).asInteger;
-				x1 = this.mmToX(endMm).ceil.min(r.right - 1).asInteger;
+				x0 = toX.(startMm).floor.max(r.left).asInteger;
+				x1 = toX.(endMm).ceil.min(r.right - 1).asInteger;
 				columnCache = List.new;
 				x0.for(x1, { |x|
-					var env = this.prEnvelope((this.xToMm(x) - org) * spm, (this.xToMm(x + 1) - org) * spm);
+					var env = this.prEnvelope((toMm.(x) - org) * spm, (toMm.(x + 1) - org) * spm);
 					env !? { columnCache.add([x, mid - (env[1] * yScale), mid - (env[0] * yScale)]) };
 				});
 				columnKey = key;
@@ -458,7 +468,7 @@ FrictionView {
 			Pen.stroke;
 			// The fragment's ends.
 			[startMm, endMm].do { |mm, i|
-				var x = this.mmToX(mm).round;
+				var x = toX.(mm).round;
 				if(x >= r.left and: { x <= r.right }) {
 					var text = if(i == 0) { "start % mm" } { "end % mm" }.format(this.prFormat(mm, 2));
 					var at = (if(i == 0) { x + 3 } { x - 3 - (text.size * 5.6) }) @ (r.top + 2);
@@ -472,7 +482,7 @@ FrictionView {
 		};
 		Pen.strokeColor = Color.gray(0.6); Pen.width = 1; Pen.strokeRect(r);
 		// The puck: a bar across the surface and a triangle above it.
-		px = this.mmToX(positionMm).round;
+		px = toX.(positionMm).round;
 		Pen.fillColor = markerColor;
 		if(px >= r.left and: { px <= r.right }) {
 			Pen.fillRect(Rect(px - 1, r.top + 1, 3, r.height - 1));
@@ -495,7 +505,7 @@ FrictionView {
 	}
 
 	prDrawStrip { |r, font, which, rows|
-		var latest, range, toY, fragment, values, labels;
+		var ageToX = { |ageS| r.right - (ageS / historyS * r.width) }, latest, range, toY, fragment, values, labels;
 		Pen.fillColor = Color.white; Pen.fillRect(r);
 		latest = if(rows.notEmpty) { rows.last[0] } { 0 };
 		if(which == \speed) {
@@ -514,7 +524,7 @@ FrictionView {
 			Pen.fillColor = Color.gray(0.9);
 			rows.doAdjacentPairs { |a, b|
 				if(a[1] >= fragment[0] and: { a[1] <= fragment[1] }) {
-					var xa = this.ageToX(latest - a[0]), xb = this.ageToX(latest - b[0]);
+					var xa = ageToX.(latest - a[0]), xb = ageToX.(latest - b[0]);
 					if(xb > r.left) { Pen.fillRect(Rect(xa.max(r.left), r.top + 1, xb - xa.max(r.left) + 1, r.height - 1)) }
 				}
 			};
@@ -549,10 +559,10 @@ FrictionView {
 	}
 
 	prTrace { |rows, latest, r, toY, column, color, width|
-		var first = true;
+		var first = true, ageToX = { |ageS| r.right - (ageS / historyS * r.width) };
 		Pen.strokeColor = color; Pen.width = width;
 		rows.do { |row|
-			var x = this.ageToX(latest - row[0]), point;
+			var x = ageToX.(latest - row[0]), point;
 			if(x >= r.left) {
 				point = x.round @ toY.(row[column]).round;
 				if(first) { Pen.moveTo(point); first = false } { Pen.lineTo(point) };
@@ -577,7 +587,7 @@ FrictionView {
 		v = (range[0] / step).ceil * step;
 		Pen.strokeColor = Color.gray(0.6); Pen.width = 1;
 		while { v <= (range[1] + (step * 1e-6)) } {
-			x = if(isTime) { this.ageToX(v.neg) } { r.left + ((v - range[0]) / (range[1] - range[0]) * r.width) };
+			x = if(isTime) { r.right - (v.neg / historyS * r.width) } { r.left + ((v - range[0]) / (range[1] - range[0]) * r.width) };
 			Pen.line(x @ r.bottom, x @ (r.bottom + 4)); Pen.stroke;
 			if(title.notNil and: { x + 26 < titleLeft }) {
 				Pen.stringAtPoint(this.prFormat(v, decimals), (x - 12) @ (r.bottom + 5), font, Color.gray(0.2))
