@@ -1,6 +1,6 @@
 """What FrictionView costs: CPU of scsynth and of sclang (which draws) with a playing pilot, for
 PHASE_S seconds without the view, then PHASE_S seconds with it (its own window on Xvfb, 30
-frames/s), measured from /proc/<pid>/stat (user + system time) and scsynth's own average load.
+frames/s), then with 20 of its monitor synths and no drawing, measured from /proc/<pid>/stat (user + system time) and scsynth's own average load.
 
 Usage: bench/view_cost.py   (after the build; needs jackd, sclang, Xvfb). Not part of
 bench/run.py: a machine shared with other work makes these numbers noisy; run it alone.
@@ -17,9 +17,9 @@ from xvfb import Xvfb  # noqa: E402
 PHASE_S = 10
 
 SCRIPT = r"""
-var dev, pilot, v, cpu, measure, hand;
+var dev, pilot, v, cpu, measure, hand, def, monitors;
 cpu = { |pid|
-	var fields = File.readAllString("/proc/%/stat".format(pid)).split($)).last.split($ );
+	var fields = "cat /proc/%/stat".format(pid).unixCmdGetStdOut.split($)).last.split($ );
 	(fields[12].asInteger + fields[13].asInteger) / 100  // utime + stime (fields 14, 15), in s
 };
 measure = { |name|
@@ -39,7 +39,15 @@ v.rangeMm = [-20, 120];
 2.wait;
 measure.("pilot+view");
 "KF-FRAMES % %".format(v.frameCount, v.timeS).postln;
-v.free; pilot.free; dev.close; s.sync;
+def = v.synth.defName;
+v.free;
+s.sync;
+// The monitor synth alone, without drawing: 20 of them (their replies find no responder).
+monitors = 20.collect { Synth.tail(RootNode(s), def) };
+s.sync;
+2.wait;
+measure.("pilot+20monitors");
+monitors.do(_.free); pilot.free; dev.close; s.sync;
 """
 
 
@@ -52,10 +60,11 @@ def main():
     print(f"{'':12} {'wall s':>7} {'scsynth cpu s':>14} {'sclang cpu s':>13} {'scsynth avgCPU %':>17}")
     for name, (wall, synth, lang, load) in rows.items():
         print(f"{name:12} {wall:7.1f} {synth:14.2f} {lang:13.2f} {load:17.2f}")
-    a, b = rows["pilot"], rows["pilot+view"]
+    a, b, c = rows["pilot"], rows["pilot+view"], rows["pilot+20monitors"]
     print(f"the view adds: scsynth {100 * (b[1] / b[0] - a[1] / a[0]):+.2f} % of a core, "
           f"sclang {100 * (b[2] / b[0] - a[2] / a[0]):+.1f} % of a core "
-          f"(frames {run.lines('KF-FRAMES ')[0]})")
+          f"(frames, server time: {run.lines('KF-FRAMES ')[0]})")
+    print(f"one monitor synth (from 20, no drawing): scsynth {100 * (c[1] / c[0] - a[1] / a[0]) / 20:+.3f} % of a core")
 
 
 if __name__ == "__main__":
