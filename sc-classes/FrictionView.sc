@@ -169,6 +169,7 @@ FrictionView {
 	// gone too: clear what it left on its bus, so the view waits for it to play again.
 	doOnServerTree {
 		if(isFree.not) {
+			fetching = false;  // a fetch cut off by a quit or Cmd-. is taken again
 			if(pilot.notNil) { pilot.monitorBus.setn(0 ! 5) };
 			this.prStartSynth
 		}
@@ -342,7 +343,7 @@ FrictionView {
 
 	prFetchSignalIfNeeded { |force|
 		var buf = this.buffer;
-		if(buf.isNil or: { fetching } or: { isFree }) { ^this };
+		if(buf.isNil or: { fetching } or: { isFree } or: { server.serverRunning.not }) { ^this };
 		if(force.not and: { signalBufnum == buf.bufnum }) { ^this };
 		fetching = true;
 		fork {
