@@ -296,12 +296,14 @@ HID_FILE = rt.TEST_DATA_DIR / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 # Any device and any player: a replayed real mouse on slot 2 and the user's own synth writing
 # its requested and commanded force into a control bus; then Cmd-. and closing the view.
 ANY_PLAYER = r"""
-var dev, bus, buf, mine, v, info = List.new, queried, frames, t0;
+var dev, bus, posBus, buf, mine, v, v2, w2, info = List.new, queried, frames, t0, p;
 bus = Bus.control(s, 2);
+posBus = Bus.audio(s, 2);  // the user's position and speed, at audio rate
 buf = Buffer.sendCollection(s, Signal.sineFill(1000, [1]), 1);
 SynthDef(\kfMine, { |force = 0.3|
 	var m = FrictionMouseIn.kr(2);
 	Out.kr(bus, [force, FrictionOut.kr(2, force)]);
+	Out.ar(posBus, K2A.ar([m[0], m[2]]));
 }).add;
 s.sync;
 dev = FrictionDevice.replay(s, @HID@, 2);
@@ -312,6 +314,15 @@ t0 = Main.elapsedTime;
 while { v.frameCount < 45 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
 "KF-BEFORE % % % % % %".format(v.frameCount, v.forceN, v.commandedForceN, v.signalFrames, v.timeS, v.fragmentMm).postln;
 v.history.do { |row| "KF-ROW % %".format(row[1], row[2]).postln };
+// A second view on the user's position bus (audio rate): it shows the user's position.
+w2 = Window().front;
+v2 = FrictionView(dev, buf, 100, 5, bus, posBus, parent: w2);
+t0 = Main.elapsedTime;
+while { v2.frameCount < 15 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
+p = v.history.last;
+"KF-POSBUS % % % % %".format(v2.positionMm, v2.speedMmPerS, v.history.keep(-15).collect { |r| r[2].abs }.maxItem, p[1], p[2]).postln;
+v2.free;
+w2.close;
 // Follow the puck; zoom with the mapping about the puck; wheel and drag (their actions, called as
 // Qt calls them).
 v.follow = true;
@@ -352,7 +363,7 @@ s.sync;
 0.2.wait;
 "KF-QUERIES % % %".format(info.size, info.includes(queried), v.isFree).postln;
 "KF-WINDOWS %".format(Window.allWindows.size).postln;
-dev.close; buf.free; bus.free;
+dev.close; buf.free; bus.free; posBus.free;
 """
 
 
@@ -374,6 +385,12 @@ def test_any_device_and_player_cmd_period_and_close():
     print(f"after Cmd-.: {after} frames in {float(wall_s):.2f} s, the new monitor's time {float(time_s):.2f} s")
     assert int(after) >= 30 and has_synth == "true", f"{after} frames in {wall_s} s after Cmd-."
     assert float(time_s) < float(wall_s) + 0.5 and int(after) >= 0.9 * (float(time_s) * 30 + 1)
+    # The view on the user's audio-rate position bus reads what the user's synth reads (the same
+    # device, both started before the views): within what the puck moves in a few frames (at
+    # the last half second's top speed) and a few counts (the replayed mouse creeps by single
+    # counts of 0.021 mm between reports).
+    pos2, speed2, recent_speed, pos1, speed1 = (float(v) for v in run.lines("KF-POSBUS ")[0])
+    assert pos2 == pytest.approx(pos1, abs=0.2 * max(abs(speed1), abs(speed2), recent_speed) + 5 * 0.021), (pos1, pos2)
     # Following: the view's middle is the puck (as of the latest frame).
     middle, puck = (float(v) for v in run.lines("KF-FOLLOW ")[0])
     assert middle == pytest.approx(puck, abs=1e-3)
