@@ -8,7 +8,7 @@ FrictionPilot {
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
-	var <buffer, <synth, <defName;
+	var <buffer, <synth, <defName, monitorBus;
 
 	*initClass {
 		var pilot = KineticFriction.paperPilot, mapping = KineticFriction.paperMapping;
@@ -137,7 +137,8 @@ FrictionPilot {
 	// bufnum, samplesPerMm, origin (mm), friction (0 off .. 1 on), amp, out (stereo), audioDelay
 	// (s, default the device's), and with record: true, recordBus: 6 audio channels from there
 	// (see recordChannelNames).
-	*synthDef { |name = \frictionPilot, device = 0, record = false, loForceN, hiForceN|
+	// monitor: true adds a control bus output (monitorBus: 5 channels) for FrictionView.
+	*synthDef { |name = \frictionPilot, device = 0, record = false, loForceN, hiForceN, monitor = false|
 		var index = this.prDeviceIndex(device, "synthDef");
 		var delay = this.prAudioDelay(device);
 		var lo = loForceN ?? { this.prMinForce(device) };
@@ -160,6 +161,11 @@ FrictionPilot {
 			Out.ar(\out.kr(0), p[\delayedAudio] ! 2);
 			if(record) {
 				Out.ar(\recordBus.kr(2), [\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
+			};
+			// Position, speed, requested and commanded force once per control block, and 1 while
+			// running (the buffer is loaded before the synth starts).
+			if(monitor == true) {
+				Out.kr(\monitorBus.kr(0), A2K.kr([p[\position], p[\speed], p[\force], p[\commandedForce]]) ++ [DC.kr(1)])
 			};
 		})
 	}
@@ -235,11 +241,11 @@ FrictionPilot {
 		forkIfNeeded {
 			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
-			this.class.synthDef(defName, device).add;
+			this.class.synthDef(defName, device, monitor: true).add;
 			server.sync;
 			if(synth === starting) {
 				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm,
-					\origin, origin, \friction, friction, \amp, amp, \out, out]));
+					\origin, origin, \friction, friction, \amp, amp, \out, out, \monitorBus, this.monitorBus.index]));
 			};
 		};
 	}
@@ -258,9 +264,18 @@ FrictionPilot {
 	origin_ { |mm| origin = this.class.prCheckFinite(mm, "origin", "origin_"); synth !? { synth.set(\origin, origin) } }
 	amp_ { |value| amp = this.class.prCheckFinite(value, "amp", "amp_"); synth !? { synth.set(\amp, amp) } }
 
+	// Opens a FrictionView of this pilot (its own window; or in parent).
+	view { |parent, bounds| ^FrictionView.pilot(this, parent, bounds) }
+
+	// 5 control channels the playing synth writes (position mm, speed mm/s, requested force N,
+	// commanded force N, 1 while running), for FrictionView. Kept for the pilot's life, so a
+	// view keeps reading it across free and play.
+	monitorBus { ^monitorBus ?? { monitorBus = Bus.control(this.server, 5) } }
+
 	free {
 		synth !? { synth.free };
 		synth = nil;
+		monitorBus !? { monitorBus.setn(0 ! 5) };
 		buffer !? { buffer.free };
 		buffer = nil;
 	}

@@ -13,6 +13,7 @@ import numpy as np
 
 from kfharness import paths
 from kfharness import pilot as P
+from view_shot import write_view_shot
 
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
@@ -195,6 +196,12 @@ def main():
             f"audio {x['f_lo']:.4g}..{x['f_hi']:.5g} Hz at {x['speed_lo']:.1f}..{x['speed_hi']:.1f} mm/s; crossings "
             + ", ".join(f"{c[0]} {c[2]:.3f} s" for c in x["crossings"]))
     summary(scenes, results, args.rate, out_dir, time.time() - start)
+    # The live view (FrictionView) beside the plots, when a realtime server and a display can run.
+    if write_view_shot(out_dir, log):
+        with open(out_dir / "summary.md", "a") as f:
+            f.write("\n`view.png`: FrictionView (`pilot.view`) in realtime on the simulated device after the puck "
+                    "crossed mapping 2's fragment: the signal on the surface, the puck, its speed and the requested "
+                    "and commanded force.\n")
     log(f"== pilot done in {time.time() - start:.1f} s. Results: {out_dir} (summary: {out_dir / 'summary.md'})")
 
 
