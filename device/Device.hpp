@@ -96,6 +96,8 @@ class Device {
   double lastPumpS_ = -1.0;
   double lastCommandS_ = 0.0;
   MouseReport pollBuffer_[kPollBatch];
+  int64_t xCounts_ = 0;  // the puck's position since open (MouseReport::xCounts)
+  int64_t yCounts_ = 0;
 
   std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
   std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads

@@ -74,7 +74,6 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
   kf::LoudnessToFriction loudness(history.data(), static_cast<int>(history.size()));
   loudness.setWindowSamples(48);
   kf::TrajectoryReconstructor trajectory(125.0, kf::TrajectoryMode::Predictive);
-  kf::DeviceClockMapper clock;
   kf::ForceFramer framer(0.001, 0.14, 1.4);
   std::vector<float> x(kBlock), y(kBlock), vx(kBlock), vy(kBlock);
 
@@ -93,11 +92,10 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
     {
       AudioSection audioThread;
       // FrictionMouseIn
-      const kf::sc::SlotView view = kf::sc::viewSlot(2, block, startS + kBlock * kSampleDurS);
-      for (int i = 0; i < view.numReports; ++i)
-        trajectory.addReport(clock.map(view.reports[i].deviceTimeS, startS), view.reports[i].dxCounts * 0.021, 0.0,
-                             view.reports[i].flags);
-      reportsSeen += view.numReports;
+      const kf::sc::SlotView view = kf::sc::viewSlot(2, kf::sc::BlockClock{block, startS, kSampleDurS, kBlock});
+      if (block == 0) trajectory = view.trajectory->reference(kf::TrajectoryMode::Predictive);
+      kf::sc::addEntries(trajectory, view.trajectory->entries(), view.trajectory->numEntries());
+      reportsSeen += view.trajectory->numEntries();
       trajectory.render(startS, kSampleDurS, kBlock, 0.0, x.data(), y.data(), vx.data(), vy.data());
       // SpatialBufRd
       const kf::SignalView sv{signal.data(), static_cast<int64_t>(signal.size()), 1};
