@@ -8,7 +8,15 @@
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry)
 //   kfClose      index
+//   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
+//                                   default, for every reader, from the next block on)
+//
+// Replies follow the server's conventions: `/done cmdName` when a command succeeded; when it
+// failed, no /done but `/kfFail` to the notified clients (node 0, replyID = the slot index,
+// then the reason as character codes), and the reason is posted. The open commands refuse a
+// slot that holds a device unless given the setting `replace 1`. `/sync` works after all.
 #include <algorithm>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -25,6 +33,7 @@ constexpr int kMaxValues = 8192;
 constexpr int kMaxOverrides = 32;
 constexpr int kMaxKeyChars = 48;
 constexpr int kMaxPathChars = 1024;
+constexpr int kMaxReasonChars = 200;
 
 struct CommandData {
   const char* name;
@@ -38,7 +47,46 @@ struct CommandData {
   kf::Device* device;    // opened by stage 2, or the target of record/status
   kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
   double* values;        // the hand script (kfOpenSim only), RTAlloc'd to its size
+  bool replace;          // open commands: a device in the slot is closed, not refused
+  bool ownsDevice;       // open commands: `device` is theirs until published
+  bool failed;           // a stage failed; `reason` says why
+  char reason[kMaxReasonChars];
+  AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
 };
+
+// Records why the command failed; the stage wrappers post it and answer /kfFail with it.
+void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void failWith(CommandData* data, const char* format, ...) {
+  data->failed = true;
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(data->reason, kMaxReasonChars, format, args);
+  va_end(args);
+}
+
+// RT: the failure to the notified clients, as the node reply /kfFail from the root group.
+void replyFailure(World* world, const CommandData* data) {
+  float codes[kMaxReasonChars];
+  int n = 0;
+  for (; n < kMaxReasonChars && data->reason[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(data->reason[n]);
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->index, "/kfFail", n, codes);
+}
+
+// The same from an NRT stage: a copy of the reason travels to the RT thread.
+struct FailureCopy {
+  CommandData data;
+};
+
+void replyFailureFromNrt(World* world, const CommandData* data) {
+  auto* copy = static_cast<FailureCopy*>(NRTAlloc(sizeof(FailureCopy)));
+  if (copy == nullptr) return;
+  std::memcpy(&copy->data, data, sizeof(CommandData));
+  FifoMsg msg;
+  msg.Set(
+      world, [](FifoMsg* m) { replyFailure(m->mWorld, &static_cast<FailureCopy*>(m->mData)->data); },
+      [](FifoMsg* m) { NRTFree(m->mData); }, copy);
+  SendMsgToRT(world, msg);
+}
 
 void copyString(char* to, const char* from, size_t capacity) {
   std::snprintf(to, capacity, "%s", from != nullptr ? from : "");
@@ -57,6 +105,8 @@ CommandData* newCommand(World* world, const char* name, sc_msg_iter* args) {
   data->path[0] = '\0';
   data->device = data->previous = nullptr;
   data->values = nullptr;
+  data->replace = data->failed = data->ownsDevice = false;
+  data->reason[0] = '\0';
   return data;
 }
 
@@ -65,6 +115,10 @@ void readOverrides(sc_msg_iter* args, CommandData* data) {
   while (args->remain() > 0 && data->numOverrides < kMaxOverrides) {
     const char* key = args->gets(nullptr);
     if (key == nullptr) break;
+    if (std::strcmp(key, "replace") == 0) {  // not a device setting: how to treat a taken slot
+      data->replace = args->getd(0.0) != 0.0;
+      continue;
+    }
     copyString(data->keys[data->numOverrides], key, kMaxKeyChars);
     data->overrideValues[data->numOverrides++] = args->getd(0.0);
   }
@@ -83,23 +137,60 @@ void freeCommand(World* world, void* raw) {
   RTFree(world, data);
 }
 
+// The stages every command runs, around its own: a failing NRT stage does not end the command
+// (so that the RT stage can answer /kfFail); the last stage sends /done only on success and
+// still runs after a refusal, to delete what was opened for nothing.
+bool wrappedStage2(World* world, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (!data->stages[0](world, data) && !data->failed) failWith(data, "%s failed", data->name);
+  if (data->failed) Print("%s\n", data->reason);
+  return true;
+}
+
+bool wrappedStage3(World* world, void* raw) {  // RT
+  auto* data = static_cast<CommandData*>(raw);
+  const bool failedBefore = data->failed;
+  if (!failedBefore && !data->stages[1](world, data) && !data->failed) failWith(data, "%s failed", data->name);
+  if (data->failed && !failedBefore) kf::sc::postFromRt(world, "%s\n", data->reason);
+  if (data->failed) replyFailure(world, data);
+  return !data->failed || data->device != nullptr || data->previous != nullptr;
+}
+
+bool wrappedStage4(World* world, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->failed) {
+    delete data->previous;                                                        // unpublished: nothing else holds it
+    if (data->ownsDevice && data->previous != data->device) delete data->device;  // never published
+    return false;
+  }
+  if (data->stages[2](world, data)) return true;
+  if (!data->failed) failWith(data, "%s failed", data->name);
+  Print("%s\n", data->reason);
+  replyFailureFromNrt(world, data);
+  return false;
+}
+
 void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
          AsyncStageFn stage4) {
-  DoAsynchronousCommand(world, replyAddr, data->name, data, stage2, stage3, stage4, freeCommand, 0, nullptr);
+  data->stages[0] = stage2;
+  data->stages[1] = stage3;
+  data->stages[2] = stage4;
+  DoAsynchronousCommand(world, replyAddr, data->name, data, wrappedStage2, wrappedStage3, wrappedStage4, freeCommand, 0,
+                        nullptr);
 }
 
 // Applies the overrides to a spec and simulation settings; false (and a message) on a bad key.
-bool applyOverrides(const CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim) {
+bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim) {
   for (int i = 0; i < data->numOverrides; ++i) {
     const char* key = data->keys[i];
     const double value = data->overrideValues[i];
     if (spec.applyOverride(key, value)) continue;
     if (sim != nullptr && sim->applyOverride(key, value)) continue;
-    Print("%s: unknown setting or value out of range: %s = %g\n", data->name, key, value);
+    failWith(data, "%s: unknown setting or value out of range: %s = %g", data->name, key, value);
     return false;
   }
   if (!spec.isValid()) {
-    Print("%s: the device settings do not fit together (check force range and rates)\n", data->name);
+    failWith(data, "%s: the device settings do not fit together (check force range and rates)", data->name);
     return false;
   }
   return true;
@@ -127,6 +218,11 @@ bool publishStage(World* world, void* raw) {  // RT
   // A lockstep device's time starts with the next block, as a realtime one's starts at open.
   if (data->device != nullptr && data->device->isLockstep())
     data->device->setLockstepOriginS(kf::sc::blockStartTimeS(world));
+  if (!data->replace && kf::sc::peekSlot(data->index) != nullptr) {
+    // Refused: the new device is deleted by the last stage; the open one stays.
+    failWith(data, "%s: device index %d is taken; close it first or open with replace", data->name, data->index);
+    return true;
+  }
   data->previous = kf::sc::exchangeSlot(data->index, data->device);
   return true;
 }
@@ -145,12 +241,13 @@ bool openSimStage(World* world, void* raw) {  // NRT
   if (!applyOverrides(data, spec, &sim)) return false;
   const kf::HandScript hand = handScriptOf(data);
   if (data->kind >= 0 && !hand.isValid()) {
-    Print("kfOpenSim: the hand script is not usable (times must ascend, values be finite)\n");
+    failWith(data, "kfOpenSim: the hand script is not usable (times must ascend, values be finite)");
     return false;
   }
   std::string error;
+  data->ownsDevice = true;
   data->device = kf::openSimDevice(spec, sim, hand, !world->mRealTime, &error).release();
-  if (data->device == nullptr) Print("kfOpenSim: %s\n", error.c_str());
+  if (data->device == nullptr) failWith(data, "kfOpenSim: %s", error.c_str());
   return data->device != nullptr;
 }
 
@@ -180,8 +277,9 @@ bool openReplayStage(World* world, void* raw) {  // NRT
   kf::DeviceSpec spec;
   if (!applyOverrides(data, spec, nullptr)) return false;
   std::string error;
+  data->ownsDevice = true;
   data->device = kf::openReplayDevice(data->path, spec, !world->mRealTime, error).release();
-  if (data->device == nullptr) Print("kfOpenReplay: %s\n", error.c_str());
+  if (data->device == nullptr) failWith(data, "kfOpenReplay: %s", error.c_str());
   return data->device != nullptr;
 }
 
@@ -215,7 +313,7 @@ bool unpublishStage(World*, void* raw) {  // RT
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (data->device == nullptr) {
-    Print("kfRecord: no device is open at index %d\n", data->index);
+    failWith(data, "kfRecord: no device is open at index %d", data->index);
     return false;
   }
   if (data->path[0] == '\0') {
@@ -224,7 +322,7 @@ bool recordStage(World*, void* raw) {  // NRT
   }
   std::string error;
   if (!data->device->startRecording(data->path, error)) {
-    Print("kfRecord: %s\n", error.c_str());
+    failWith(data, "kfRecord: %s", error.c_str());
     return false;
   }
   return true;
@@ -281,6 +379,27 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   run(world, replyAddr, data, nrtHop, unpublishStage, deletePreviousStage);
 }
 
+// --- kfZero --------------------------------------------------------------------------------
+
+bool rtNothing(World*, void*) { return true; }
+
+void zeroCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  CommandData* data = newCommand(world, "kfZero", args);
+  if (data == nullptr) return;
+  const double xMm = args->getd(0.0);
+  const double yMm = args->getd(0.0);
+  if (!checkSlot(world, data)) return freeCommand(world, data);
+  // At once, in the RT thread at the command's time (a bundle's time stamp): every reader of
+  // the slot is re-based at the next block. The asynchronous part only answers /done.
+  if (!kf::sc::requestSlotPosition(data->index, xMm, yMm)) {
+    failWith(data, "kfZero: no device is open at index %d", data->index);
+    kf::sc::postFromRt(world, "%s\n", data->reason);
+    replyFailure(world, data);
+    return freeCommand(world, data);
+  }
+  run(world, replyAddr, data, nrtHop, rtNothing, nrtHop);
+}
+
 }  // namespace
 
 void registerDeviceCommands() {
@@ -289,4 +408,5 @@ void registerDeviceCommands() {
   DefinePlugInCmd("kfRecord", recordCmd, nullptr);
   DefinePlugInCmd("kfStatus", statusCmd, nullptr);
   DefinePlugInCmd("kfClose", closeCmd, nullptr);
+  DefinePlugInCmd("kfZero", zeroCmd, nullptr);
 }

@@ -10,6 +10,7 @@ struct Slot {
   // Audio thread only: the reports popped in a block, and the slot's position.
   MouseReport reports[kMaxReportsPerBlock];
   SlotTrajectory trajectory;
+  SlotForce force;
 };
 
 Slot gSlots[kNumDeviceSlots];
@@ -68,8 +69,11 @@ Device* exchangeSlot(int index, Device* device) {
   Slot& slot = gSlots[index];
   slot.generation.store(gNextGeneration.fetch_add(1, std::memory_order_relaxed), std::memory_order_release);
   slot.trajectory.reset(device != nullptr ? device->spec() : DeviceSpec{});
+  slot.force.reset(device != nullptr ? device->spec() : DeviceSpec{});
   return slot.device.exchange(device, std::memory_order_acq_rel);
 }
+
+SlotForce* forceOfSlot(int index) { return isValidSlot(index) ? &gSlots[index].force : nullptr; }
 
 Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;

@@ -4,13 +4,16 @@
 //
 // Reports are fanned out on the audio side: the first FrictionMouseIn of a block that asks a
 // slot pops its queue (single consumer) into the slot's SlotTrajectory, whose position
-// entries every FrictionMouseIn of that block then reads: one position per device.
+// entries every FrictionMouseIn of that block then reads: one position per device. Forces
+// are fanned in the same way: every FrictionOut of a slot adds into its SlotForce, which sends
+// the device one frame per millisecond.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 
 #include "Device.hpp"
+#include "SlotForce.hpp"
 #include "SlotTrajectory.hpp"
 
 namespace kf::sc {
@@ -31,6 +34,10 @@ SlotView viewSlot(int index, const BlockClock& clock);
 // Audio thread (RT stage of kfZero): from the next block on, the slot's latest reported
 // position reads (xMm, yMm). False when no device is open there.
 bool requestSlotPosition(int index, double xMm, double yMm);
+
+// Audio thread: the slot's force combiner (one per slot, whether a device is open or not);
+// null for an out-of-range index.
+SlotForce* forceOfSlot(int index);
 
 // Audio thread: the slot's device, pumped to lockstepTimeS if it runs in lockstep.
 Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation);

@@ -69,12 +69,11 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
   constexpr int kBlock = 64;
   constexpr double kSampleDurS = 1.0 / 48000;
   // Set up as the NRT stages and constructors do (allocation allowed here).
-  std::vector<float> history(960), signal(24000), audio(kBlock), forceN(kBlock), commandedN(kBlock);
+  std::vector<float> history(960), signal(24000), audio(kBlock), forceN(kBlock);
   for (size_t i = 0; i < signal.size(); ++i) signal[i] = static_cast<float>(std::sin(i * 0.0628));
   kf::LoudnessToFriction loudness(history.data(), static_cast<int>(history.size()));
   loudness.setWindowSamples(48);
   kf::TrajectoryReconstructor trajectory(125.0, kf::TrajectoryMode::Predictive);
-  kf::ForceFramer framer(0.001, 0.14, 1.4);
   std::vector<float> x(kBlock), y(kBlock), vx(kBlock), vy(kBlock);
 
   std::string error;
@@ -106,8 +105,9 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
       // FrictionOut
       uint32_t generation = 0;
       kf::Device* d = kf::sc::deviceOfSlot(2, startS, &generation);
-      auto sink = [d](double timeS, float f) { d->pushForceFrame(kf::ForceFrame{timeS, f, d->nowS()}); };
-      framer.process(startS, kSampleDurS, forceN.data(), kBlock, commandedN.data(), sink);
+      auto sink = [d](double timeS, float f, double) { d->pushForceFrame(kf::ForceFrame{timeS, f, d->nowS()}); };
+      kf::sc::forceOfSlot(2)->write(kf::sc::BlockClock{block, startS, kSampleDurS, kBlock}, forceN.data(), kBlock,
+                                    sink);
     }
     std::this_thread::sleep_for(std::chrono::microseconds(1333));  // a block of real time
   }
