@@ -177,7 +177,10 @@ FrictionDevice {
 	prSendAnswered { |cmd, msg, onDone, onFail, block = true|
 		var cond, answer, inRoutine = block and: { thisThread.isKindOf(Routine) };
 		if(server.isNil) { ^this };
-		if(server.serverRunning.not) { Error("FrictionDevice: server % is not running".format(server)).throw };
+		// (At ServerBoot, re-opening, the server is up but not yet marked running.)
+		if(block and: { server.serverRunning.not }) {
+			Error("FrictionDevice: server % is not running".format(server)).throw
+		};
 		cond = Condition(false);
 		this.class.prExpect(server, cmd, index, {
 			answer = \done;

@@ -8,7 +8,7 @@ FrictionPilot {
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
-	var <buffer, <synth, <defName;
+	var <buffer, <synth, <defName, quitAction;
 
 	*initClass {
 		// Table 1: samples per mm of the three mappings.
@@ -222,6 +222,9 @@ FrictionPilot {
 		// The synth is claimed now, so that a second play does nothing and a free before it starts
 		// (below) keeps it from starting at all.
 		synth = Synth.basicNew(defName, server);
+		// Cmd-. frees the synth (the buffer stays); a quit frees both: play starts again.
+		CmdPeriod.add(this);
+		quitAction ?? { quitAction = { synth = nil; buffer = nil }; ServerQuit.add(quitAction, server) };
 		forkIfNeeded {
 			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
@@ -230,6 +233,8 @@ FrictionPilot {
 			if(synth === starting) {
 				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm,
 					\origin, origin, \friction, friction, \amp, amp, \out, out]));
+				// Freed by anyone (n_free, s.freeAll): forgotten, so that play starts it again.
+				starting.onFree { if(synth === starting) { synth = nil } };
 			};
 		};
 	}
@@ -248,9 +253,17 @@ FrictionPilot {
 	origin_ { |mm| origin = this.class.prCheckFinite(mm, "origin", "origin_"); synth !? { synth.set(\origin, origin) } }
 	amp_ { |value| amp = this.class.prCheckFinite(value, "amp", "amp_"); synth !? { synth.set(\amp, amp) } }
 
+	isPlaying { ^synth.notNil }
+
+	// Cmd-. has freed the synth: the pilot is stopped, and play starts it again.
+	cmdPeriod { synth = nil; CmdPeriod.remove(this) }
+
 	free {
 		synth !? { synth.free };
 		synth = nil;
+		CmdPeriod.remove(this);
+		quitAction !? { ServerQuit.remove(quitAction, this.server) };
+		quitAction = nil;
 		buffer !? { buffer.free };
 		buffer = nil;
 	}
