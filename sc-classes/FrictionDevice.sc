@@ -153,24 +153,25 @@ FrictionDevice {
 	// Opens on the server. Inside a Routine (fork, s.waitForBoot, Tdef) it waits for the answer
 	// and a refusal is an Error; elsewhere the refusal is posted as an ERROR when it comes.
 	prOpen {
-		var existing;
 		if(server.isNil) { ^this };
 		if(server.serverRunning.not) { Error("FrictionDevice: server % is not running".format(server)).throw };
-		existing = this.class.at(server, index);
-		if(existing.notNil and: { existing !== this }) {
-			if(replace.not) {
-				Error("FrictionDevice: slot % of % is held by %; close it first or pass replace: true".format(index, server, existing)).throw
-			};
-			existing.prForget(\replaced);
-		};
+		state = \opening;
+		// The server decides whether the slot is free (or replaced): it holds the devices of
+		// every client. Its answer updates what sclang holds.
+		this.prSendAnswered([\kfOpenSim, \kfOpenReplay][[\sim, \replay].indexOf(kind)], this.openMsg, {
+			this.prHold;
+		}, {
+			state = \failed;
+		});
+	}
+
+	prHold {
+		var previous = this.class.at(server, index);
+		if(previous.notNil and: { previous !== this }) { previous.prForget(\replaced) };
 		slots[server] = slots[server] ?? { Array.newClear(16) };
 		slots[server][index] = this;
-		state = \opening;
-		this.prSendAnswered([\kfOpenSim, \kfOpenReplay][[\sim, \replay].indexOf(kind)], this.openMsg, {
-			state = \open;
-		}, {
-			if(this.class.at(server, index) === this) { this.prForget(\failed) };
-		});
+		state = \open;
+		forceBus !? { this.prStartWriter };
 	}
 
 	// Sends msg and awaits /done cmd or /kfFail for this slot (answerTimeout s at most).
@@ -275,7 +276,7 @@ FrictionDevice {
 			state = \open;
 			this.prStartWriter;
 		}, {
-			if(this.class.at(server, index) === this) { this.prForget(\failed) };
+			this.prForget(\failed);
 		}, false);
 	}
 
