@@ -64,9 +64,16 @@ void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* repor
     add(PositionEntry{clock.startS, shiftXMm, shiftYMm, 0, true});
     positionRequested_ = false;
   }
+  // A backlog (nobody read for a while) counts for its position only: it arrived late all at
+  // once, and would teach the clock mapper a delay that is not there.
+  if (!continuous) clock_.reset();
   for (int i = 0; i < numReports; ++i) {
     const MouseReport& r = reports[i];
-    const double timeS = lockstep ? r.deviceTimeS + lockstepOriginS : clock_.map(r.deviceTimeS, clock.startS);
+    double timeS = clock.startS;
+    if (lockstep)
+      timeS = r.deviceTimeS + lockstepOriginS;
+    else if (continuous)
+      timeS = clock_.map(r.deviceTimeS, clock.startS);
     // From absolute counts: reports lost on the way (a full queue) still count.
     add(PositionEntry{timeS, countsToMm(r.xCounts - xCounts_), countsToMm(r.yCounts - yCounts_), r.flags, false});
     xCounts_ = r.xCounts;

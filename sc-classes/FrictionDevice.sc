@@ -7,7 +7,7 @@ FrictionDevice {
 	// answer (/done or /kfFail), by server; how long to wait for one.
 	classvar slots, pendingAnswers, responders, <>answerTimeout = 5;
 	var <server, <index, <specs, <kind, <source, <overrides;
-	var <state = \described, <replace = false, forceBus, forceWriter;
+	var <state = \described, <replace = false, forceBus, forceWriter, positionBus, positionReader;
 
 	*initClass {
 		// DESIGN.md's names for the device's numbers, and the device library's setting names
@@ -110,6 +110,32 @@ FrictionDevice {
 	status { this.prSendAnswered(\kfStatus, this.statusMsg) }
 	statusMsg { ^['/cmd', \kfStatus, index] }
 
+	// A 4-channel control Bus of the puck's [x, y, speedX, speedY] (mm, mm/s), made on first
+	// use and written by one reader synth at the head of the server: for GUIs and re-centring
+	// (positionBus.getn(4, action)); it comes back after Cmd-. and a reboot.
+	positionBus {
+		if(server.isNil) { Error("FrictionDevice.positionBus: the device has no server").throw };
+		positionBus ?? {
+			positionBus = Bus.control(server, 4);
+			this.prStartReader;
+		};
+		^positionBus
+	}
+
+	prStartReader {
+		var def = SynthDef(\kfPositionReader, { Out.kr(\bus.ir(0), FrictionMouseIn.kr(\device.ir(0))) });
+		var reader;
+		if(positionReader.notNil or: { positionBus.isNil }) { ^this };
+		reader = positionReader = Synth.basicNew(\kfPositionReader, server);
+		forkIfNeeded {
+			def.add;
+			server.sync;
+			if(positionReader === reader) {
+				server.sendMsg(*reader.newMsg(RootNode(server), [\device, index, \bus, positionBus.index], \addToHead));
+			};
+		};
+	}
+
 	// Closes the device if this object still holds its slot (a device opened with replace: true
 	// in the same slot is not closed by the object it replaced).
 	close {
@@ -172,6 +198,7 @@ FrictionDevice {
 		slots[server][index] = this;
 		state = \open;
 		forceBus !? { this.prStartWriter };
+		positionBus !? { this.prStartReader };
 	}
 
 	// Sends msg and awaits /done cmd or /kfFail for this slot (answerTimeout s at most).
@@ -208,6 +235,10 @@ FrictionDevice {
 		forceWriter = nil;
 		forceBus !? { forceBus.free };
 		forceBus = nil;
+		positionReader !? { if(server.serverRunning) { positionReader.free } };
+		positionReader = nil;
+		positionBus !? { positionBus.free };
+		positionBus = nil;
 	}
 
 	// One writer per device, claimed at once so that it is never started twice.
@@ -266,15 +297,17 @@ FrictionDevice {
 		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prRestoreWriter } } };
 	}
 
-	prQuit { state = \quit; forceWriter = nil }
+	prQuit { state = \quit; forceWriter = nil; positionReader = nil }
 
 	prReopen {
 		if(state != \quit) { ^this };
 		forceBus !? { server.audioBusAllocator.reserve(forceBus.index, 1, false) };
+		positionBus !? { server.controlBusAllocator.reserve(positionBus.index, 4, false) };
 		state = \opening;
 		this.prSendAnswered([\kfOpenSim, \kfOpenReplay][[\sim, \replay].indexOf(kind)], this.openMsg, {
 			state = \open;
 			this.prStartWriter;
+			this.prStartReader;
 		}, {
 			this.prForget(\failed);
 		}, false);
@@ -282,7 +315,12 @@ FrictionDevice {
 
 	// After Cmd-. (all nodes freed): the force writer again.
 	prRestoreWriter {
-		if(state == \open and: { forceBus.notNil }) { forceWriter = nil; this.prStartWriter };
+		if(state == \open) {
+			forceWriter = nil;
+			positionReader = nil;
+			this.prStartWriter;
+			this.prStartReader;
+		};
 	}
 
 	// In a ProxySpace (~dev = FrictionDevice.sim(s)), the proxy plays the puck's position and

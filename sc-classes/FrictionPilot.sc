@@ -94,7 +94,7 @@ FrictionPilot {
 	// friction 0 keeps the magnet at loForceN (use the device's minimum, 0.14 N for the paper).
 	// amp scales only what is heard; the force follows the signal as read (amplitude 1 = 0 dB).
 	*ar { |device = 0, bufnum = 0, samplesPerMm = 4000, origin = 0, friction = 1, amp = 1,
-		audioDelay = 0.001, loForceN = 0.14, hiForceN = 0.5, maxAudioDelay = 0.05|
+		audioDelay = 0.001, loForceN = 0.14, hiForceN = 0.5, maxAudioDelay = 0.05, keep = 0|
 		var mouse, audio, loudness, force, commanded, delayed;
 		[\samplesPerMm, samplesPerMm, \origin, origin, \friction, friction, \amp, amp,
 			\loForceN, loForceN, \hiForceN, hiForceN].pairsDo { |name, value|
@@ -112,7 +112,7 @@ FrictionPilot {
 			Error("FrictionPilot.ar: audioDelay must be within [0, %] s, got %".format(maxAudioDelay, audioDelay)).throw
 		};
 		mouse = FrictionMouseIn.ar(device, 0, 1);
-		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4);
+		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4, keep);
 		// Equations (1) and (2): 1 ms mean |a| -> dB -> [-30, 0] dB onto [lo, hi] N.
 		loudness = LoudnessToFriction.ar(audio, 0.001, -30, 0, loForceN, hiForceN, 1);
 		force = loForceN + (friction.clip(0, 1) * (loudness - loForceN));
@@ -146,7 +146,7 @@ FrictionPilot {
 		if(hi <= lo) { Error("FrictionPilot.synthDef: hiForceN (%) must be above loForceN (%)".format(hi, lo)).throw };
 		^SynthDef(name.asSymbol, {
 			var p = this.ar(\device.kr(index), \bufnum.kr(0), \samplesPerMm.kr(4000), \origin.kr(0),
-				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay));
+				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay), \keep.kr(0));
 			Out.ar(\out.kr(0), p[\delayedAudio] ! 2);
 			if(record) {
 				Out.ar(\recordBus.kr(2), [\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
@@ -242,7 +242,17 @@ FrictionPilot {
 	mapping_ { |newMapping|
 		samplesPerMm = this.class.samplesPerMmOf(newMapping);
 		mapping = newMapping;
-		synth !? { synth.set(\samplesPerMm, samplesPerMm) }
+		synth !? { synth.set(\keep, 0, \samplesPerMm, samplesPerMm) }
+	}
+
+	// Changes the mapping (a name of Table 1 or samples per mm) about the puck: the server moves
+	// the layout so that the sample under the puck stays in place (SpatialBufRd's keep), at the
+	// block the change takes effect. From then on origin_ changes keep it in place too; mapping_
+	// goes back to the absolute layout.
+	zoom { |newMapping|
+		samplesPerMm = this.class.samplesPerMmOf(newMapping);
+		mapping = newMapping;
+		synth !? { synth.set(\keep, 1, \samplesPerMm, samplesPerMm) }
 	}
 
 	friction_ { |on|

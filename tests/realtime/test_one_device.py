@@ -207,3 +207,55 @@ def test_a_multichannel_force_into_one_slot_is_rejected_when_the_synthdef_is_bui
     """, jack, name="multichannel")
     assert not run.ok
     assert "FrictionOut: force has 2 channels for one device" in run.output, run.output[-2000:]
+
+
+# --- zoom about the puck, position on a bus ---------------------------------------------------
+
+def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
+    wav = rt.WORK_DIR / "zoom-index.wav"
+    wav.unlink(missing_ok=True)
+    run = rt.require_ok(rt.run_sclang(f"""
+        var dev, ramp, rec, syn, pos;
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 12]]));
+        ramp = Buffer.loadCollection(s, (0..199999));
+        rec = Buffer.alloc(s, 48000 * 2, 2);
+        SynthDef(\\kfZoomIndex, {{ |spm = 500, keep = 1|
+            var x = FrictionMouseIn.ar(0)[0];
+            RecordBuf.ar([SpatialBufRd.ar(1, \\ramp.ir(0), x, spm, 0, 2, keep), x], \\rec.ir(0), loop: 0, doneAction: 2);
+        }}).add;
+        s.sync;
+        1.0.wait;
+        syn = Synth(\\kfZoomIndex, [\\ramp, ramp, \\rec, rec]);
+        1.0.wait;
+        syn.set(\\spm, 1000);          // from sclang, with no bundle: the server decides
+        3.0.wait;                       // the recording (2 s of audio) is over
+        rec.write({rt.sc_string(wav)}, "wav", "float");
+        s.sync;
+        dev.positionBus;
+        0.5.wait;
+        dev.positionBus.getn(4, {{ |v| pos = v }});
+        s.sync; 0.1.wait;
+        "KF-POSITION-BUS %".format(pos.join(" ")).postln;
+        dev.close;
+    """, jack, name="zoom"))
+    import soundfile
+    data, rate = soundfile.read(str(wav), dtype="float64")
+    recorded = np.nonzero(data[:, 0])[0][-1]
+    index, x = data[:recorded, 0], data[:recorded, 1]
+    steps = np.abs(np.diff(index))
+    # Samples per mm, from the index against the position over 100 ms windows: the change is
+    # where it goes from 500 to 1000.
+    w = 4800
+    spm = np.array([(index[i + w] - index[i]) / (x[i + w] - x[i]) if abs(x[i + w] - x[i]) > 0.1 else np.nan
+                    for i in range(0, len(index) - w, w)])
+    first_1000 = int(np.nanargmax(spm > 750))
+    assert np.nanmedian(spm[:first_1000 - 1]) == pytest.approx(500, rel=0.01)
+    assert np.nanmedian(spm[first_1000 + 1:]) == pytest.approx(1000, rel=0.01)
+    lo, hi = (first_1000 - 1) * w, (first_1000 + 1) * w  # the change is in here
+    at = steps[lo:hi].max()
+    around = np.concatenate([steps[max(lo - 9600, 0):lo], steps[hi:hi + 9600]]).max()
+    print(f"KF-FIGURE realtime_zoom_max_step_in_the_change_window_samples {at:.4f} around {around:.4f}")
+    assert at <= around * 1.05 + 1e-3, (at, around)
+    pos = [float(v) for v in run.lines("KF-POSITION-BUS ")[0]]
+    print(f"KF-FIGURE position_bus {pos}")
+    assert pos[0] > 50 and abs(pos[2] - 20) < 5, "x mm and speedX mm/s on the position bus"
