@@ -8,6 +8,7 @@
 #include "Device.hpp"
 #include "DeviceSpec.hpp"
 #include "HandScript.hpp"
+#include "ReplayBackend.hpp"
 #include "SimParams.hpp"
 
 namespace kf {
@@ -20,6 +21,7 @@ std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& s
 // A ReplayBackend of a kf-session or hid-recorder file, with a CountingForceSink as the force
 // side. For kf-session files the spec of the file's header wins over `spec`.
 std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
-                                         std::string& error, DeviceOptions options = {});
+                                         std::string& error, DeviceOptions options = {},
+                                         const ReplayOptions& replay = {});
 
 }  // namespace kf

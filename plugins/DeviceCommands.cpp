@@ -4,7 +4,7 @@
 //
 //   kfOpenSim    index kind numValues values... [key value]...   kind: -1 none, 0 path
 //                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N)
-//   kfOpenReplay index path [key value]...
+//   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry)
 //   kfClose      index
@@ -180,12 +180,13 @@ void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, 
 }
 
 // Applies the overrides to a spec and simulation settings; false (and a message) on a bad key.
-bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim) {
+bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim, kf::ReplayOptions* replay = nullptr) {
   for (int i = 0; i < data->numOverrides; ++i) {
     const char* key = data->keys[i];
     const double value = data->overrideValues[i];
     if (spec.applyOverride(key, value)) continue;
     if (sim != nullptr && sim->applyOverride(key, value)) continue;
+    if (replay != nullptr && replay->applyOverride(key, value)) continue;
     failWith(data, "%s: unknown setting or value out of range: %s = %g", data->name, key, value);
     return false;
   }
@@ -275,10 +276,11 @@ void openSimCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 bool openReplayStage(World* world, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   kf::DeviceSpec spec;
-  if (!applyOverrides(data, spec, nullptr)) return false;
+  kf::ReplayOptions replay;
+  if (!applyOverrides(data, spec, nullptr, &replay)) return false;
   std::string error;
   data->ownsDevice = true;
-  data->device = kf::openReplayDevice(data->path, spec, !world->mRealTime, error).release();
+  data->device = kf::openReplayDevice(data->path, spec, !world->mRealTime, error, {}, replay).release();
   if (data->device == nullptr) failWith(data, "kfOpenReplay: %s", error.c_str());
   return data->device != nullptr;
 }

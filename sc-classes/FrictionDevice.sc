@@ -168,6 +168,7 @@ FrictionDevice {
 		source = argSource;
 		overrides = ();
 		(profile ? ()).keysValuesDo { |key, value|
+			if(value == true or: { value == false }) { value = value.binaryValue };  // loop: true
 			if(value.isNumber.not) { Error("FrictionDevice: setting % must be a number, got %".format(key, value)).throw };
 			overrides[settingNames[key] ? key] = value;  // DESIGN names become setting names
 		};
