@@ -10,7 +10,8 @@
 // (two do not double the magnet-off force), and forces above the floor add up.
 //
 // Writers register with the slot (constructor, destructor: FrictionOut), so the last writer of
-// a block knows it is the last and frames the block at once: no added latency. A registered
+// a block knows it is the last and frames the block at once: no added latency. (A writer that
+// starts after the others of its first block have framed it joins from the next block.) A registered
 // writer that does not run (a paused synth) leaves the block open; the first writer of the
 // next block frames it then, one block late. Audio thread only; nothing allocates.
 #pragma once
@@ -75,6 +76,10 @@ class SlotForce {
 
 template <class Sink>
 bool SlotForce::write(const BlockClock& clock, const float* forceN, int numSamples, Sink& sink) {
+  // A writer whose synth starts this block registers in its first calc (scsynth constructs
+  // units then): if the writers before it have framed the block already, its force joins from
+  // the next block, so no millisecond is framed twice.
+  if (!open_ && framedBlock_ == clock.block) return false;
   if (!open_ || block_.block != clock.block) {
     if (open_) frame(sink);  // a writer of that block never came (paused): framed late
     begin(clock);

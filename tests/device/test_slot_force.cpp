@@ -188,3 +188,21 @@ TEST_CASE("control-rate writers and 44.1 to 192 kHz: still one frame per millise
     for (const Frame& f : sink.frames) REQUIRE(f.forceN == Approx(0.14 + 0.46 + 0.26).epsilon(1e-6));
   }
 }
+
+TEST_CASE("a writer that registers after the block was framed joins from the next block, no frame twice") {
+  // scsynth constructs a synth's units in its first calc: a new writer later in node order
+  // registers after the others of that block have framed it.
+  auto slot = makeSlot(1);
+  Recorder sink;
+  std::vector<float> a(64, 0.3f), b(64, 1.0f);
+  for (int64_t blk = 0; blk < 75; ++blk) {
+    slot->write(clockOf(blk), a.data(), 64, sink);
+    if (blk == 10) slot->registerWriter();  // b's constructor, after a has framed block 10
+    if (blk >= 10) slot->write(clockOf(blk), b.data(), 64, sink);
+  }
+  REQUIRE(sink.frames.size() == 100);
+  for (size_t i = 1; i < sink.frames.size(); ++i)
+    REQUIRE(sink.frames[i].timeS - sink.frames[i - 1].timeS == Approx(0.001).margin(1e-12));
+  CHECK(sink.frames[5].forceN == Approx(0.3));
+  CHECK(sink.frames[20].forceN == Approx(1.16));
+}

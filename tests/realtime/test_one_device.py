@@ -121,7 +121,7 @@ def frames_per_ms(frames, start, end):
     """Frames per millisecond of audio time (the frames' own times) in [start, end): (min, max)
     over the milliseconds, and the frames per 250 ms."""
     audio_t = frames[:, 1]
-    ms = np.floor(audio_t[(audio_t >= start) & (audio_t < end)] * 1000 + 1e-6).astype(int)
+    ms = np.round(audio_t[(audio_t >= start) & (audio_t < end)] * 1000).astype(int)  # frames start on whole ms
     per_ms = np.bincount(ms - int(round(start * 1000)), minlength=int(round((end - start) * 1000)))
     per_250 = [int(per_ms[i:i + 250].sum()) for i in range(0, len(per_ms) - 249, 250)]
     return int(per_ms.min()), int(per_ms.max()), per_250
