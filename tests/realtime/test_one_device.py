@@ -97,6 +97,7 @@ def test_zero_rebases_every_reader_at_once(jack):
         "KF-ZERO-DONE %".format(Main.elapsedTime).postln;
         1.0.wait;
         dev.setPosition(100, 0);
+        "KF-SET-DONE %".format(Main.elapsedTime).postln;
         1.0.wait;
         dev.close;
         [a, b, cmp].do(_.free);
@@ -105,13 +106,16 @@ def test_zero_rebases_every_reader_at_once(jack):
     rows = floats(run, "KF-POS ")
     t, diff, x = rows[:, 0], rows[:, 1], rows[:, 2]
     t_zero = float(run.lines("KF-ZERO ")[0][0])
+    t_zero_done = float(run.lines("KF-ZERO-DONE ")[0][0])
+    t_set_done = float(run.lines("KF-SET-DONE ")[0][0])
     figure("readers_max_abs_difference_mm_across_zero", diff.max())
     assert diff.max() == 0.0
-    before = x[t < t_zero - 0.05]
-    after = x[(t > t_zero + 0.1) & (t < t_zero + 0.5)]
+    before = x[t < t_zero]
+    after = x[(t > t_zero_done + 0.05) & (t < t_set_done)]  # /done: every reader re-based
     assert before[-1] > 15, before[-1]          # ~30 mm/s for 1 s
     assert 0 < after[0] < 15, after[0]          # re-based to 0, moving on at 30 mm/s
-    late = x[t > t_zero + 1.3]
+    assert after[-1] > after[0], "the puck moves on after the zero"
+    late = x[t > t_set_done + 0.05]
     assert late.min() > 100, "setPosition(100) moved every reader to 100 mm"
 
 
