@@ -23,6 +23,7 @@ void SlotTrajectory::reset(const DeviceSpec& spec) {
   xCounts_ = yCounts_ = 0;
   offsetXMm_ = offsetYMm_ = 0.0;
   positionRequested_ = false;
+  reportsTaken_ = 0;
   clock_.reset();
   for (int m = 0; m < kNumModes; ++m) {
     references_[m].~TrajectoryReconstructor();
@@ -40,6 +41,7 @@ void SlotTrajectory::requestPosition(double xMm, double yMm) {
 void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* reports, int numReports, bool lockstep,
                                double lockstepOriginS) {
   const bool continuous = valid_ && lastBlock_ == clock.block - 1;
+  reportsTaken_ += numReports;
   // The references catch up with the previous block, rendered as an audio-rate reader did.
   if (continuous)
     for (TrajectoryReconstructor& reference : references_)

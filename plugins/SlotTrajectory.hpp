@@ -76,6 +76,8 @@ class SlotTrajectory {
   double reportedXMm() const { return countsToMm(xCounts_) + offsetXMm_; }
   double reportedYMm() const { return countsToMm(yCounts_) + offsetYMm_; }
   int64_t lastBlock() const { return lastBlock_; }
+  // Reports handed to takeBlock since reset (a backlog beyond the buffer counts as one).
+  int64_t reportsTaken() const { return reportsTaken_; }
 
  private:
   static int modeIndex(TrajectoryMode mode) { return static_cast<int>(mode); }
@@ -99,6 +101,7 @@ class SlotTrajectory {
                                                     TrajectoryReconstructor(125.0, TrajectoryMode::Predictive)};
   PositionEntry entries_[kMaxEntries];
   int numEntries_ = 0;
+  int64_t reportsTaken_ = 0;
 };
 
 }  // namespace kf::sc

@@ -84,7 +84,7 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
   REQUIRE(kf::sc::exchangeSlot(2, raw) == nullptr);
 
   gAllocations = gLocks = 0;
-  int reportsSeen = 0;
+  int64_t reportsSeen = 0;
   const auto start = std::chrono::steady_clock::now();
   for (int64_t block = 0; std::chrono::steady_clock::now() - start < std::chrono::milliseconds(400); ++block) {
     const double startS = block * kBlock * kSampleDurS;
@@ -94,7 +94,7 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
       const kf::sc::SlotView view = kf::sc::viewSlot(2, kf::sc::BlockClock{block, startS, kSampleDurS, kBlock});
       if (block == 0) trajectory = view.trajectory->reference(kf::TrajectoryMode::Predictive);
       kf::sc::addEntries(trajectory, view.trajectory->entries(), view.trajectory->numEntries());
-      reportsSeen += view.trajectory->numEntries();
+      reportsSeen = view.trajectory->reportsTaken();
       trajectory.render(startS, kSampleDurS, kBlock, 0.0, x.data(), y.data(), vx.data(), vy.data());
       // SpatialBufRd
       const kf::SignalView sv{signal.data(), static_cast<int64_t>(signal.size()), 1};
