@@ -192,6 +192,10 @@ void Device::pumpLocked(double nowS) {
     polled = mouse_->pollReports(nowS, pollBuffer_, kPollBatch);
     for (int i = 0; i < polled; ++i) {
       pollBuffer_[i].hostTimeS = nowS;
+      xCounts_ += pollBuffer_[i].dxCounts;
+      yCounts_ += pollBuffer_[i].dyCounts;
+      pollBuffer_[i].xCounts = xCounts_;
+      pollBuffer_[i].yCounts = yCounts_;
       telemetry_.countReport(pollBuffer_[i].deviceTimeS);
       recorder_.writeReport(nowS, pollBuffer_[i]);
       reportQueue_.push(pollBuffer_[i]);  // a full queue counts the overflow

@@ -150,6 +150,8 @@ class Device {
   size_t pendingHead_ = 0;
   size_t pendingCount_ = 0;
   double releaseLatencyS_;
+  int64_t xCounts_ = 0;  // the puck's position since open (MouseReport::xCounts)
+  int64_t yCounts_ = 0;
 
   std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
   std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads

@@ -23,7 +23,8 @@ std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& s
 }
 
 std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
-                                         std::string& error, DeviceOptions options, std::string* warning) {
+                                         std::string& error, DeviceOptions options, std::string* warning,
+                                         const ReplayOptions& replay) {
   DeviceSpec replaySpec = spec;
   std::vector<TimedReport> reports;
   if (!loadReplayReports(path, replaySpec, reports, error, nullptr, warning)) return nullptr;
@@ -32,7 +33,7 @@ std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSp
     error = path + ": invalid device spec: " + why;
     return nullptr;
   }
-  auto mouse = std::make_shared<ReplayBackend>(std::move(reports));
+  auto mouse = std::make_shared<ReplayBackend>(std::move(reports), replay, replaySpec.updateRateHz);
   auto force = std::make_shared<CountingForceSink>();
   auto device = std::make_unique<Device>(replaySpec, mouse, force, lockstep, options);
   device->start();

@@ -8,6 +8,7 @@
 #include "Device.hpp"
 #include "DeviceSpec.hpp"
 #include "HandScript.hpp"
+#include "ReplayBackend.hpp"
 #include "SimParams.hpp"
 
 namespace kf {
@@ -19,9 +20,10 @@ std::unique_ptr<Device> openSimDevice(const DeviceSpec& spec, const SimParams& s
 
 // A ReplayBackend of a kf-session or hid-recorder file, with a CountingForceSink as the force
 // side. For kf-session files the spec of the file's header wins over `spec`. `warning`
-// receives what was loaded despite a problem (a last line cut mid-way).
+// receives what was loaded despite a problem (a last line cut mid-way); `replay` where to start,
+// whether to loop and at what rate.
 std::unique_ptr<Device> openReplayDevice(const std::string& path, const DeviceSpec& spec, bool lockstep,
-                                         std::string& error, DeviceOptions options = {},
-                                         std::string* warning = nullptr);
+                                         std::string& error, DeviceOptions options = {}, std::string* warning = nullptr,
+                                         const ReplayOptions& replay = {});
 
 }  // namespace kf

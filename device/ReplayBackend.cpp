@@ -1,16 +1,75 @@
 #include "ReplayBackend.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "HidMouseDecoder.hpp"
 #include "HidRecorderFile.hpp"
 #include "HidReportDescriptor.hpp"
+#include "SettingBounds.hpp"
 #include "TextFileReader.hpp"
 
 namespace kf {
 
+bool ReplayOptions::applyOverride(std::string_view key, double value, std::string* error) {
+  double ReplayOptions::*number = key == "startS" ? &ReplayOptions::startS
+                                  : key == "rate" ? &ReplayOptions::rate
+                                                  : nullptr;
+  bool ReplayOptions::*flag = key == "skipIdle" ? &ReplayOptions::skipIdle
+                              : key == "loop"   ? &ReplayOptions::loop
+                                                : nullptr;
+  std::string message;
+  if (number == nullptr && flag == nullptr)
+    message = "unknown replay setting '" + std::string(key) + "'";
+  else
+    message = checkSetting(key, value);
+  if (!message.empty()) {
+    if (error != nullptr) *error = message;
+    return false;
+  }
+  if (number != nullptr)
+    this->*number = value;
+  else
+    this->*flag = value != 0.0;
+  return true;
+}
+
+ReplayBackend::ReplayBackend(std::vector<TimedReport> reports, const ReplayOptions& options, double updateRateHz)
+    : reports_(std::move(reports)), options_(options) {
+  if (!(options_.rate > 0.0) || !std::isfinite(options_.rate)) options_.rate = 1.0;
+  const double intervalS = 1.0 / (updateRateHz > 0.0 ? updateRateHz : 125.0);
+  double startS = options_.startS;
+  if (options_.skipIdle) {
+    for (const TimedReport& r : reports_) {
+      if (r.hostTimeS >= startS && (r.report.dxCounts != 0 || r.report.dyCounts != 0)) {
+        startS = std::max(startS, r.hostTimeS - intervalS);
+        break;
+      }
+    }
+  }
+  // Without options the file plays on its own clock, as recorded (start 0, rate 1).
+  const bool retimed = startS > 0.0 || options_.rate != 1.0 || options_.loop;
+  startFileS_ = retimed ? startS : 0.0;
+  while (first_ < reports_.size() && reports_[first_].hostTimeS < startFileS_) ++first_;
+  next_ = first_;
+  if (first_ < reports_.size()) periodFileS_ = reports_.back().hostTimeS - startFileS_ + intervalS;
+}
+
 int ReplayBackend::pollReports(double untilTimeS, MouseReport* out, int capacity) {
   int written = 0;
-  while (written < capacity && next_ < reports_.size() && reports_[next_].hostTimeS <= untilTimeS)
-    out[written++] = reports_[next_++].report;
+  while (written < capacity) {
+    if (next_ >= reports_.size()) {
+      if (!options_.loop || first_ >= reports_.size() || !(periodFileS_ > 0.0)) break;
+      next_ = first_;  // the next pass: the puck carries on from where the last one left it
+      passOffsetS_ += periodFileS_ / options_.rate;
+    }
+    const TimedReport& r = reports_[next_];
+    if (replayTimeS(r.hostTimeS) > untilTimeS) break;
+    MouseReport report = r.report;
+    report.deviceTimeS = replayTimeS(r.report.deviceTimeS);
+    out[written++] = report;
+    ++next_;
+  }
   return written;
 }
 

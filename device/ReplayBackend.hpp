@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "DeviceSpec.hpp"
@@ -15,18 +16,42 @@
 
 namespace kf {
 
+// How a recording is played for live use. The recorded spec still applies (counts, update
+// rate): only the timing changes.
+struct ReplayOptions {
+  double startS = 0.0;    // file time to start at (reports before it are not played)
+  bool skipIdle = false;  // start one update interval before the first report that moves
+  bool loop = false;      // at the end, start again (the position carries on accumulating)
+  double rate = 1.0;      // 2: twice as fast (same path, speeds doubled)
+
+  // Replay settings by name (startS, skipIdle, loop, rate); false for another key or a value
+  // outside its bounds (SettingBounds), with `error`, if given, saying which.
+  bool applyOverride(std::string_view key, double value, std::string* error = nullptr);
+};
+
 class ReplayBackend : public MouseBackend {
  public:
-  explicit ReplayBackend(std::vector<TimedReport> reports) : reports_(std::move(reports)) {}
+  explicit ReplayBackend(std::vector<TimedReport> reports, const ReplayOptions& options = {},
+                         double updateRateHz = 125.0);
 
   int pollReports(double untilTimeS, MouseReport* out, int capacity) override;
 
   size_t reportCount() const { return reports_.size(); }
-  bool isFinished() const { return next_ >= reports_.size(); }
+  bool isFinished() const { return !options_.loop && next_ >= reports_.size(); }
+  // The file time the replay starts at (after startS / skipIdle).
+  double startFileS() const { return startFileS_; }
 
  private:
+  // Host (release) and device times of report i in the current pass, on the replay's clock.
+  double replayTimeS(double fileTimeS) const { return (fileTimeS - startFileS_) / options_.rate + passOffsetS_; }
+
   std::vector<TimedReport> reports_;
+  ReplayOptions options_;
+  size_t first_ = 0;  // the first report played in every pass
   size_t next_ = 0;
+  double startFileS_ = 0.0;
+  double periodFileS_ = 0.0;  // one pass, in file time
+  double passOffsetS_ = 0.0;  // replay time at which the current pass started
 };
 
 // Force side of a replayed device: counts what it is told (no magnet). Readable from any

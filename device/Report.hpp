@@ -20,6 +20,11 @@ struct MouseReport {
   uint32_t buttons = 0;    // bit i = button i + 1
   uint32_t flags = 0;      // ReportFlag bits
   double hostTimeS = 0.0;  // set by Device: its clock when the device thread took the report
+  // Set by Device: the puck's position after this report, in counts since the device opened.
+  // Every reader of the device derives its position from these, so a reader that starts late
+  // or misses reports (a full queue) still agrees with the others.
+  int64_t xCounts = 0;
+  int64_t yCounts = 0;
 };
 
 // One 1 ms frame: the mean force requested over it.

@@ -26,6 +26,11 @@ constexpr SettingBounds kBounds[] = {
     {"maxDriveLevel", 1e-3, 1.0, false, "of full-scale drive"},
     {"heatTimeConstantS", 0.01, 1e5, false, "s"},
     {"heatRatedDuty", 1e-3, 1.0, false, "of full-scale drive squared"},
+    // ReplayOptions
+    {"startS", 0.0, 1e6, false, "s"},
+    {"rate", 0.01, 100.0, false, ""},  // a replay at 1/100 .. 100 times the recorded speed
+    {"skipIdle", 0.0, 1.0, true, ""},
+    {"loop", 0.0, 1.0, true, ""},
     // SimParams
     {"handStiffnessNPerM", 0.0, 1e4, false, "N/m"},
     {"handDampingNSPerM", 0.0, 1e3, false, "N s/m"},

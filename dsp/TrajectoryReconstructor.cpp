@@ -43,23 +43,37 @@ void TrajectoryReconstructor::reset() {
   mode_ = nextMode_;
 }
 
+void TrajectoryReconstructor::resetAt(double xMm, double yMm) {
+  reset();
+  axes_[0].anchorMm = std::isfinite(xMm) ? xMm : 0.0;
+  axes_[1].anchorMm = std::isfinite(yMm) ? yMm : 0.0;
+  renderedMm_[0] = axes_[0].anchorMm;
+  renderedMm_[1] = axes_[1].anchorMm;
+}
+
 void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags) {
   if (flags & kAfterLossFlag) ++reportsAfterLoss_;
+  enqueue(reportTimeS, dxMm, dyMm, false);
+}
+
+void TrajectoryReconstructor::addShift(double timeS, double dxMm, double dyMm) { enqueue(timeS, dxMm, dyMm, true); }
+
+void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm, bool isShift) {
   if (!std::isfinite(dxMm)) dxMm = 0.0;  // one bad report must not poison the position
   if (!std::isfinite(dyMm)) dyMm = 0.0;
-  if (!std::isfinite(reportTimeS)) reportTimeS = pendingCount_ > 0 ? lastQueuedTimeS_ : lastRenderTimeS_;
-  if (pendingCount_ > 0) reportTimeS = std::max(reportTimeS, lastQueuedTimeS_);
+  if (!std::isfinite(timeS)) timeS = pendingCount_ > 0 ? lastQueuedTimeS_ : lastRenderTimeS_;
+  if (pendingCount_ > 0) timeS = std::max(timeS, lastQueuedTimeS_);
   if (pendingCount_ == kQueueCapacity) {
-    // Full: never drop distance; the newest report absorbs this one.
+    // Full: never drop distance; the newest entry absorbs this one.
     Pending& newest = queue_[(pendingHead_ + pendingCount_ - 1) % kQueueCapacity];
     newest.dMm[0] += dxMm;
     newest.dMm[1] += dyMm;
     ++reportsMerged_;
     return;
   }
-  queue_[(pendingHead_ + pendingCount_) % kQueueCapacity] = Pending{reportTimeS, {dxMm, dyMm}};
+  queue_[(pendingHead_ + pendingCount_) % kQueueCapacity] = Pending{timeS, {dxMm, dyMm}, isShift};
   ++pendingCount_;
-  lastQueuedTimeS_ = reportTimeS;
+  lastQueuedTimeS_ = timeS;
 }
 
 double TrajectoryReconstructor::positionAt(const Axis& axis, double sinceAnchorS) const {
@@ -87,6 +101,11 @@ double TrajectoryReconstructor::speedAt(const Axis& axis, double sinceAnchorS) c
 }
 
 void TrajectoryReconstructor::take(const Pending& report, double nowS) {
+  if (report.isShift) {
+    // Anchor and everything relative to it move together: the output steps by the shift.
+    for (int a = 0; a < 2; ++a) axes_[a].anchorMm += report.dMm[a];
+    return;
+  }
   // Taken at its own time, or at the last rendered sample if that is already past it, so the
   // position just before it is what was (or would have been) output.
   double takeS = std::min(report.timeS, nowS);

@@ -49,11 +49,17 @@ class TrajectoryReconstructor {
 
   // Back to position (0, 0), at rest, no pending reports.
   void reset();
+  // The same at position (xMm, yMm): a reader that joins a moving puck starts where it is.
+  void resetAt(double xMm, double yMm);
 
   // Reports in order of time (an earlier time than the previous report's is taken as that
   // one's). flags: ReportFlag bits (kAfterLoss counts a loss). If the queue is full the
   // displacement is merged into the newest pending report, so no distance is lost.
   void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0);
+  // Moves the coordinates by (dxMm, dyMm) at a time, in order with the reports: a re-basing
+  // (zero, set position), not a movement, so the output steps by exactly that and speed and
+  // interpolation go on as before.
+  void addShift(double timeS, double dxMm, double dyMm);
 
   // Sample i is at startTimeS + i * sampleDurS; times should increase from call to call.
   // originMm is subtracted from x in double before the float output (y is not shifted).
@@ -85,6 +91,7 @@ class TrajectoryReconstructor {
   struct Pending {
     double timeS;
     double dMm[2];
+    bool isShift;
   };
   struct Axis {
     double anchorMm = 0.0;      // reported position: the exact sum of displacements
@@ -92,6 +99,7 @@ class TrajectoryReconstructor {
     double correctionMm = 0.0;  // c: position before the latest report minus the anchor
   };
 
+  void enqueue(double timeS, double dxMm, double dyMm, bool isShift);
   void take(const Pending& report, double nowS);
   double positionAt(const Axis& axis, double sinceAnchorS) const;
   double speedAt(const Axis& axis, double sinceAnchorS) const;

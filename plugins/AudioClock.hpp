@@ -3,6 +3,7 @@
 #pragma once
 
 #include "PluginShared.hpp"
+#include "SlotTrajectory.hpp"
 
 namespace kf::sc {
 
@@ -11,5 +12,16 @@ inline double blockStartTimeS(const World* world) {
 }
 
 inline double blockDurationS(const World* world) { return world->mFullRate.mBufLength * world->mFullRate.mSampleDur; }
+
+// The full-rate block being computed. Audio-rate device UGens render with exactly this
+// sample duration, so that all readers of a slot compute the same sample times.
+inline BlockClock blockClockOf(const World* world) {
+  BlockClock clock;
+  clock.block = world->mBufCounter;
+  clock.startS = blockStartTimeS(world);
+  clock.sampleDurS = 1.0 / world->mFullRate.mSampleRate;
+  clock.numSamples = world->mFullRate.mBufLength;
+  return clock;
+}
 
 }  // namespace kf::sc

@@ -236,6 +236,15 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
       return noneLeft(args, error, errorSize);
     case CommandShape::kRecord:
       return readPath(args, out, error, errorSize) && noneLeft(args, error, errorSize);
+    case CommandShape::kPosition:
+      out.positionMm[0] = out.positionMm[1] = 0.0;
+      for (int axis = 0; axis < 2 && !args.atEnd(); ++axis) {
+        const char* name = axis == 0 ? "xMm" : "yMm";
+        if (!args.readNumber(out.positionMm[axis])) return fail(error, errorSize, "%s: %s", name, describe(args));
+        if (!(std::fabs(out.positionMm[axis]) <= 1e6))
+          return fail(error, errorSize, "%s = %g is out of range -1e6..1e6 mm", name, shown(out.positionMm[axis]));
+      }
+      return noneLeft(args, error, errorSize);
     case CommandShape::kOpenReplay:
       if (!readPath(args, out, error, errorSize)) return false;
       if (out.path[0] == '\0') return fail(error, errorSize, "path: empty");

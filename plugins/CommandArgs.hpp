@@ -53,6 +53,7 @@ enum class CommandShape {
   kOpenSim,     // index kind count values... [key value]...
   kOpenReplay,  // index path [key value]...
   kRecord,      // index path ("" stops)
+  kPosition,    // kfZero: index [xMm yMm]
 };
 
 struct CommandArgs {
@@ -64,6 +65,7 @@ struct CommandArgs {
   char keys[kMaxOverrides][kMaxKeyChars];
   double overrideValues[kMaxOverrides];
   char path[kMaxPathChars];
+  double positionMm[2] = {0.0, 0.0};  // kPosition: x, y
 };
 
 // Storage for `count` hand script values (RTAlloc in the plugin); null: out of memory.

@@ -4,11 +4,19 @@
 //
 //   kfOpenSim    index kind numValues values... [key value]...   kind: -1 none, 0 path
 //                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N)
-//   kfOpenReplay index path [key value]...
+//   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry)
 //   kfClose      index
+//   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
+//                                   default, for every reader, from the next block on)
+//
+// Replies follow the server's conventions: `/done cmdName` when a command succeeded; when it
+// failed, no /done but `/kfFail` to the notified clients (node 0, replyID = the slot index,
+// then the reason as character codes), and the reason is posted. The open commands refuse a
+// slot that holds a device unless given the setting `replace 1`. `/sync` works after all.
 #include <algorithm>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -27,12 +35,53 @@ namespace {
 
 using kf::sc::CommandShape;
 
+constexpr int kMaxReasonChars = 200;
+
 struct CommandData {
   const char* name;
   kf::sc::CommandArgs args;  // args.values: the hand script (kfOpenSim only), RTAlloc'd to its size
   kf::Device* device;        // opened by stage 2, or the target of record/status
   kf::Device* previous;      // swapped out of the slot, deleted in an NRT stage
+  bool replace;              // open commands: a device in the slot is closed, not refused
+  bool ownsDevice;           // open commands: `device` is theirs until published
+  bool failed;               // a stage failed; `reason` says why
+  char reason[kMaxReasonChars];
+  AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
 };
+
+// Records why the command failed; the stage wrappers post it and answer /kfFail with it.
+void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void failWith(CommandData* data, const char* format, ...) {
+  data->failed = true;
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(data->reason, kMaxReasonChars, format, args);
+  va_end(args);
+}
+
+// RT: the failure to the notified clients, as the node reply /kfFail from the root group.
+void replyFailure(World* world, const CommandData* data) {
+  float codes[kMaxReasonChars];
+  int n = 0;
+  for (; n < kMaxReasonChars && data->reason[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(data->reason[n]);
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfFail", n, codes);
+}
+
+// The same from an NRT stage: a copy of the reason travels to the RT thread.
+struct FailureCopy {
+  CommandData data;
+};
+
+void replyFailureFromNrt(World* world, const CommandData* data) {
+  auto* copy = static_cast<FailureCopy*>(NRTAlloc(sizeof(FailureCopy)));
+  if (copy == nullptr) return;
+  std::memcpy(&copy->data, data, sizeof(CommandData));
+  FifoMsg msg;
+  msg.Set(
+      world, [](FifoMsg* m) { replyFailure(m->mWorld, &static_cast<FailureCopy*>(m->mData)->data); },
+      [](FifoMsg* m) { NRTFree(m->mData); }, copy);
+  SendMsgToRT(world, msg);
+}
 
 double* allocValues(void* world, int count) {
   return static_cast<double*>(RTAlloc(static_cast<World*>(world), sizeof(double) * static_cast<size_t>(count)));
@@ -84,6 +133,8 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   }
   data->name = name;
   data->device = data->previous = nullptr;
+  data->replace = data->failed = data->ownsDevice = false;
+  data->reason[0] = '\0';
   kf::sc::OscArgReader reader = readerOf(msg);
   char error[200];
   if (!kf::sc::parseCommandArgs(shape, reader, kf::sc::kNumDeviceSlots, data->args, allocValues, world, error,
@@ -95,27 +146,70 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   return data;
 }
 
+// The stages every command runs, around its own: a failing NRT stage does not end the command
+// (so that the RT stage can answer /kfFail); the last stage sends /done only on success and
+// still runs after a refusal, to delete what was opened for nothing.
+bool wrappedStage2(World* world, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (!data->stages[0](world, data) && !data->failed) failWith(data, "%s failed", data->name);
+  if (data->failed) Print("%s\n", data->reason);
+  return true;
+}
+
+bool wrappedStage3(World* world, void* raw) {  // RT
+  auto* data = static_cast<CommandData*>(raw);
+  const bool failedBefore = data->failed;
+  if (!failedBefore && !data->stages[1](world, data) && !data->failed) failWith(data, "%s failed", data->name);
+  if (data->failed && !failedBefore) kf::sc::postFromRt(world, "%s\n", data->reason);
+  if (data->failed) replyFailure(world, data);
+  return !data->failed || data->device != nullptr || data->previous != nullptr;
+}
+
+bool wrappedStage4(World* world, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->failed) {
+    delete data->previous;                                                        // unpublished: nothing else holds it
+    if (data->ownsDevice && data->previous != data->device) delete data->device;  // never published
+    return false;
+  }
+  if (data->stages[2](world, data)) return true;
+  if (!data->failed) failWith(data, "%s failed", data->name);
+  Print("%s\n", data->reason);
+  replyFailureFromNrt(world, data);
+  return false;
+}
+
 void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
          AsyncStageFn stage4) {
-  DoAsynchronousCommand(world, replyAddr, data->name, data, stage2, stage3, stage4, freeCommand, 0, nullptr);
+  data->stages[0] = stage2;
+  data->stages[1] = stage3;
+  data->stages[2] = stage4;
+  DoAsynchronousCommand(world, replyAddr, data->name, data, wrappedStage2, wrappedStage3, wrappedStage4, freeCommand, 0,
+                        nullptr);
 }
 
 // Applies the overrides to a spec and simulation settings; false (and a message) on a bad key.
-bool applyOverrides(const CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim) {
+bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim, kf::ReplayOptions* replay = nullptr) {
   for (int i = 0; i < data->args.numOverrides; ++i) {
     const char* key = data->args.keys[i];
     const double value = data->args.overrideValues[i];
+    if (std::strcmp(key, "replace") == 0) {  // not a device setting: how to treat a taken slot
+      data->replace = value != 0.0;
+      continue;
+    }
     std::string error;
     if (spec.applyOverride(key, value, &error)) continue;
-    // Not a device setting: perhaps a simulation one (a device setting out of range stays an error).
+    // Not a device setting: perhaps a simulation or replay one (a device setting out of range
+    // stays an error).
     const bool unknown = error.rfind("unknown", 0) == 0;
     if (unknown && sim != nullptr && sim->applyOverride(key, value, &error)) continue;
-    Print("%s: %s; not opened\n", data->name, error.c_str());
+    if (unknown && replay != nullptr && replay->applyOverride(key, value, &error)) continue;
+    failWith(data, "%s: %s; not opened", data->name, error.c_str());
     return false;
   }
   std::string error;
   if (!spec.isValid(&error)) {
-    Print("%s: the device settings do not fit together: %s; not opened\n", data->name, error.c_str());
+    failWith(data, "%s: the device settings do not fit together: %s; not opened", data->name, error.c_str());
     return false;
   }
   return true;
@@ -144,6 +238,11 @@ bool publishStage(World* world, void* raw) {  // RT
   // A lockstep device's time starts with the next block, as a realtime one's starts at open.
   if (data->device != nullptr && data->device->isLockstep())
     data->device->setLockstepOriginS(kf::sc::blockStartTimeS(world));
+  if (!data->replace && kf::sc::peekSlot(data->args.index) != nullptr) {
+    // Refused: the new device is deleted by the last stage; the open one stays.
+    failWith(data, "%s: device index %d is taken; close it first or open with replace", data->name, data->args.index);
+    return true;
+  }
   data->previous = kf::sc::exchangeSlot(data->args.index, data->device);
   return true;
 }
@@ -162,14 +261,15 @@ bool openSimStage(World* world, void* raw) {  // NRT
   if (!applyOverrides(data, spec, &sim)) return false;
   const kf::HandScript hand = handScriptOf(data);
   if (data->args.kind >= 0 && !hand.isValid()) {
-    Print(
-        "kfOpenSim: the hand script is not usable (times must ascend; times, positions and durations within "
-        "+-1e6 s/mm, speeds within +-1e5 mm/s, a force within +-100 N); not opened\n");
+    failWith(data,
+             "kfOpenSim: the hand script is not usable (times must ascend; times, positions and durations within "
+             "+-1e6 s/mm, speeds within +-1e5 mm/s, a force within +-100 N); not opened");
     return false;
   }
   std::string error;
+  data->ownsDevice = true;
   data->device = kf::openSimDevice(spec, sim, hand, !world->mRealTime, &error).release();
-  if (data->device == nullptr) Print("kfOpenSim: %s\n", error.c_str());
+  if (data->device == nullptr) failWith(data, "kfOpenSim: %s", error.c_str());
   return data->device != nullptr;
 }
 
@@ -183,10 +283,12 @@ void openSimCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 bool openReplayStage(World* world, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   kf::DeviceSpec spec;
-  if (!applyOverrides(data, spec, nullptr)) return false;
+  kf::ReplayOptions replay;
+  if (!applyOverrides(data, spec, nullptr, &replay)) return false;
   std::string error, warning;
-  data->device = kf::openReplayDevice(data->args.path, spec, !world->mRealTime, error, {}, &warning).release();
-  if (data->device == nullptr) Print("kfOpenReplay: %s\n", error.c_str());
+  data->ownsDevice = true;
+  data->device = kf::openReplayDevice(data->args.path, spec, !world->mRealTime, error, {}, &warning, replay).release();
+  if (data->device == nullptr) failWith(data, "kfOpenReplay: %s", error.c_str());
   if (!warning.empty()) Print("kfOpenReplay: warning: %s\n", warning.c_str());
   return data->device != nullptr;
 }
@@ -217,7 +319,7 @@ bool unpublishStage(World*, void* raw) {  // RT
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (data->device == nullptr) {
-    Print("kfRecord: no device is open at index %d\n", data->args.index);
+    failWith(data, "kfRecord: no device is open at index %d", data->args.index);
     return false;
   }
   if (data->args.path[0] == '\0') {
@@ -226,7 +328,7 @@ bool recordStage(World*, void* raw) {  // NRT
   }
   std::string error;
   if (!data->device->startRecording(data->args.path, error)) {
-    Print("kfRecord: %s\n", error.c_str());
+    failWith(data, "kfRecord: %s", error.c_str());
     return false;
   }
   return true;
@@ -290,6 +392,24 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   run(world, replyAddr, data, nrtHop, unpublishStage, deletePreviousStage);
 }
 
+// --- kfZero --------------------------------------------------------------------------------
+
+bool rtNothing(World*, void*) { return true; }
+
+void zeroCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  CommandData* data = newCommand(world, "kfZero", CommandShape::kPosition, args);
+  if (data == nullptr) return;
+  // At once, in the RT thread at the command's time (a bundle's time stamp): every reader of
+  // the slot is re-based at the next block. The asynchronous part only answers /done.
+  if (!kf::sc::requestSlotPosition(data->args.index, data->args.positionMm[0], data->args.positionMm[1])) {
+    failWith(data, "kfZero: no device is open at index %d", data->args.index);
+    kf::sc::postFromRt(world, "%s\n", data->reason);
+    replyFailure(world, data);
+    return freeCommand(world, data);
+  }
+  run(world, replyAddr, data, nrtHop, rtNothing, nrtHop);
+}
+
 }  // namespace
 
 void registerDeviceCommands() {
@@ -300,4 +420,5 @@ void registerDeviceCommands() {
   DefinePlugInCmd("kfRecord", recordCmd, nullptr);
   DefinePlugInCmd("kfStatus", statusCmd, nullptr);
   DefinePlugInCmd("kfClose", closeCmd, nullptr);
+  DefinePlugInCmd("kfZero", zeroCmd, nullptr);
 }

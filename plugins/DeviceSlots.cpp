@@ -7,10 +7,10 @@ namespace {
 struct Slot {
   std::atomic<Device*> device{nullptr};
   std::atomic<uint32_t> generation{0};
-  // Audio thread only: this block's reports, popped once per block.
-  int64_t reportsBlock = -1;
-  int numReports = 0;
+  // Audio thread only: the reports popped in a block, and the slot's position.
   MouseReport reports[kMaxReportsPerBlock];
+  SlotTrajectory trajectory;
+  SlotForce force;
 };
 
 Slot gSlots[kNumDeviceSlots];
@@ -56,26 +56,37 @@ Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation) {
   return device;
 }
 
-SlotView viewSlot(int index, int64_t blockCounter, double lockstepTimeS) {
+SlotView viewSlot(int index, const BlockClock& clock) {
   SlotView view;
-  view.device = deviceOfSlot(index, lockstepTimeS, &view.generation);
+  view.device = deviceOfSlot(index, clock.startS + clock.numSamples * clock.sampleDurS, &view.generation);
   if (view.device == nullptr) return view;
   Slot& slot = gSlots[index];
-  if (slot.reportsBlock != blockCounter) {
-    slot.reportsBlock = blockCounter;
-    slot.numReports = view.device->popReports(slot.reports, kMaxReportsPerBlock);
+  if (!slot.trajectory.hasBlock(clock.block)) {
+    int numReports = view.device->popReports(slot.reports, kMaxReportsPerBlock);
+    // A backlog larger than the buffer (nobody read for seconds): the newest report stands for
+    // the rest; its absolute counts include them.
+    if (numReports == kMaxReportsPerBlock)
+      while (view.device->popReports(&slot.reports[kMaxReportsPerBlock - 1], 1) == 1) {
+      }
+    slot.trajectory.takeBlock(clock, slot.reports, numReports, view.device->isLockstep(),
+                              view.device->lockstepOriginS());
   }
-  view.reports = slot.reports;
-  view.numReports = slot.numReports;
+  view.trajectory = &slot.trajectory;
   return view;
+}
+
+bool requestSlotPosition(int index, double xMm, double yMm) {
+  if (!isValidSlot(index) || gSlots[index].device.load(std::memory_order_acquire) == nullptr) return false;
+  gSlots[index].trajectory.requestPosition(xMm, yMm);
+  return true;
 }
 
 Device* exchangeSlot(int index, Device* device) {
   if (!isValidSlot(index)) return device;
   Slot& slot = gSlots[index];
   slot.generation.store(gNextGeneration.fetch_add(1, std::memory_order_relaxed), std::memory_order_release);
-  slot.reportsBlock = -1;
-  slot.numReports = 0;
+  slot.trajectory.reset(device != nullptr ? device->spec() : DeviceSpec{});
+  slot.force.reset(device != nullptr ? device->spec() : DeviceSpec{});
   Device* previous = slot.device.exchange(device, std::memory_order_acq_rel);
   retire(previous);
   return previous;
@@ -94,6 +105,8 @@ void deleteRetired(Device* device) {
   // (the table was full), then this stage owns it alone.
   if (!gExiting.load()) delete device;
 }
+
+SlotForce* forceOfSlot(int index) { return isValidSlot(index) ? &gSlots[index].force : nullptr; }
 
 Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;

@@ -3,14 +3,18 @@
 // pointer it loads once per block, and never keeps it across blocks.
 //
 // Reports are fanned out on the audio side: the first FrictionMouseIn of a block that asks a
-// slot pops its queue (single consumer) into a per-slot buffer that every FrictionMouseIn
-// of that block then reads, so several UGens may follow one device.
+// slot pops its queue (single consumer) into the slot's SlotTrajectory, whose position
+// entries every FrictionMouseIn of that block then reads: one position per device. Forces
+// are fanned in the same way: every FrictionOut of a slot adds into its SlotForce, which sends
+// the device one frame per millisecond.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 
 #include "Device.hpp"
+#include "SlotForce.hpp"
+#include "SlotTrajectory.hpp"
 
 namespace kf::sc {
 
@@ -18,16 +22,22 @@ constexpr int kNumDeviceSlots = 16;
 constexpr int kMaxReportsPerBlock = 256;
 
 struct SlotView {
-  Device* device = nullptr;              // null: closed or never opened
-  uint32_t generation = 0;               // changes whenever the slot's device does
-  const MouseReport* reports = nullptr;  // this block's reports, in order
-  int numReports = 0;
+  Device* device = nullptr;                    // null: closed or never opened
+  uint32_t generation = 0;                     // changes whenever the slot's device does
+  const SlotTrajectory* trajectory = nullptr;  // this block's position entries, references
 };
 
-// Audio thread. Out-of-range indices give an empty view. `blockCounter` is World::mBufCounter;
-// `lockstepTimeS` is the end of the block in audio time, to which a lockstep device is
-// pumped before its reports are taken.
-SlotView viewSlot(int index, int64_t blockCounter, double lockstepTimeS);
+// Audio thread. Out-of-range indices give an empty view. A lockstep device is pumped to the
+// end of the block before its reports are taken.
+SlotView viewSlot(int index, const BlockClock& clock);
+
+// Audio thread (RT stage of kfZero): from the next block on, the slot's latest reported
+// position reads (xMm, yMm). False when no device is open there.
+bool requestSlotPosition(int index, double xMm, double yMm);
+
+// Audio thread: the slot's force combiner (one per slot, whether a device is open or not);
+// null for an out-of-range index.
+SlotForce* forceOfSlot(int index);
 
 // Audio thread: the slot's device, pumped to lockstepTimeS if it runs in lockstep.
 Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation);

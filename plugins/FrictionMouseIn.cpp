@@ -1,12 +1,11 @@
 // FrictionMouseIn: the puck's position and speed from a device slot, reconstructed at audio
-// rate from its timestamped 125 Hz reports.
+// rate from its timestamped 125 Hz reports. The position is the device's (SlotTrajectory):
+// every reader of a slot, whenever it started, reads the same trajectory.
 // Inputs: device (slot index), origin (mm, subtracted from x in double), interpolation
 // (0 hold, 1 linear as the paper, 2 predictive). Outputs: x mm, y mm, speedX, speedY mm/s.
 #include <cmath>
-#include <new>
 
 #include "AudioClock.hpp"
-#include "DeviceClockMapper.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 #include "TrajectoryReconstructor.hpp"
@@ -27,8 +26,8 @@ class FrictionMouseIn : public SCUnit {
  private:
   void next(int numSamples) {
     const int index = kf::sc::slotIndexOf(in0(kDevice));
-    const double startS = kf::sc::blockStartTimeS(mWorld);
-    const kf::sc::SlotView slot = kf::sc::viewSlot(index, mWorld->mBufCounter, startS + kf::sc::blockDurationS(mWorld));
+    const kf::sc::BlockClock clock = kf::sc::blockClockOf(mWorld);
+    const kf::sc::SlotView slot = kf::sc::viewSlot(index, clock);
     if (slot.device == nullptr) {
       if (index < 0)
         mSlot.badIndex(mWorld, "FrictionMouseIn", in0(kDevice), kf::sc::kNumDeviceSlots, "position and speed are 0.");
@@ -37,18 +36,15 @@ class FrictionMouseIn : public SCUnit {
       for (int c = 0; c < 4; ++c) std::fill_n(out(c), numSamples, 0.f);
       return;
     }
-    if (mSlot.isNew(slot.generation)) attach(*slot.device);
-
-    const kf::DeviceSpec& spec = slot.device->spec();
-    const bool lockstep = slot.device->isLockstep();
-    const double originS = slot.device->lockstepOriginS();
-    for (int i = 0; i < slot.numReports; ++i) {
-      const kf::MouseReport& r = slot.reports[i];
-      // Lockstep devices run on audio time; realtime ones on their own clock, mapped here.
-      const double reportS = lockstep ? r.deviceTimeS + originS : mClock.map(r.deviceTimeS, startS);
-      mTrajectory.addReport(reportS, r.dxCounts * spec.countMm, r.dyCounts * spec.countMm, r.flags);
+    const kf::TrajectoryMode mode = kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation)));
+    if (mSlot.isNew(slot.generation)) {
+      // Joins the device where the puck is: the slot's reference for this mode already holds
+      // this block's entries.
+      mTrajectory = slot.trajectory->reference(mode);
+    } else {
+      kf::sc::addEntries(mTrajectory, slot.trajectory->entries(), slot.trajectory->numEntries());
+      mTrajectory.setMode(mode);
     }
-    mTrajectory.setMode(kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation))));
     // A NaN or infinite origin would make every position NaN: 0 instead, said once.
     double originMm = in0(kOriginMm);
     if (!std::isfinite(originMm)) {
@@ -59,18 +55,12 @@ class FrictionMouseIn : public SCUnit {
     } else {
       mWarnedOrigin = false;
     }
-    mTrajectory.render(startS, 1.0 / sampleRate(), numSamples, originMm, out(0), out(1), out(2), out(3));
-  }
-
-  // A new device in the slot: start from its origin, with its update rate.
-  void attach(const kf::Device& device) {
-    mTrajectory.~TrajectoryReconstructor();
-    new (&mTrajectory) kf::TrajectoryReconstructor(device.spec().updateRateHz);
-    mClock.reset();
+    // Audio rate: the slot's own sample duration, so all readers compute the same times.
+    const double sampleDurS = mCalcRate == calc_FullRate ? clock.sampleDurS : 1.0 / sampleRate();
+    mTrajectory.render(clock.startS, sampleDurS, numSamples, originMm, out(0), out(1), out(2), out(3));
   }
 
   kf::TrajectoryReconstructor mTrajectory;
-  kf::DeviceClockMapper mClock;
   kf::sc::SlotFollower mSlot;
   bool mWarnedOrigin = false;
 };

@@ -1,33 +1,66 @@
 // FrictionOut: sends an audio-rate force (N) to a device slot as 1 ms frames, each the mean
-// over its millisecond, clamped to the device's range, NaN/Inf as the minimum. Outputs the
-// force the device actually commanded after its safety path, so it can be scoped and recorded.
+// over its millisecond, clamped to the device's range, NaN/Inf as the minimum. All FrictionOut
+// of a slot are combined into one force (SlotForce: the forces above the minimum add up), so
+// the device gets one frame per millisecond however many write to it. Outputs the force the
+// device actually commanded after its safety path (slew, drive limits, watchdog), so it can be
+// scoped and recorded: per sample for the last writer of a block (the only one when there is
+// one), held from the previous block for the others.
 // Inputs: device (slot index), force (N).
-#include <new>
-
 #include "AudioClock.hpp"
 #include "DeviceSlots.hpp"
-#include "ForceFramer.hpp"
 #include "PluginShared.hpp"
 
 namespace {
 
 enum Input { kDevice, kForceN };
 
+// Pushes the slot's frames to its device, each stamped with the device-clock time its
+// millisecond ended: now, less the audio time between the frame's end and the end of the
+// block being computed. Returns what the device commanded: in lockstep this frame's result,
+// in realtime the latest sent to the magnet.
+struct FrameSink {
+  kf::Device* device;
+  double deviceNowS;
+  double blockEndS;
+  float operator()(double frameTimeS, float forceN, double frameEndS) const {
+    // Lockstep devices take frames on their own time (audio time less their origin).
+    const double deviceFrameS = device->isLockstep() ? frameTimeS - device->lockstepOriginS() : frameTimeS;
+    device->pushForceFrame(kf::ForceFrame{deviceFrameS, forceN, deviceNowS - (blockEndS - frameEndS)});
+    return device->commandedForceN();
+  }
+};
+
 class FrictionOut : public SCUnit {
  public:
   FrictionOut() {
     // Not set_calc_function, which would run a block now and send a frame at the wrong time.
     mCalcFunc = make_calc_function<FrictionOut, &FrictionOut::next>();
+    follow(kf::sc::slotIndexOf(in0(kDevice)));
     out0(0) = mMinForceN;
+  }
+
+  ~FrictionOut() {
+    kf::sc::SlotForce* force = kf::sc::forceOfSlot(mIndex);
+    if (force == nullptr) return;
+    force->unregisterWriter();
+    // The others of this block may all have written already: then the block is framed now.
+    const kf::sc::BlockClock clock = kf::sc::blockClockOf(mWorld);
+    kf::Device* device = kf::sc::deviceOfSlot(mIndex, clock.startS + kf::sc::blockDurationS(mWorld), nullptr);
+    if (device == nullptr) return;
+    FrameSink sink{device, device->nowS(), clock.startS + kf::sc::blockDurationS(mWorld)};
+    force->writerGone(clock, sink);
   }
 
  private:
   void next(int numSamples) {
     const int index = kf::sc::slotIndexOf(in0(kDevice));
-    const double startS = kf::sc::blockStartTimeS(mWorld);
+    if (index != mIndex) follow(index);
+    const kf::sc::BlockClock clock = kf::sc::blockClockOf(mWorld);
+    const double blockEndS = clock.startS + kf::sc::blockDurationS(mWorld);
     uint32_t generation = 0;
-    kf::Device* device = kf::sc::deviceOfSlot(index, startS + kf::sc::blockDurationS(mWorld), &generation);
-    if (device == nullptr) {
+    kf::Device* device = kf::sc::deviceOfSlot(index, blockEndS, &generation);
+    kf::sc::SlotForce* force = kf::sc::forceOfSlot(index);
+    if (device == nullptr || force == nullptr) {
       if (index < 0)
         mSlot.badIndex(mWorld, "FrictionOut", in0(kDevice), kf::sc::kNumDeviceSlots, "no force is sent.");
       else
@@ -35,41 +68,30 @@ class FrictionOut : public SCUnit {
       std::fill_n(out(0), numSamples, mMinForceN);  // no device: its magnet is off
       return;
     }
-    if (mSlot.isNew(generation)) attach(*device);
+    if (mSlot.isNew(generation)) mMinForceN = static_cast<float>(device->spec().minForceN);
 
-    // Each frame is stamped with the device-clock time its millisecond ended: now, less the
-    // audio time between the frame's end and the end of this block.
-    const double blockEndS = startS + numSamples / sampleRate();
-    const double deviceNowS = device->nowS();
-    const double framePeriodS = device->spec().forceFramePeriodS;
-    auto sink = [&](double frameTimeS, float forceN) {
-      // Lockstep devices take frames on their own time (audio time less their origin).
-      const double deviceFrameS = device->isLockstep() ? frameTimeS - device->lockstepOriginS() : frameTimeS;
-      device->pushForceFrame(
-          kf::ForceFrame{deviceFrameS, forceN, deviceNowS - (blockEndS - (frameTimeS + framePeriodS))});
-      // The output shows what the device commanded after its safety path (slew, drive limits,
-      // watchdog): in lockstep this frame's result, in realtime the latest sent to the magnet.
-      mFramer.showCommanded(device->commandedForceN());
-    };
-    const double sampleDurS = 1.0 / sampleRate();
-    if (isAudioRateIn(kForceN)) {
-      mFramer.process(startS, sampleDurS, in(kForceN), numSamples, out(0), sink);
+    FrameSink sink{device, device->nowS(), blockEndS};
+    // A control-rate force is held over the block.
+    const bool audioRate = isAudioRateIn(kForceN);
+    const bool framed = force->write(clock, in(kForceN), audioRate ? clock.numSamples : 1, sink);
+    if (framed && mCalcRate == calc_FullRate) {
+      std::copy_n(force->commanded(), std::min(numSamples, kf::sc::SlotForce::kMaxBlockSamples), out(0));
+    } else if (framed) {
+      out0(0) = force->commanded()[clock.numSamples - 1];
     } else {
-      // A control-rate force is held over the block.
-      const float heldN = in0(kForceN);
-      for (int i = 0; i < numSamples; ++i)
-        mFramer.process(startS + i * sampleDurS, sampleDurS, &heldN, 1, out(0) + i, sink);
+      std::fill_n(out(0), numSamples, force->lastCommandedN());
     }
   }
 
-  void attach(const kf::Device& device) {
-    const kf::DeviceSpec& spec = device.spec();
-    mMinForceN = static_cast<float>(spec.minForceN);
-    mFramer.~ForceFramer();
-    new (&mFramer) kf::ForceFramer(spec.forceFramePeriodS, spec.minForceN, spec.maxForceN);
+  // Registers this writer with a slot (moving from the previous one), so that the slot knows
+  // when a block has all its writers.
+  void follow(int index) {
+    if (kf::sc::SlotForce* previous = kf::sc::forceOfSlot(mIndex)) previous->unregisterWriter();
+    mIndex = index;
+    if (kf::sc::SlotForce* force = kf::sc::forceOfSlot(mIndex)) force->registerWriter();
   }
 
-  kf::ForceFramer mFramer;
+  int mIndex = -1;
   float mMinForceN = static_cast<float>(kf::DeviceSpec{}.minForceN);  // of the last device seen
   kf::sc::SlotFollower mSlot;
 };

@@ -1,6 +1,9 @@
 // SpatialBufRd: plays a buffer laid out on the surface, read at the puck's position.
-// Inputs: bufnum, position (mm), samplesPerMm, origin (mm), interpolation (1, 2, 4).
-// samplesPerMm, origin and interpolation are read once per block.
+// Inputs: bufnum, position (mm), samplesPerMm, origin (mm), interpolation (1, 2, 4), keep
+// (0/1, optional). samplesPerMm, origin, interpolation and keep are read once per block.
+// keep 1: when samplesPerMm or origin change, the sample under the puck stays in place (zoom
+// about the puck): the layout is moved, in double, so that the index at the block's first
+// position is the one the old mapping gave there. The read index stays continuous.
 #include <cmath>
 #include <cstdio>
 
@@ -11,7 +14,7 @@
 
 namespace {
 
-enum Input { kBufnum, kPositionMm, kSamplesPerMm, kOriginMm, kInterpolation };
+enum Input { kBufnum, kPositionMm, kSamplesPerMm, kOriginMm, kInterpolation, kKeep };
 
 // Why a block came out silent; posted once each time it changes.
 enum class BufferProblem { None, BadBufnum, NotAllocated, ChannelMismatch };
@@ -35,7 +38,7 @@ class SpatialBufRd : public SCUnit {
 
     const kf::SignalView signal{buf->data, buf->frames, buf->channels};
     const double samplesPerMm = in0(kSamplesPerMm);
-    const double originMm = in0(kOriginMm);
+    const double originMm = layoutOriginMm(samplesPerMm, in0(kOriginMm));
     const auto interpolation = kf::interpolationFromCode(static_cast<int>(in0(kInterpolation)));
     // One call per block: indices for the whole block first, then the taps (see
     // readSpatialBlock), so an output buffer may share memory with the position input.
@@ -46,6 +49,25 @@ class SpatialBufRd : public SCUnit {
   void silence(BufferProblem problem, const SndBuf* buf, int numSamples) {
     report(problem, buf);
     for (uint32 c = 0; c < mNumOutputs; ++c) std::fill_n(out(c), numSamples, 0.f);
+  }
+
+  // The origin the block reads with: the input, or with keep on, one moved at every change of
+  // samplesPerMm or origin so that the puck's sample stays where it is. Decided here, at the
+  // block the change takes effect.
+  double layoutOriginMm(double samplesPerMm, double originMm) {
+    const bool keep = mNumInputs > kKeep && in0(kKeep) > 0.f;
+    const bool changed = samplesPerMm != mLastSamplesPerMm || originMm != mLastOriginMm;
+    if (!keep || !mStarted) {
+      mLayoutOriginMm = originMm;
+    } else if (changed && std::isfinite(samplesPerMm) && samplesPerMm != 0.0 && std::isfinite(mLastSamplesPerMm)) {
+      const double positionMm = in(kPositionMm)[0];
+      if (std::isfinite(positionMm))
+        mLayoutOriginMm = positionMm - (positionMm - mLayoutOriginMm) * mLastSamplesPerMm / samplesPerMm;
+    }
+    mLastSamplesPerMm = samplesPerMm;
+    mLastOriginMm = originMm;
+    mStarted = true;
+    return mLayoutOriginMm;
   }
 
   // The buffer for the bufnum input, global or local to the synth, or nullptr. As GET_BUF
@@ -97,6 +119,10 @@ class SpatialBufRd : public SCUnit {
   int mBufnum = -1;
   bool mBadBufnum = false;
   kf::sc::PostLimiter mLimits[4];
+  bool mStarted = false;
+  double mLastSamplesPerMm = 0.0;
+  double mLastOriginMm = 0.0;
+  double mLayoutOriginMm = 0.0;
 };
 
 }  // namespace

@@ -8,7 +8,7 @@ FrictionPilot {
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
-	var <buffer, <synth, <defName, monitorBus;
+	var <buffer, <synth, <defName, monitorBus, quitAction;
 
 	*initClass {
 		var pilot = KineticFriction.paperPilot, mapping = KineticFriction.paperMapping;
@@ -101,7 +101,7 @@ FrictionPilot {
 	// friction 0 keeps the magnet at loForceN (use the device's minimum, 0.14 N for the paper).
 	// amp scales only what is heard; the force follows the signal as read (amplitude 1 = 0 dB).
 	*ar { |device = 0, bufnum = 0, samplesPerMm = 4000, origin = 0, friction = 1, amp = 1,
-		audioDelay, loForceN, hiForceN, maxAudioDelay = 0.05|
+		audioDelay, loForceN, hiForceN, maxAudioDelay = 0.05, keep = 0|
 		var mouse, audio, loudness, force, commanded, delayed;
 		audioDelay = audioDelay ? paperAudioDelayS;
 		loForceN = loForceN ? paperLoForceN;
@@ -122,7 +122,7 @@ FrictionPilot {
 			Error("FrictionPilot.ar: audioDelay must be within [0, %] s, got %".format(maxAudioDelay, audioDelay)).throw
 		};
 		mouse = FrictionMouseIn.ar(device, 0, 1);
-		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4);
+		audio = SpatialBufRd.ar(1, bufnum, mouse[0], samplesPerMm, origin, 4, keep);
 		// Equations (1) and (2): 1 ms mean |a| -> dB -> [-30, 0] dB onto [lo, hi] N.
 		loudness = LoudnessToFriction.ar(audio, loForce: loForceN, hiForce: hiForceN);
 		force = loForceN + (friction.clip(0, 1) * (loudness - loForceN));
@@ -157,7 +157,7 @@ FrictionPilot {
 		if(hi <= lo) { Error("FrictionPilot.synthDef: hiForceN (%) must be above loForceN (%)".format(hi, lo)).throw };
 		^SynthDef(name.asSymbol, {
 			var p = this.ar(\device.kr(index), \bufnum.kr(0), \samplesPerMm.kr(4000), \origin.kr(0),
-				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay));
+				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay), \keep.kr(0));
 			Out.ar(\out.kr(0), p[\delayedAudio] ! 2);
 			if(record) {
 				Out.ar(\recordBus.kr(2), [\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
@@ -238,6 +238,9 @@ FrictionPilot {
 		// The synth is claimed now, so that a second play does nothing and a free before it starts
 		// (below) keeps it from starting at all.
 		synth = Synth.basicNew(defName, server);
+		// Cmd-. frees the synth (the buffer stays); a quit frees both: play starts again.
+		CmdPeriod.add(this);
+		quitAction ?? { quitAction = { synth = nil; buffer = nil }; ServerQuit.add(quitAction, server) };
 		forkIfNeeded {
 			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
@@ -246,6 +249,8 @@ FrictionPilot {
 			if(synth === starting) {
 				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm,
 					\origin, origin, \friction, friction, \amp, amp, \out, out, \monitorBus, this.monitorBus.index]));
+				// Freed by anyone (n_free, s.freeAll): forgotten, so that play starts it again.
+				starting.onFree { if(synth === starting) { synth = nil } };
 			};
 		};
 	}
@@ -253,7 +258,17 @@ FrictionPilot {
 	mapping_ { |newMapping|
 		samplesPerMm = this.class.samplesPerMmOf(newMapping);
 		mapping = newMapping;
-		synth !? { synth.set(\samplesPerMm, samplesPerMm) }
+		synth !? { synth.set(\keep, 0, \samplesPerMm, samplesPerMm) }
+	}
+
+	// Changes the mapping (a name of Table 1 or samples per mm) about the puck: the server moves
+	// the layout so that the sample under the puck stays in place (SpatialBufRd's keep), at the
+	// block the change takes effect. From then on origin_ changes keep it in place too; mapping_
+	// goes back to the absolute layout.
+	zoom { |newMapping|
+		samplesPerMm = this.class.samplesPerMmOf(newMapping);
+		mapping = newMapping;
+		synth !? { synth.set(\keep, 1, \samplesPerMm, samplesPerMm) }
 	}
 
 	friction_ { |on|
@@ -272,10 +287,18 @@ FrictionPilot {
 	// view keeps reading it across free and play.
 	monitorBus { ^monitorBus ?? { monitorBus = Bus.control(this.server, 5) } }
 
+	isPlaying { ^synth.notNil }
+
+	// Cmd-. has freed the synth: the pilot is stopped, and play starts it again.
+	cmdPeriod { synth = nil; CmdPeriod.remove(this) }
+
 	free {
 		synth !? { synth.free };
 		synth = nil;
 		monitorBus !? { monitorBus.setn(0 ! 5) };
+		CmdPeriod.remove(this);
+		quitAction !? { ServerQuit.remove(quitAction, this.server) };
+		quitAction = nil;
 		buffer !? { buffer.free };
 		buffer = nil;
 	}

@@ -211,9 +211,9 @@ FrictionView {
 		positionBus = argPositionBus;
 		frameRate = argFrameRate;
 		historyS = argHistoryS;
-		minForceN = if(device.isKindOf(FrictionDevice)) { device.specs[\minForce] } { FrictionPilot.paperLoForceN };
+		minForceN = if(device.isKindOf(FrictionDevice)) { device.specs[\minForceN] } { FrictionPilot.paperLoForceN };
 		forceRangeN = if(pilot.notNil) { [0, FrictionPilot.paperHiForceN * 1.2] } {
-			[0, if(device.isKindOf(FrictionDevice)) { device.specs[\maxForce] } { 1.4 }]
+			[0, if(device.isKindOf(FrictionDevice)) { device.specs[\maxForceN] } { KineticFriction.paperDevice[\maxForceN] }]
 		};
 		history = Array.fill((historyS * frameRate * 1.5).ceil.asInteger + 16, { FloatArray.newClear(5) });
 		rangeMm = [-10, 10];

@@ -1,12 +1,13 @@
 // Plays a buffer laid out on the surface: the sample at index (position - origin) * samplesPerMm,
-// silent outside the signal. Positions in mm.
+// silent outside the signal. Positions in mm. keep 1: a change of samplesPerMm or origin keeps
+// the sample under the puck in place (zoom about the puck), decided on the server.
 SpatialBufRd : MultiOutUGen {
-	*ar { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4|
-		^this.multiNew('audio', numChannels, bufnum, position, samplesPerMm, origin, interpolation)
+	*ar { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4, keep = 0|
+		^this.multiNew('audio', numChannels, bufnum, position, samplesPerMm, origin, interpolation, keep)
 	}
 
-	*kr { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4|
-		^this.multiNew('control', numChannels, bufnum, position, samplesPerMm, origin, interpolation)
+	*kr { |numChannels = 1, bufnum = 0, position = 0, samplesPerMm = 1, origin = 0, interpolation = 4, keep = 0|
+		^this.multiNew('control', numChannels, bufnum, position, samplesPerMm, origin, interpolation, keep)
 	}
 
 	init { |argNumChannels ... theInputs|

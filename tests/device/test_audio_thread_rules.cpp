@@ -106,13 +106,11 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
   constexpr int kBlock = 64;
   constexpr double kSampleDurS = 1.0 / 48000;
   // Set up as the NRT stages and constructors do (allocation allowed here).
-  std::vector<float> history(960), signal(24000), audio(kBlock), forceN(kBlock), commandedN(kBlock);
+  std::vector<float> history(960), signal(24000), audio(kBlock), forceN(kBlock);
   for (size_t i = 0; i < signal.size(); ++i) signal[i] = static_cast<float>(std::sin(i * 0.0628));
   kf::LoudnessToFriction loudness(history.data(), static_cast<int>(history.size()));
   loudness.setWindowSamples(48);
   kf::TrajectoryReconstructor trajectory(125.0, kf::TrajectoryMode::Predictive);
-  kf::DeviceClockMapper clock;
-  kf::ForceFramer framer(0.001, 0.14, 1.4);
   std::vector<float> x(kBlock), y(kBlock), vx(kBlock), vy(kBlock);
 
   std::string error;
@@ -123,18 +121,17 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
   REQUIRE(kf::sc::exchangeSlot(2, raw) == nullptr);
 
   gAllocations = gLocks = 0;
-  int reportsSeen = 0;
+  int64_t reportsSeen = 0;
   const auto start = std::chrono::steady_clock::now();
   for (int64_t block = 0; std::chrono::steady_clock::now() - start < std::chrono::milliseconds(400); ++block) {
     const double startS = block * kBlock * kSampleDurS;
     {
       AudioSection audioThread;
       // FrictionMouseIn
-      const kf::sc::SlotView view = kf::sc::viewSlot(2, block, startS + kBlock * kSampleDurS);
-      for (int i = 0; i < view.numReports; ++i)
-        trajectory.addReport(clock.map(view.reports[i].deviceTimeS, startS), view.reports[i].dxCounts * 0.021, 0.0,
-                             view.reports[i].flags);
-      reportsSeen += view.numReports;
+      const kf::sc::SlotView view = kf::sc::viewSlot(2, kf::sc::BlockClock{block, startS, kSampleDurS, kBlock});
+      if (block == 0) trajectory = view.trajectory->reference(kf::TrajectoryMode::Predictive);
+      kf::sc::addEntries(trajectory, view.trajectory->entries(), view.trajectory->numEntries());
+      reportsSeen = view.trajectory->reportsTaken();
       trajectory.render(startS, kSampleDurS, kBlock, 0.0, x.data(), y.data(), vx.data(), vy.data());
       // SpatialBufRd
       const kf::SignalView sv{signal.data(), static_cast<int64_t>(signal.size()), 1};
@@ -145,8 +142,12 @@ TEST_CASE("a block of every UGen's work allocates nothing and locks nothing") {
       // FrictionOut
       uint32_t generation = 0;
       kf::Device* d = kf::sc::deviceOfSlot(2, startS, &generation);
-      auto sink = [d](double timeS, float f) { d->pushForceFrame(kf::ForceFrame{timeS, f, d->nowS()}); };
-      framer.process(startS, kSampleDurS, forceN.data(), kBlock, commandedN.data(), sink);
+      auto sink = [d](double timeS, float f, double) {
+        d->pushForceFrame(kf::ForceFrame{timeS, f, d->nowS()});
+        return d->commandedForceN();
+      };
+      kf::sc::forceOfSlot(2)->write(kf::sc::BlockClock{block, startS, kSampleDurS, kBlock}, forceN.data(), kBlock,
+                                    sink);
     }
     std::this_thread::sleep_for(std::chrono::microseconds(1333));  // a block of real time
   }

@@ -1,0 +1,203 @@
+// SlotTrajectory: one position per device. Readers that start at different times agree to the
+// sample, a late reader starts where the puck is, re-basing moves every reader at once, and
+// reports lost on the way still count (absolute counts).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <vector>
+
+#include "SlotTrajectory.hpp"
+
+using kf::MouseReport;
+using kf::TrajectoryMode;
+using kf::TrajectoryReconstructor;
+using kf::sc::BlockClock;
+using kf::sc::SlotTrajectory;
+
+namespace {
+
+constexpr int kBlock = 64;
+constexpr double kSampleDurS = 1.0 / 48000.0;
+constexpr double kCountMm = 0.021;
+
+// A reader as FrictionMouseIn is one: copies the reference when it starts, then follows the
+// entries and renders every block at audio rate.
+struct Reader {
+  TrajectoryMode mode;
+  bool started = false;
+  TrajectoryReconstructor trajectory;
+  std::vector<float> x = std::vector<float>(kBlock), speed = std::vector<float>(kBlock);
+
+  explicit Reader(TrajectoryMode m) : mode(m) {}
+  void block(const SlotTrajectory& slot, const BlockClock& clock) {
+    if (!started) {
+      trajectory = slot.reference(mode);
+      started = true;
+    } else {
+      kf::sc::addEntries(trajectory, slot.entries(), slot.numEntries());
+    }
+    trajectory.render(clock.startS, clock.sampleDurS, clock.numSamples, 0.0, x.data(), nullptr, speed.data(), nullptr);
+  }
+};
+
+// Reports of a puck moving at varying speed: 125 Hz, counts from a sine speed profile.
+struct Puck {
+  int64_t xCounts = 0;
+  int64_t yCounts = 0;
+  double nextReportS = 0.008;
+  int index = 0;
+  // Reports due up to timeS (device time = audio time, lockstep).
+  int poll(double untilS, MouseReport* out, int capacity) {
+    int n = 0;
+    while (nextReportS <= untilS && n < capacity) {
+      const int dx = static_cast<int>(std::lround(40.0 * std::sin(index * 0.05)));
+      xCounts += dx;
+      yCounts += 1;
+      MouseReport r;
+      r.deviceTimeS = nextReportS;
+      r.dxCounts = dx;
+      r.dyCounts = 1;
+      r.xCounts = xCounts;
+      r.yCounts = yCounts;
+      out[n++] = r;
+      nextReportS += 0.008;
+      ++index;
+    }
+    return n;
+  }
+};
+
+BlockClock clockOf(int64_t block) { return BlockClock{block, block * kBlock * kSampleDurS, kSampleDurS, kBlock}; }
+
+}  // namespace
+
+TEST_CASE("two readers of one slot agree to the sample, whenever each started") {
+  for (TrajectoryMode mode : {TrajectoryMode::Hold, TrajectoryMode::Linear, TrajectoryMode::Predictive}) {
+    kf::DeviceSpec spec;
+    SlotTrajectory slot;
+    slot.reset(spec);
+    Puck puck;
+    Reader early(mode), late(mode);
+    MouseReport reports[64];
+    int compared = 0;
+    for (int64_t b = 0; b < 3000; ++b) {
+      const BlockClock clock = clockOf(b);
+      const int n = puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64);
+      slot.takeBlock(clock, reports, n, /*lockstep=*/true, 0.0);
+      early.block(slot, clock);
+      if (b >= 1234) {  // 1.6 s later, in the middle of a movement
+        late.block(slot, clock);
+        for (int i = 0; i < kBlock; ++i) {
+          REQUIRE(late.x[i] == early.x[i]);
+          REQUIRE(late.speed[i] == early.speed[i]);
+        }
+        ++compared;
+      }
+    }
+    CHECK(compared == 3000 - 1234);
+    // And both sit on the device's absolute position once the last report has played out.
+    CHECK(early.trajectory.reportedXMm() == Approx(puck.xCounts * kCountMm).margin(1e-9));
+  }
+}
+
+TEST_CASE("a reader that starts late starts where the puck is, not at 0") {
+  kf::DeviceSpec spec;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  Puck puck;
+  Reader early(TrajectoryMode::Linear);
+  MouseReport reports[64];
+  for (int64_t b = 0; b < 1000; ++b) {
+    const BlockClock clock = clockOf(b);
+    slot.takeBlock(clock, reports, puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64), true, 0.0);
+    early.block(slot, clock);
+  }
+  REQUIRE(std::abs(early.x[kBlock - 1]) > 10.0);  // the puck has moved away from 0
+  const BlockClock clock = clockOf(1000);
+  slot.takeBlock(clock, reports, puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64), true, 0.0);
+  Reader late(TrajectoryMode::Linear);
+  late.block(slot, clock);
+  early.block(slot, clock);
+  CHECK(late.x[0] == early.x[0]);
+  CHECK(late.x[kBlock - 1] == early.x[kBlock - 1]);
+}
+
+TEST_CASE("re-basing (kfZero) moves every reader at the same block by the same step") {
+  kf::DeviceSpec spec;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  Puck puck;
+  Reader a(TrajectoryMode::Linear), b(TrajectoryMode::Predictive);
+  MouseReport reports[64];
+  double before = 0.0;
+  for (int64_t blk = 0; blk < 1500; ++blk) {
+    const BlockClock clock = clockOf(blk);
+    if (blk == 900) {
+      before = slot.reportedXMm();
+      slot.requestPosition(0.0, 5.0);
+    }
+    slot.takeBlock(clock, reports, puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64), true, 0.0);
+    if (blk == 900) {
+      // The latest reported position (before this block's reports) became (0, 5): the block's
+      // first entry is the shift, then the reports move on from there.
+      REQUIRE(slot.numEntries() >= 1);
+      CHECK(slot.entries()[0].isShift);
+      CHECK(slot.entries()[0].dxMm == Approx(-before));
+    }
+    const float ax = a.x[kBlock - 1];
+    a.block(slot, clock);
+    b.block(slot, clock);
+    if (blk == 900) CHECK(std::abs(a.x[0] - (ax - before)) < 0.5);  // stepped by -before, not drifted
+  }
+  // After re-basing, the absolute position is the counts since the zero plus the new origin.
+  CHECK(slot.reportedXMm() == Approx(puck.xCounts * kCountMm - before).margin(1e-9));
+  CHECK(a.trajectory.reportedXMm() == Approx(slot.reportedXMm()).margin(1e-9));
+  CHECK(b.trajectory.reportedYMm() == Approx(slot.reportedYMm()).margin(1e-9));
+}
+
+TEST_CASE("reports lost before the slot (a full queue) still count, and a gap restarts at the position") {
+  kf::DeviceSpec spec;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  Puck puck;
+  Reader r(TrajectoryMode::Linear);
+  MouseReport reports[64];
+  for (int64_t b = 0; b < 400; ++b) {
+    const BlockClock clock = clockOf(b);
+    int n = puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64);
+    if (b % 10 == 3) n = 0;  // these reports are lost; later ones carry their counts
+    slot.takeBlock(clock, reports, n, true, 0.0);
+    r.block(slot, clock);
+  }
+  // Blocks 400..599: nobody looks. Then a new reader and the old one come back.
+  for (int64_t b = 400; b < 600; ++b) puck.poll(clockOf(b).startS + kBlock * kSampleDurS, reports, 64);
+  const BlockClock clock = clockOf(600);
+  const int n = puck.poll(clock.startS + kBlock * kSampleDurS, reports, 64);
+  slot.takeBlock(clock, reports, n, true, 0.0);
+  Reader fresh(TrajectoryMode::Linear);
+  fresh.block(slot, clock);
+  CHECK(slot.numEntries() == 0);  // the backlog counts for its position only
+  CHECK(fresh.x[0] == Approx(puck.xCounts * kCountMm).margin(1e-4));
+}
+
+TEST_CASE("realtime: one clock mapping for the slot, so readers agree under arrival jitter") {
+  kf::DeviceSpec spec;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  Puck puck;
+  Reader early(TrajectoryMode::Predictive), late(TrajectoryMode::Predictive);
+  MouseReport reports[64];
+  uint32_t seed = 12345;
+  for (int64_t b = 0; b < 2000; ++b) {
+    const BlockClock clock = clockOf(b);
+    // Device clock 0.3 s behind audio, reports arriving one block late now and then.
+    seed = seed * 1664525u + 1013904223u;
+    const double lagS = (seed >> 28) == 0 ? kBlock * kSampleDurS : 0.0;
+    int n = puck.poll(clock.startS - 0.3 - lagS, reports, 64);
+    slot.takeBlock(clock, reports, n, /*lockstep=*/false, 0.0);
+    early.block(slot, clock);
+    if (b >= 777) {
+      late.block(slot, clock);
+      for (int i = 0; i < kBlock; ++i) REQUIRE(late.x[i] == early.x[i]);
+    }
+  }
+}

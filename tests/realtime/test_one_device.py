@@ -1,0 +1,266 @@
+"""One puck, one force (issue 14), on a realtime server (JACK dummy) with a simulated device:
+readers started at different times read the same position, several force writers and a
+JITLib crossfade give one frame per millisecond that never alternates, and the life cycle
+(answers, taken slots, Cmd-., reboot) behaves as SuperCollider's conventions say.
+
+Each test prints its measured figures on a line starting with KF-FIGURE.
+"""
+import numpy as np
+import pytest
+
+from kfharness import paths, readers, sclang
+from kfharness.jack import JackServer
+
+COUNT_MM = 0.021
+
+
+@pytest.fixture
+def jack():
+    with JackServer() as server:
+        yield server
+
+
+def figure(name, value):
+    print(f"KF-FIGURE {name} {value}")
+
+
+def floats(run, tag):
+    rows = [[float(v) for v in r] for r in run.lines(tag)]
+    return np.array(rows)
+
+
+def session_frames(path):
+    header, records = readers.read_session(path)
+    return np.array([f for tag, f in records if tag == "F"])
+
+
+# --- one position ------------------------------------------------------------------------------
+
+def test_two_readers_agree_to_the_sample_and_a_late_reader_starts_where_the_puck_is(jack):
+    run = sclang.require_ok(sclang.run_with_server(r"""
+        var dev, a, b, cmp, busA = Bus.audio(s, 1), busB = Bus.audio(s, 1);
+        ~diff = List.new;
+        OSCdef(\kfDiff, { |msg| ~diff.add(msg[3..]) }, '/kfDiff');
+        SynthDef(\kfReader, { |bus| Out.ar(bus, FrictionMouseIn.ar(0)[0]) }).add;
+        // Sample by sample |a - b| (max so far), and both positions.
+        SynthDef(\kfCompare, { |busA, busB|
+            var a = In.ar(busA), b = In.ar(busB);
+            SendReply.ar(Impulse.ar(20), '/kfDiff', [RunningMax.ar((a - b).abs), a, b]);
+        }).add;
+        s.sync;
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 1], [-30, 1], [40, 2]]));
+        "KF-OPEN %".format(dev.isOpen).postln;
+        a = Synth(\kfReader, [\bus, busA]);
+        1.5.wait;
+        // B and its comparer start in one bundle, at one block.
+        s.bind {
+            b = Synth(\kfReader, [\bus, busB]);
+            cmp = Synth.tail(s, \kfCompare, [\busA, busA, \busB, busB]);
+        };
+        2.5.wait;
+        dev.close;
+        [a, b, cmp].do(_.free);
+        ~diff.do { |row| ("KF-DIFF " ++ row.join(" ")).postln };
+    """, jack, name="readers"))
+    assert run.lines("KF-OPEN ")[0] == ["true"], "the open waits for /done inside a Routine"
+    rows = floats(run, "KF-DIFF ")
+    assert len(rows) >= 20, run.output[-2000:]
+    max_diff = rows[:, 0].max()
+    first_a, first_b = rows[0, 1], rows[0, 2]
+    figure("readers_max_abs_difference_mm", max_diff)
+    figure("late_reader_first_x_mm", first_b)
+    figure("early_reader_x_mm_at_that_time", first_a)
+    assert max_diff == 0.0, f"two readers differ by up to {max_diff} mm"
+    assert first_b > 5.0, f"the late reader starts at {first_b} mm, not where the puck is"
+    assert np.ptp(rows[:, 1]) > 5.0, "the puck should move while they are compared"
+
+
+def test_zero_rebases_every_reader_at_once(jack):
+    run = sclang.require_ok(sclang.run_with_server(r"""
+        var dev, a, b, cmp, busA = Bus.audio(s, 1), busB = Bus.audio(s, 1);
+        ~rows = List.new;
+        OSCdef(\kfPos, { |msg| ~rows.add([Main.elapsedTime] ++ msg[3..]) }, '/kfPos');
+        SynthDef(\kfReader, { |bus, mode = 1| Out.ar(bus, FrictionMouseIn.ar(0, 0, mode)[0]) }).add;
+        SynthDef(\kfCompare, { |busA, busB|
+            var a = In.ar(busA), b = In.ar(busB);
+            SendReply.ar(Impulse.ar(50), '/kfPos', [RunningMax.ar((a - b).abs), a]);
+        }).add;
+        s.sync;
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[30, 3]]));
+        s.bind {
+            a = Synth(\kfReader, [\bus, busA]);
+            b = Synth(\kfReader, [\bus, busB]);
+            cmp = Synth.tail(s, \kfCompare, [\busA, busA, \busB, busB]);
+        };
+        1.0.wait;
+        "KF-ZERO %".format(Main.elapsedTime).postln;
+        dev.zero;        // waits for /done inside a Routine
+        "KF-ZERO-DONE %".format(Main.elapsedTime).postln;
+        1.0.wait;
+        dev.setPosition(100, 0);
+        "KF-SET-DONE %".format(Main.elapsedTime).postln;
+        1.0.wait;
+        dev.close;
+        [a, b, cmp].do(_.free);
+        ~rows.do { |row| ("KF-POS " ++ row.join(" ")).postln };
+    """, jack, name="zero"))
+    rows = floats(run, "KF-POS ")
+    t, diff, x = rows[:, 0], rows[:, 1], rows[:, 2]
+    t_zero = float(run.lines("KF-ZERO ")[0][0])
+    t_zero_done = float(run.lines("KF-ZERO-DONE ")[0][0])
+    t_set_done = float(run.lines("KF-SET-DONE ")[0][0])
+    figure("readers_max_abs_difference_mm_across_zero", diff.max())
+    assert diff.max() == 0.0
+    before = x[t < t_zero]
+    after = x[(t > t_zero_done + 0.05) & (t < t_set_done)]  # /done: every reader re-based
+    assert before[-1] > 15, before[-1]          # ~30 mm/s for 1 s
+    assert 0 < after[0] < 15, after[0]          # re-based to 0, moving on at 30 mm/s
+    assert after[-1] > after[0], "the puck moves on after the zero"
+    late = x[t > t_set_done + 0.05]
+    assert late.min() > 100, "setPosition(100) moved every reader to 100 mm"
+
+
+# --- one force ---------------------------------------------------------------------------------
+
+def frames_per_ms(frames, start, end):
+    """Frames per millisecond of audio time (the frames' own times) in [start, end): (min, max)
+    over the milliseconds, and the frames per 250 ms."""
+    audio_t = frames[:, 1]
+    ms = np.round(audio_t[(audio_t >= start) & (audio_t < end)] * 1000).astype(int)  # frames start on whole ms
+    per_ms = np.bincount(ms - int(round(start * 1000)), minlength=int(round((end - start) * 1000)))
+    per_250 = [int(per_ms[i:i + 250].sum()) for i in range(0, len(per_ms) - 249, 250)]
+    return int(per_ms.min()), int(per_ms.max()), per_250
+
+
+def reversals(values, tolerance=1e-4):
+    d = np.diff(values)
+    d = d[np.abs(d) > tolerance]
+    return int(np.sum(np.sign(d[1:]) != np.sign(d[:-1])))
+
+
+def test_a_jitlib_crossfade_into_the_force_bus_hands_over_smoothly(jack):
+    record = paths.work_dir() / "crossfade.kfs"
+    record.unlink(missing_ok=True)
+    sclang.require_ok(sclang.run_with_server(f"""
+        var dev;
+        dev = FrictionDevice.sim(s, 0);
+        Ndef(\\friction).fadeTime = 0.5;
+        Ndef(\\friction, {{ DC.ar(0.3) }});
+        Ndef(\\friction).play(dev.forceBus.index, 1);
+        s.sync;
+        dev.record({sclang.sc_string(record)});
+        1.0.wait;
+        "KF-SWITCH".postln;
+        dev.status;
+        Ndef(\\friction, {{ DC.ar(1.0) }});
+        1.5.wait;
+        dev.close;
+        Ndef(\\friction).clear;
+    """, jack, name="crossfade"))
+    frames = session_frames(record)
+    t, commanded = frames[:, 0], frames[:, 3]
+    # The switch: the first frame above 0.31 N.
+    t = frames[:, 1]  # audio time
+    t_switch = t[np.argmax(commanded > 0.31)]
+    fade = (t >= t_switch - 0.05) & (t <= t_switch + 0.6)
+    lo, hi, counts = frames_per_ms(frames, np.ceil(t_switch * 1000) / 1000 - 0.25,
+                                   np.ceil(t_switch * 1000) / 1000 + 0.75)
+    alternations = reversals(commanded[fade])
+    figure("crossfade_frames_per_ms_min_max", (lo, hi))
+    figure("crossfade_frames_per_250ms", counts)
+    figure("crossfade_direction_reversals", alternations)
+    figure("crossfade_force_range_N", (commanded[fade].min(), commanded[fade].max()))
+    assert (lo, hi) == (1, 1), "exactly one frame in every millisecond"
+    assert alternations == 0
+    assert commanded[fade].min() >= 0.3 - 1e-3 and commanded[fade].max() <= 1.0 + 1e-3
+    assert np.all(np.diff(commanded[fade]) >= -1e-4), "the force only rises from 0.3 to 1.0 N"
+    assert commanded[t > t_switch + 0.6].min() == pytest.approx(1.0, abs=1e-3)
+
+
+def test_several_friction_outs_on_one_slot_send_one_combined_frame_per_millisecond(jack):
+    record = paths.work_dir() / "writers.kfs"
+    record.unlink(missing_ok=True)
+    sclang.require_ok(sclang.run_with_server(f"""
+        var dev, a, b, c;
+        dev = FrictionDevice.sim(s, 0);
+        dev.record({sclang.sc_string(record)});
+        a = {{ FrictionOut.ar(0, DC.ar(0.3)); Silent.ar }}.play;
+        b = {{ FrictionOut.ar(0, DC.ar(1.0)); Silent.ar }}.play;
+        c = {{ FrictionOut.ar(0, DC.ar(0.14)); Silent.ar }}.play;  // idle: adds nothing
+        1.5.wait;
+        [a, b, c].do(_.free);
+        0.2.wait;
+        dev.close;
+    """, jack, name="writers"))
+    frames = session_frames(record)
+    t, commanded = frames[:, 0], frames[:, 3]
+    t = frames[:, 1]  # audio time
+    steady = (t > t[0] + 0.3) & (t < t[0] + 1.2)
+    lo, hi, counts = frames_per_ms(frames, np.ceil(t[0] * 1000) / 1000 + 0.3, np.ceil(t[0] * 1000) / 1000 + 1.05)
+    figure("three_writers_frames_per_ms_min_max", (lo, hi))
+    figure("three_writers_frames_per_250ms", counts)
+    figure("three_writers_force_N", np.unique(np.round(commanded[steady], 5)).tolist())
+    figure("three_writers_direction_reversals", reversals(commanded[steady]))
+    assert (lo, hi) == (1, 1), "exactly one frame in every millisecond"
+    assert np.allclose(commanded[steady], 0.14 + 0.16 + 0.86, atol=1e-4)
+    assert reversals(commanded[steady]) == 0
+
+
+def test_a_multichannel_force_into_one_slot_is_rejected_when_the_synthdef_is_built(jack):
+    run = sclang.run_with_server(r"""
+        SynthDef(\kfTwo, { FrictionOut.ar(0, [DC.ar(0.3), DC.ar(1.0)]) }).add;
+    """, jack, name="multichannel")
+    assert not run.ok
+    assert "FrictionOut: force has 2 channels for one device" in run.output, run.output[-2000:]
+
+
+# --- zoom about the puck, position on a bus ---------------------------------------------------
+
+def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
+    wav = paths.work_dir() / "zoom-index.wav"
+    wav.unlink(missing_ok=True)
+    run = sclang.require_ok(sclang.run_with_server(f"""
+        var dev, ramp, rec, syn, pos;
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 12]]));
+        ramp = Buffer.loadCollection(s, (0..199999));
+        rec = Buffer.alloc(s, 48000 * 2, 2);
+        SynthDef(\\kfZoomIndex, {{ |spm = 500, keep = 1|
+            var x = FrictionMouseIn.ar(0)[0];
+            RecordBuf.ar([SpatialBufRd.ar(1, \\ramp.ir(0), x, spm, 0, 2, keep), x], \\rec.ir(0), loop: 0, doneAction: 2);
+        }}).add;
+        s.sync;
+        1.0.wait;
+        syn = Synth(\\kfZoomIndex, [\\ramp, ramp, \\rec, rec]);
+        1.0.wait;
+        syn.set(\\spm, 1000);          // from sclang, with no bundle: the server decides
+        3.0.wait;                       // the recording (2 s of audio) is over
+        rec.write({sclang.sc_string(wav)}, "wav", "float");
+        s.sync;
+        dev.positionBus;
+        0.5.wait;
+        dev.positionBus.getn(4, {{ |v| pos = v }});
+        s.sync; 0.1.wait;
+        "KF-POSITION-BUS %".format(pos.join(" ")).postln;
+        dev.close;
+    """, jack, name="zoom"))
+    import soundfile
+    data, rate = soundfile.read(str(wav), dtype="float64")
+    recorded = np.nonzero(data[:, 0])[0][-1]
+    index, x = data[:recorded, 0], data[:recorded, 1]
+    steps = np.abs(np.diff(index))
+    # Samples per mm, from the index against the position over 100 ms windows: the change is
+    # where it goes from 500 to 1000.
+    w = 4800
+    spm = np.array([(index[i + w] - index[i]) / (x[i + w] - x[i]) if abs(x[i + w] - x[i]) > 0.1 else np.nan
+                    for i in range(0, len(index) - w, w)])
+    first_1000 = int(np.nanargmax(spm > 750))
+    assert np.nanmedian(spm[:first_1000 - 1]) == pytest.approx(500, rel=0.01)
+    assert np.nanmedian(spm[first_1000 + 1:]) == pytest.approx(1000, rel=0.01)
+    lo, hi = (first_1000 - 1) * w, (first_1000 + 1) * w  # the change is in here
+    at = steps[lo:hi].max()
+    around = np.concatenate([steps[max(lo - 9600, 0):lo], steps[hi:hi + 9600]]).max()
+    print(f"KF-FIGURE realtime_zoom_max_step_in_the_change_window_samples {at:.4f} around {around:.4f}")
+    assert at <= around * 1.05 + 1e-3, (at, around)
+    pos = [float(v) for v in run.lines("KF-POSITION-BUS ")[0]]
+    print(f"KF-FIGURE position_bus {pos}")
+    assert pos[0] > 50 and abs(pos[2] - 20) < 5, "x mm and speedX mm/s on the position bus"
