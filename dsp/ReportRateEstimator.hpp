@@ -44,6 +44,14 @@ class ReportRateEstimator {
     return periodS_ != previous;
   }
 
+  // USB mice poll at 125 Hz x 2^k (up to 8 kHz): a measured rate within 5% of one is that
+  // one, so that speed steps (one count per T) stay exact under timing jitter; others stand.
+  static double snapToUsbRateHz(double rateHz) {
+    for (double usbHz = 125.0; usbHz <= 8000.0; usbHz *= 2.0)
+      if (std::fabs(rateHz - usbHz) <= 0.05 * usbHz) return usbHz;
+    return rateHz;
+  }
+
   bool hasEstimate() const { return periodS_ > 0.0; }
   // 0 before kMinIntervals intervals were seen.
   double periodS() const { return periodS_; }
