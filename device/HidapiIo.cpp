@@ -166,10 +166,9 @@ std::shared_ptr<HidApi> realHidApi() {
 
 std::string permissionFix(const std::string& path) {
   return "permission denied opening " + path +
-         ". Install the udev rule: sudo cp device/udev/70-kineticfriction.rules /etc/udev/rules.d/ && "
-         "sudo udevadm control --reload && sudo udevadm trigger, then unplug and replug the mouse "
-         "(or add yourself to the group that owns " +
-         path + ")";
+         ". Fix: install KineticFriction's udev rule (device/udev/ of the repository, udev/ of the "
+         "extension folder): sudo cp 70-kineticfriction.rules /etc/udev/rules.d/ && sudo udevadm control "
+         "--reload && sudo udevadm trigger, then unplug and replug the mouse";
 }
 
 }  // namespace kf
