@@ -260,6 +260,8 @@ bool statusStage(World*, void* raw) {  // NRT
   line("loop period", t.pumpPeriod);
   line("report to UGen", t.reportLatency);
   line("force to magnet", t.forceLatency);
+  const std::string source = data->device->mouseBackend().statusLine();
+  if (!source.empty()) Print("kfStatus %d: %s\n", data->index, source.c_str());
   return true;
 }
 

@@ -66,4 +66,5 @@ PluginLoad(KineticFriction) {
   registerFrictionMouseIn();
   registerFrictionOut();
   registerDeviceCommands();
+  registerMouseCommands();
 }

@@ -46,3 +46,4 @@ void registerLoudnessToFriction();
 void registerFrictionMouseIn();
 void registerFrictionOut();
 void registerDeviceCommands();
+void registerMouseCommands();

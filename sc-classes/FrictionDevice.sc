@@ -48,6 +48,7 @@ FrictionDevice {
 	audioDelay { ^specs[\tactileLatency] - specs[\audioLatency] }
 
 	openMsg {
+		if(kind == \mouse) { ^this.mouseMsg };  // FrictionDeviceMouse.sc
 		^if(kind == \sim) {
 			['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] }) ++ this.prOverrideArgs
 		} {
