@@ -10,6 +10,7 @@
 #include "HidapiMouseBackend.hpp"
 #include "MouseDeviceFactory.hpp"
 #include "MouseSelect.hpp"
+#include "ReplayBackend.hpp"
 
 using namespace kf;
 using kf::test::FakeEvdevApi;
@@ -402,4 +403,36 @@ TEST_CASE("the real hidapi and evdev enumerate this machine and cope with findin
   CHECK_FALSE(openMouseDevice(options, DeviceSpec{}, error, &why));
   CHECK(why == OpenFailure::kNotFound);
   CHECK(error.find("/dev/hidraw-kf-none") != std::string::npos);
+}
+
+TEST_CASE("a real mouse's session is recorded like any device's and replays to the same sums", "[mouse]") {
+  FakeMouseScript script;
+  script.recording = genius();
+  script.startS = 6.0;
+  script.endS = 6.5;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  DeviceSpec spec;
+  spec.countMm = 0.0212;
+  auto device = openMouseDevice(MouseOpenOptions{}, spec, error, nullptr, api);
+  REQUIRE(device);
+  const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
+  REQUIRE(device->startRecording(path, error));
+  MouseReport buffer[64];
+  while (api->timeline->nowSincePlugS() < 0.6) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    device->popReports(buffer, 64);
+  }
+  device->close();
+
+  DeviceSpec replaySpec;
+  std::vector<TimedReport> recorded;
+  REQUIRE(loadReplayReports(path, replaySpec, recorded, error));
+  CHECK(replaySpec.countMm == 0.0212);  // the session carries the mouse's spec
+  std::vector<MouseReport> reports;
+  for (const TimedReport& t : recorded) reports.push_back(t.report);
+  const Sums expected = sumOfPlayed(*api->timeline);
+  CHECK(sumOf(reports).reports == expected.reports);
+  CHECK(sumOf(reports).x == expected.x);
+  CHECK(sumOf(reports).y == expected.y);
 }
