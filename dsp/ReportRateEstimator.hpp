@@ -5,8 +5,8 @@
 // slowly moving one skips intervals, so intervals are T, 2T, 3T... plus long silences. The
 // estimate is the lower quartile of the last kWindow intervals shorter than kSilenceS: robust
 // to silences, to skipped intervals (while at least a quarter are single ones) and to single
-// outliers. Header-only, no allocation: used by the audio side (TrajectoryReconstructor) and
-// by the device thread (status).
+// outliers; intervals under kBurstS (reports read in one go) are not counted. Header-only, no allocation: used by the
+// audio side (TrajectoryReconstructor) and by the device thread (status).
 #pragma once
 
 #include <algorithm>
@@ -20,6 +20,9 @@ class ReportRateEstimator {
   static constexpr int kWindow = 32;
   static constexpr int kMinIntervals = 16;   // before this, no estimate
   static constexpr double kSilenceS = 0.05;  // a longer interval is a still mouse (< 20 Hz)
+  // A shorter one is no poll interval (8 kHz is 125 us): reports stamped on arrival that a late
+  // reader took in one go.
+  static constexpr double kBurstS = 0.0001;
 
   void reset() { *this = ReportRateEstimator{}; }
 
@@ -30,7 +33,7 @@ class ReportRateEstimator {
     const double intervalS = timeS - lastS_;
     hasLast_ = true;
     lastS_ = timeS;
-    if (!hadLast || !(intervalS > 0.0) || intervalS >= kSilenceS) return false;
+    if (!hadLast || !(intervalS >= kBurstS) || intervalS >= kSilenceS) return false;
     intervals_[next_] = intervalS;
     next_ = (next_ + 1) % kWindow;
     count_ = std::min(count_ + 1, kWindow);

