@@ -42,16 +42,17 @@ bool EvdevMouseBackend::openInfo(const MouseInfo& info, std::string& error, Open
   if (!handle) return false;
   std::string clockError;
   kernelTimestamps_ = handle->setMonotonicClock(clockError);
-  if (!kernelTimestamps_) setError(info.path + ": " + clockError + "; using arrival times instead");
+  if (!kernelTimestamps_.load()) setError(info.path + ": " + clockError + "; using arrival times instead");
   if (grab_ && !handle->grab(true, error)) {
     error = info.path + ": " + error + " (another program holds the mouse?)";
     why = OpenFailure::kOther;
     return false;
   }
-  info_ = info;
+  current_ = info;
   const std::string name = handle->name();
-  if (!name.empty()) info_.product = name;
-  handle->id(info_.vendorId, info_.productId);
+  if (!name.empty()) current_.product = name;
+  handle->id(current_.vendorId, current_.productId);
+  publishInfo(current_);
   handle_ = std::move(handle);
   dx_ = dy_ = 0;
   packetHasData_ = packetSaturated_ = dropping_ = false;
@@ -62,7 +63,7 @@ bool EvdevMouseBackend::reopenHandle(std::string& error) {
   std::vector<MouseInfo> mice;
   MouseInfo info;
   OpenFailure why = OpenFailure::kNone;
-  if (!api_->enumerateMice(mice, error) || !selectMouse(mice, reselector(info_), info, error)) return false;
+  if (!api_->enumerateMice(mice, error) || !selectMouse(mice, reselector(current_), info, error)) return false;
   if (!openInfo(info, error, why)) return false;
   afterLoss_ = true;
   return true;
@@ -112,7 +113,8 @@ int EvdevMouseBackend::readSome(int timeoutMs) {
   int errorCode = 0;
   const int count = handle_->read(events, 64, timeoutMs, &errorCode);
   if (count < 0) {
-    setError(info_.path + ": read failed: " + std::strerror(errorCode) + (errorCode == ENODEV ? " (unplugged)" : ""));
+    setError(current_.path + ": read failed: " + std::strerror(errorCode) +
+             (errorCode == ENODEV ? " (unplugged)" : ""));
     return -1;
   }
   for (int i = 0; i < count; ++i) take(events[i]);

@@ -5,6 +5,7 @@
 // SYN_REPORT are dropped, a loss is counted and the next report flagged.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -36,7 +37,8 @@ class EvdevMouseBackend : public RealMouseBackend {
   std::shared_ptr<EvdevApi> api_;
   std::unique_ptr<EvdevHandle> handle_;
   bool grab_;
-  bool kernelTimestamps_ = true;
+  std::atomic<bool> kernelTimestamps_{true};  // written by the reader at a re-open
+  MouseInfo current_;                         // the reader thread's (and open's) own
   // The packet being assembled (events up to SYN_REPORT; may span reads).
   int32_t dx_ = 0, dy_ = 0;
   uint32_t buttons_ = 0;

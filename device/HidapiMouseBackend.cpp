@@ -43,7 +43,8 @@ bool HidapiMouseBackend::openInfo(const MouseInfo& info, std::string& error, Ope
   }
   handle_ = std::move(handle);
   decoder_ = std::move(decoder);
-  info_ = info;
+  current_ = info;
+  publishInfo(current_);
   return true;
 }
 
@@ -51,7 +52,7 @@ bool HidapiMouseBackend::reopenHandle(std::string& error) {
   std::vector<MouseInfo> mice;
   MouseInfo info;
   OpenFailure why = OpenFailure::kNone;
-  if (!api_->enumerateMice(mice, error) || !selectMouse(mice, reselector(info_), info, error)) return false;
+  if (!api_->enumerateMice(mice, error) || !selectMouse(mice, reselector(current_), info, error)) return false;
   if (!openInfo(info, error, why)) return false;
   afterLoss_ = true;  // whatever moved while it was away is lost
   return true;
@@ -86,7 +87,7 @@ int HidapiMouseBackend::readSome(int timeoutMs) {
     size = handle_->readTimeout(buffer, sizeof(buffer), 0);  // what else is queued, at once
   }
   if (size < 0) {
-    setError(info_.path + ": read failed (unplugged?): " + handle_->lastError());
+    setError(current_.path + ": read failed (unplugged?): " + handle_->lastError());
     return -1;
   }
   if (drained >= kKernelQueueReports) {

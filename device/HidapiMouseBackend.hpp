@@ -38,6 +38,7 @@ class HidapiMouseBackend : public RealMouseBackend {
   HidMouseDecoder decoder_;
   int64_t xMin_ = 0, xMax_ = 0, yMin_ = 0, yMax_ = 0;  // logical limits: a delta there saturated
   bool afterLoss_ = false;
+  MouseInfo current_;  // the reader thread's (and open's) own
 };
 
 }  // namespace kf

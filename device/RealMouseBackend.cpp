@@ -77,17 +77,28 @@ MouseCounters RealMouseBackend::counters() const {
 }
 
 void RealMouseBackend::setError(const std::string& error) {
-  std::lock_guard<std::mutex> lock(errorMutex_);
+  std::lock_guard<std::mutex> lock(textMutex_);
   lastError_ = error;
 }
 
 std::string RealMouseBackend::lastError() const {
-  std::lock_guard<std::mutex> lock(errorMutex_);
+  std::lock_guard<std::mutex> lock(textMutex_);
   return lastError_;
+}
+
+void RealMouseBackend::publishInfo(const MouseInfo& info) {
+  std::lock_guard<std::mutex> lock(textMutex_);
+  info_ = info;
+}
+
+MouseInfo RealMouseBackend::info() const {
+  std::lock_guard<std::mutex> lock(textMutex_);
+  return info_;
 }
 
 std::string RealMouseBackend::describe() const {
   const MouseCounters c = counters();
+  const MouseInfo mouse = info();
   const char* state = c.state == MouseState::kRunning     ? "running"
                       : c.state == MouseState::kUnplugged ? "UNPLUGGED (position held; kfReopenMouse to re-open)"
                                                           : "stopped";
@@ -95,7 +106,7 @@ std::string RealMouseBackend::describe() const {
   std::snprintf(line, sizeof(line),
                 "%s mouse %s (%04x:%04x %s): %s, reports %llu, measured rate %.1f Hz, losses %llu, "
                 "saturated %llu, malformed %llu, overflows %llu, unplugs %llu, re-opens %llu",
-                kindName().c_str(), info_.path.c_str(), info_.vendorId, info_.productId, info_.product.c_str(), state,
+                kindName().c_str(), mouse.path.c_str(), mouse.vendorId, mouse.productId, mouse.product.c_str(), state,
                 static_cast<unsigned long long>(c.reports), c.measuredRateHz,
                 static_cast<unsigned long long>(c.lossEvents), static_cast<unsigned long long>(c.saturated),
                 static_cast<unsigned long long>(c.malformed), static_cast<unsigned long long>(c.queueOverflows),

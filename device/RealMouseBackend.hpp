@@ -65,7 +65,8 @@ class RealMouseBackend : public MouseBackend {
   std::string describe() const;
   std::string statusLine() const override { return describe(); }
   virtual std::string kindName() const = 0;
-  const MouseInfo& info() const { return info_; }
+  // The mouse open now (it may change at a re-open). Any non-realtime thread.
+  MouseInfo info() const;
 
  protected:
   RealMouseBackend();
@@ -82,8 +83,7 @@ class RealMouseBackend : public MouseBackend {
   void countMalformed() { malformed_.fetch_add(1, std::memory_order_relaxed); }
   void countSaturated() { saturated_.fetch_add(1, std::memory_order_relaxed); }
   void setError(const std::string& error);
-
-  MouseInfo info_;
+  void publishInfo(const MouseInfo& info);  // for info() and describe()
 
  private:
   void threadMain();
@@ -97,8 +97,9 @@ class RealMouseBackend : public MouseBackend {
   std::atomic<int> state_{static_cast<int>(MouseState::kStopped)};
   std::atomic<uint64_t> reports_{0}, lossEvents_{0}, saturated_{0}, malformed_{0}, unplugs_{0}, reopens_{0};
   std::atomic<double> rateHz_{0.0};
-  mutable std::mutex errorMutex_;  // not the audio thread's: NRT and the reader only
+  mutable std::mutex textMutex_;  // not the audio thread's: NRT and the reader only
   std::string lastError_;
+  MouseInfo info_;
 };
 
 }  // namespace kf
