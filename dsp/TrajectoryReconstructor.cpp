@@ -46,13 +46,14 @@ void TrajectoryReconstructor::reset() {
   intervalS_ = nominalIntervalS_;
 }
 
-void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags) {
+void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags,
+                                        double sourceTimeS) {
   if (flags & kAfterLossFlag) ++reportsAfterLoss_;
   if (!std::isfinite(dxMm)) dxMm = 0.0;  // one bad report must not poison the position
   if (!std::isfinite(dyMm)) dyMm = 0.0;
   if (!std::isfinite(reportTimeS)) reportTimeS = pendingCount_ > 0 ? lastQueuedTimeS_ : lastRenderTimeS_;
   if (pendingCount_ > 0) reportTimeS = std::max(reportTimeS, lastQueuedTimeS_);
-  rate_.addReport(reportTimeS);
+  rate_.addReport(std::isfinite(sourceTimeS) ? sourceTimeS : reportTimeS);
   if (pendingCount_ == kQueueCapacity) {
     // Full: never drop distance; the newest report absorbs this one.
     Pending& newest = queue_[(pendingHead_ + pendingCount_ - 1) % kQueueCapacity];

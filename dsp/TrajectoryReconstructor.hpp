@@ -34,6 +34,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "ReportRateEstimator.hpp"
 
@@ -58,7 +59,11 @@ class TrajectoryReconstructor {
   // Reports in order of time (an earlier time than the previous report's is taken as that
   // one's). flags: ReportFlag bits (kAfterLoss counts a loss). If the queue is full the
   // displacement is merged into the newest pending report, so no distance is lost.
-  void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0);
+  // sourceTimeS: the report's own timestamp (the device's clock), from which the update rate
+  // is measured; mapped audio times are not fit for that (a clock mapping that corrects
+  // itself spreads reports closer). NaN: reportTimeS is used.
+  void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0,
+                 double sourceTimeS = std::numeric_limits<double>::quiet_NaN());
 
   // Sample i is at startTimeS + i * sampleDurS; times should increase from call to call.
   // originMm is subtracted from x in double before the float output (y is not shifted).

@@ -42,7 +42,7 @@ class FrictionMouseIn : public SCUnit {
       const kf::MouseReport& r = slot.reports[i];
       // Lockstep devices run on audio time; realtime ones on their own clock, mapped here.
       const double reportS = lockstep ? r.deviceTimeS + originS : mClock.map(r.deviceTimeS, startS);
-      mTrajectory.addReport(reportS, r.dxCounts * spec.countMm, r.dyCounts * spec.countMm, r.flags);
+      mTrajectory.addReport(reportS, r.dxCounts * spec.countMm, r.dyCounts * spec.countMm, r.flags, r.deviceTimeS);
     }
     mTrajectory.setMode(kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation))));
     mTrajectory.render(startS, 1.0 / sampleRate(), numSamples, in0(kOriginMm), out(0), out(1), out(2), out(3));

@@ -113,3 +113,17 @@ TEST_CASE("reconstruction: the spec's rate stands when the reports keep it, jitt
   trajectory.reset();
   CHECK(trajectory.measuredRateHz() == 0.0);
 }
+
+TEST_CASE("reconstruction: the rate is measured on the device's clock, not on mapped times", "[rate]") {
+  // A clock mapping that corrects itself spreads mapped times closer (here by half); the
+  // device's own 8 ms stand.
+  TrajectoryReconstructor trajectory(125.0, TrajectoryMode::Linear);
+  std::vector<float> x(64);
+  for (int i = 0; i < 100; ++i) {
+    const double deviceS = 0.008 * i;
+    trajectory.addReport(0.004 * i, 0.021, 0.0, 0, deviceS);
+    trajectory.render(0.004 * i, 1.0 / 48000, 64, 0.0, x.data(), nullptr, nullptr, nullptr);
+  }
+  CHECK(trajectory.measuredRateHz() == Approx(125.0));
+  CHECK(trajectory.updateIntervalS() == 0.008);
+}
