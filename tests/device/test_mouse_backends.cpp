@@ -304,7 +304,7 @@ TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on req
   CHECK_FALSE(backend->lastError().empty());
   CHECK(collect(*backend, *api->timeline, 0.65).empty());  // position holds: nothing comes
 
-  backend->requestReopen();  // replugged at 0.6
+  backend->requestReopen();       // replugged at 0.6
   for (int i = 0; i < 50; ++i) {  // status read while the reader re-opens (TSan build: no race)
     CHECK_FALSE(backend->statusLine().empty());
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
