@@ -1,6 +1,8 @@
 // MouseBackend: a source of mouse reports (simulator, replayed file, real HID mouse).
 #pragma once
 
+#include <string>
+
 #include "Report.hpp"
 
 namespace kf {
@@ -13,6 +15,9 @@ class MouseBackend {
   // then, oldest first. Their deviceTimeS is the device's own clock (it may drift). Reports
   // that do not fit stay for the next call. Returns how many were written. One thread only.
   virtual int pollReports(double untilTimeS, MouseReport* out, int capacity) = 0;
+  // A line for kfStatus about the source itself (a real mouse: state, losses); empty for none.
+  // Non-realtime threads only.
+  virtual std::string statusLine() const { return {}; }
 };
 
 }  // namespace kf

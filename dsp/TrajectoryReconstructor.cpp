@@ -28,7 +28,8 @@ TrajectoryMode trajectoryModeFromCode(int code) {
 }
 
 TrajectoryReconstructor::TrajectoryReconstructor(double updateRateHz, TrajectoryMode mode)
-    : intervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : paper::device::updateRateHz)),
+    : nominalIntervalS_(1.0 / (updateRateHz > 0.0 ? updateRateHz : paper::device::updateRateHz)),
+      intervalS_(nominalIntervalS_),
       mode_(mode),
       nextMode_(mode) {}
 
@@ -41,6 +42,8 @@ void TrajectoryReconstructor::reset() {
   pendingHead_ = 0;
   pendingCount_ = 0;
   mode_ = nextMode_;
+  rate_.reset();
+  intervalS_ = nominalIntervalS_;
 }
 
 void TrajectoryReconstructor::resetAt(double xMm, double yMm) {
@@ -51,8 +54,12 @@ void TrajectoryReconstructor::resetAt(double xMm, double yMm) {
   renderedMm_[1] = axes_[1].anchorMm;
 }
 
-void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags) {
+void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags,
+                                        double sourceTimeS) {
   if (flags & kAfterLossFlag) ++reportsAfterLoss_;
+  // The update rate is measured on the device's own clock where there is one.
+  const double rateTimeS = std::isfinite(sourceTimeS) ? sourceTimeS : reportTimeS;
+  if (std::isfinite(rateTimeS)) rate_.addReport(rateTimeS);
   enqueue(reportTimeS, dxMm, dyMm, false);
 }
 
@@ -110,12 +117,18 @@ void TrajectoryReconstructor::take(const Pending& report, double nowS) {
   // position just before it is what was (or would have been) output.
   double takeS = std::min(report.timeS, nowS);
   if (hasRendered_) takeS = std::max(takeS, lastRenderTimeS_);
+  double beforeMm[2];
+  for (int a = 0; a < 2; ++a) beforeMm[a] = hasAnchor_ ? positionAt(axes_[a], takeS - anchorTimeS_) : axes_[a].anchorMm;
+  // The new T applies from this report on (positions before it were rendered with the old).
+  const double measuredS = rate_.hasEstimate() ? 1.0 / ReportRateEstimator::snapToUsbRateHz(rate_.rateHz()) : 0.0;
+  intervalS_ = measuredS > 0.0 && std::fabs(measuredS - nominalIntervalS_) > kRateBand * nominalIntervalS_
+                   ? measuredS
+                   : nominalIntervalS_;
   for (int a = 0; a < 2; ++a) {
     Axis& axis = axes_[a];
-    const double beforeMm = hasAnchor_ ? positionAt(axis, takeS - anchorTimeS_) : axis.anchorMm;
     axis.anchorMm += report.dMm[a];
     axis.speedMmPerS = report.dMm[a] / intervalS_;
-    axis.correctionMm = beforeMm - axis.anchorMm;
+    axis.correctionMm = beforeMm[a] - axis.anchorMm;
   }
   mode_ = nextMode_;
   if (mode_ == TrajectoryMode::Hold) axes_[0].correctionMm = axes_[1].correctionMm = 0.0;

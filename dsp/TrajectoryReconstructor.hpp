@@ -20,6 +20,12 @@
 // Speed output (all modes): the latest report's dx / T — the paper's speed signal, in steps
 // of one count per interval — held for 2 T, then faded to 0 over T when no reports come.
 //
+// T is measured from the reports (ReportRateEstimator, snapped to a USB rate when near one): a
+// mouse may report at any rate from 125 Hz to 8 kHz whatever the device spec assumed. The
+// constructor's rate stands until the measured one differs from it by more than kRateBand (the
+// rates mice use are a factor of 2 apart, so jitter never crosses it); T changes only at a
+// report, so p stays continuous.
+//
 // Reports wait in a fixed queue until rendering reaches their time, so several reports in one
 // block are taken in order at their own times. A report whose time has already been rendered
 // is taken at the next sample (p stays continuous; its lateness becomes lag). Nothing here
@@ -28,6 +34,9 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
+
+#include "ReportRateEstimator.hpp"
 
 #include "PaperProfile.hpp"
 
@@ -55,7 +64,11 @@ class TrajectoryReconstructor {
   // Reports in order of time (an earlier time than the previous report's is taken as that
   // one's). flags: ReportFlag bits (kAfterLoss counts a loss). If the queue is full the
   // displacement is merged into the newest pending report, so no distance is lost.
-  void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0);
+  // sourceTimeS: the report's own timestamp (the device's clock), from which the update rate
+  // is measured; mapped audio times are not fit for that (a clock mapping that corrects
+  // itself spreads reports closer). NaN: reportTimeS is used.
+  void addReport(double reportTimeS, double dxMm, double dyMm, uint32_t flags = 0,
+                 double sourceTimeS = std::numeric_limits<double>::quiet_NaN());
   // Moves the coordinates by (dxMm, dyMm) at a time, in order with the reports: a re-basing
   // (zero, set position), not a movement, so the output steps by exactly that and speed and
   // interpolation go on as before.
@@ -70,7 +83,12 @@ class TrajectoryReconstructor {
   void render(double startTimeS, double sampleDurS, int numSamples, double originXMm, double originYMm, float* xMm,
               float* yMm, float* vxMmPerS, float* vyMmPerS);
 
+  // T in use: the nominal one, or the measured one when it differs by more than kRateBand.
   double updateIntervalS() const { return intervalS_; }
+  double nominalIntervalS() const { return nominalIntervalS_; }
+  // 0 until enough reports were seen.
+  double measuredRateHz() const { return rate_.rateHz(); }
+  static constexpr double kRateBand = 0.25;
   // Sum of the displacements of all reports taken so far (exact, double).
   double reportedXMm() const { return axes_[0].anchorMm; }
   double reportedYMm() const { return axes_[1].anchorMm; }
@@ -104,7 +122,9 @@ class TrajectoryReconstructor {
   double positionAt(const Axis& axis, double sinceAnchorS) const;
   double speedAt(const Axis& axis, double sinceAnchorS) const;
 
+  double nominalIntervalS_;
   double intervalS_;
+  ReportRateEstimator rate_;
   TrajectoryMode mode_;
   TrajectoryMode nextMode_;
   std::array<Axis, 2> axes_{};

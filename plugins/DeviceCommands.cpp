@@ -374,6 +374,8 @@ bool statusStage(World*, void* raw) {  // NRT
         t.frameOffset.p99S * 1e3, t.frameOffset.maxS * 1e3, t.releaseLatencyS * 1e3,
         static_cast<unsigned long long>(t.lateFrames));
   kf::sc::postBoardStatus(data->args.index, *data->device);
+  const std::string source = data->device->mouseBackend().statusLine();
+  if (!source.empty()) Print("kfStatus %d: %s\n", data->args.index, source.c_str());
   return true;
 }
 

@@ -67,5 +67,6 @@ PluginLoad(KineticFriction) {
   registerFrictionOut();
   registerDeviceCommands();
   registerBoardCommands();
+  registerMouseCommands();
   installExitSafety();
 }

@@ -11,7 +11,7 @@ void addEntries(TrajectoryReconstructor& trajectory, const PositionEntry* entrie
     if (e.isShift)
       trajectory.addShift(e.timeS, e.dxMm, e.dyMm);
     else
-      trajectory.addReport(e.timeS, e.dxMm, e.dyMm, e.flags);
+      trajectory.addReport(e.timeS, e.dxMm, e.dyMm, e.flags, e.deviceTimeS);
   }
 }
 
@@ -77,7 +77,8 @@ void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* repor
     else if (continuous)
       timeS = clock_.map(r.deviceTimeS, clock.startS);
     // From absolute counts: reports lost on the way (a full queue) still count.
-    add(PositionEntry{timeS, countsToMm(r.xCounts - xCounts_), countsToMm(r.yCounts - yCounts_), r.flags, false});
+    add(PositionEntry{timeS, countsToMm(r.xCounts - xCounts_), countsToMm(r.yCounts - yCounts_), r.flags, false,
+                      r.deviceTimeS});
     xCounts_ = r.xCounts;
     yCounts_ = r.yCounts;
   }

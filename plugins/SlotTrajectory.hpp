@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "DeviceClockMapper.hpp"
 #include "DeviceSpec.hpp"
@@ -40,6 +41,7 @@ struct PositionEntry {
   double dyMm = 0.0;
   uint32_t flags = 0;  // ReportFlag bits
   bool isShift = false;
+  double deviceTimeS = std::numeric_limits<double>::quiet_NaN();  // the report's own time stamp
 };
 
 // Feeds the entries to a reader's reconstructor in order.

@@ -72,7 +72,11 @@ FrictionDevice {
 	// Audio is delayed by this much so that sound and touch arrive together (the paper: 1 ms).
 	audioDelay { ^specs[\tactileLatencyS] - specs[\audioLatencyS] }
 
+	// The plugin command that opens this kind of device.
+	openCommand { ^(sim: \kfOpenSim, replay: \kfOpenReplay, mouse: \kfOpenMouse)[kind] }
+
 	openMsg {
+		if(kind == \mouse) { ^this.mouseMsg };  // FrictionDeviceMouse.sc
 		^if(kind == \sim) {
 			['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] }) ++ this.prOverrideArgs
 		} {
@@ -243,7 +247,7 @@ FrictionDevice {
 		state = \opening;
 		// The server decides whether the slot is free (or replaced): it holds the devices of
 		// every client. Its answer updates what sclang holds.
-		this.prSendAnswered([\kfOpenSim, \kfOpenReplay][[\sim, \replay].indexOf(kind)], this.openMsg, {
+		this.prSendAnswered(this.openCommand, this.openMsg, {
 			this.prHold;
 		}, {
 			state = \failed;
@@ -363,7 +367,7 @@ FrictionDevice {
 		forceBus !? { server.audioBusAllocator.reserve(forceBus.index, 1, false) };
 		positionBus !? { server.controlBusAllocator.reserve(positionBus.index, 4, false) };
 		state = \opening;
-		this.prSendAnswered([\kfOpenSim, \kfOpenReplay][[\sim, \replay].indexOf(kind)], this.openMsg, {
+		this.prSendAnswered(this.openCommand, this.openMsg, {
 			state = \open;
 			this.prStartWriter;
 			this.prStartReader;

@@ -1,0 +1,36 @@
+// MouseDeviceFactory: a Device whose position comes from a real mouse (hidapi or evdev) and
+// whose force side counts what it is told (no magnet). Realtime only: a real mouse cannot be
+// stepped in lockstep with a Score render. Call from a non-realtime thread.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "Device.hpp"
+#include "MouseIo.hpp"
+
+namespace kf {
+
+enum class MouseBackendKind { kHidapi, kEvdev };
+
+// "hidapi" or "evdev" (anything else: false).
+bool mouseBackendKindFromName(const std::string& name, MouseBackendKind& out);
+
+struct MouseOpenOptions {
+  MouseBackendKind kind = MouseBackendKind::kHidapi;
+  std::string which;  // MouseSelect's selector ("" the first mouse)
+  bool grab = false;  // evdev: keep the desktop cursor still
+};
+
+// Null with a message (naming the node and the fix on permission denied) and why.
+std::unique_ptr<Device> openMouseDevice(const MouseOpenOptions& options, const DeviceSpec& spec, std::string& error,
+                                        OpenFailure* why = nullptr, std::shared_ptr<HidApi> hidApi = nullptr,
+                                        std::shared_ptr<EvdevApi> evdevApi = nullptr, DeviceOptions deviceOptions = {});
+
+// The mice a backend can open, one line each (MouseSelect's describeMouse); false with a
+// message when enumeration failed. Finding none is true with no lines.
+bool listMice(MouseBackendKind kind, std::vector<std::string>& lines, std::string& error,
+              std::shared_ptr<HidApi> hidApi = nullptr, std::shared_ptr<EvdevApi> evdevApi = nullptr);
+
+}  // namespace kf

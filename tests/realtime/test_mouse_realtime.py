@@ -1,0 +1,46 @@
+"""A realtime server asked for a real mouse on a machine that may have none (CI has none): the
+server answers listMice, and opening fails with a message naming what is wrong; the slot stays
+closed (FrictionMouseIn says so) - never a simulator in the mouse's place."""
+import pytest
+
+from kfharness import sclang
+from kfharness.jack import JackServer
+
+
+@pytest.fixture
+def jack():
+    with JackServer() as server:
+        yield server
+
+
+def test_list_and_open_without_a_mouse(jack):
+    run = sclang.require_ok(sclang.run_with_server(r"""
+        var cond = Condition.new, found;
+        FrictionDevice.listMice(s, nil, { |mice| found = mice; cond.unhang });
+        cond.hang;
+        "KF-MICE %".format(found.size).postln;
+        found.do { |m| "KF-MOUSE % % %".format(m[\backend], m[\index], m[\path]).postln };
+        SynthDef(\kfMousePos, { SendReply.kr(Impulse.kr(20), '/kfMousePos', FrictionMouseIn.kr(0)) }).add;
+        OSCdef(\kfMousePos, { |msg| "KF-POS %".format(msg[3..6].join(" ")).postln }, '/kfMousePos');
+        s.sync;
+        if(found.isEmpty) { FrictionDevice.mouse(s, 0) };  // "the first mouse": there is none
+        FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none");
+        FrictionDevice.mouse(s, 2, "/dev/input/event-kf-none", \evdev, nil, true);
+        s.sendMsg('/cmd', 'kfReopenMouse', 3);
+        s.sync;
+        Synth(\kfMousePos);
+        0.5.wait;
+        "KF-NO-MOUSE %".format(found.isEmpty).postln;
+    """, jack, name="mouse"))
+    out = run.output
+    count = int(run.lines("KF-MICE ")[0][0])
+    assert "kfListMice: hidapi: " in out and "kfListMice: evdev: " in out
+    assert len(run.lines("KF-MOUSE ")) == count
+    if count == 0:
+        assert "kfOpenMouse: no mouse found" in out
+        assert "FrictionMouseIn: no device is open at index 0" in out
+        rows = run.lines("KF-POS ")
+        assert len(rows) >= 5 and all(float(v) == 0.0 for row in rows for v in row)
+    assert "kfOpenMouse: /dev/hidraw-kf-none: " in out
+    assert "kfOpenMouse: /dev/input/event-kf-none: " in out
+    assert "kfReopenMouse: no mouse is open at index 3" in out
