@@ -180,15 +180,20 @@ bool readIndex(OscArgReader& args, int numSlots, CommandArgs& out, char* error, 
   return true;
 }
 
-bool readPath(OscArgReader& args, CommandArgs& out, char* error, size_t errorSize) {
+// A string argument into `to` (capacity chars with the terminator); `what` names it in errors.
+bool readText(OscArgReader& args, char* to, size_t capacity, const char* what, char* error, size_t errorSize) {
   const char* text = nullptr;
   size_t length = 0;
-  if (!args.readString(text, length)) return fail(error, errorSize, "path: %s", describe(args));
-  if (length >= static_cast<size_t>(kMaxPathChars))
-    return fail(error, errorSize, "path of %zu characters is longer than %d", length, kMaxPathChars - 1);
-  std::memcpy(out.path, text, length);
-  out.path[length] = '\0';
+  if (!args.readString(text, length)) return fail(error, errorSize, "%s: %s", what, describe(args));
+  if (length >= capacity)
+    return fail(error, errorSize, "%s of %zu characters is longer than %zu", what, length, capacity - 1);
+  std::memcpy(to, text, length);
+  to[length] = '\0';
   return true;
+}
+
+bool readPath(OscArgReader& args, CommandArgs& out, char* error, size_t errorSize) {
+  return readText(args, out.path, kMaxPathChars, "path", error, errorSize);
 }
 
 bool readOverrides(OscArgReader& args, CommandArgs& out, char* error, size_t errorSize) {
@@ -227,15 +232,24 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
   out.numValues = 0;
   out.values = nullptr;
   out.numOverrides = 0;
-  out.path[0] = '\0';
+  out.path[0] = out.which[0] = out.backend[0] = '\0';
   if (errorSize > 0) error[0] = '\0';
   if (args.isMalformed()) return fail(error, errorSize, "the message is cut short or malformed");
+  if (shape == CommandShape::kListMice)
+    return readText(args, out.backend, kMaxKeyChars, "backend", error, errorSize) &&
+           readPath(args, out, error, errorSize) && noneLeft(args, error, errorSize);
   if (!readIndex(args, numSlots, out, error, errorSize)) return false;
   switch (shape) {
     case CommandShape::kIndex:
       return noneLeft(args, error, errorSize);
     case CommandShape::kRecord:
       return readPath(args, out, error, errorSize) && noneLeft(args, error, errorSize);
+    case CommandShape::kOpenMouse:
+      return readText(args, out.which, kMaxPathChars, "mouse", error, errorSize) &&
+             readText(args, out.backend, kMaxKeyChars, "backend", error, errorSize) &&
+             readPath(args, out, error, errorSize) && readOverrides(args, out, error, errorSize);
+    case CommandShape::kListMice:
+      return true;  // read above
     case CommandShape::kPosition:
       out.positionMm[0] = out.positionMm[1] = 0.0;
       for (int axis = 0; axis < 2 && !args.atEnd(); ++axis) {

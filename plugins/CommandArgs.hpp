@@ -54,6 +54,8 @@ enum class CommandShape {
   kOpenReplay,  // index path [key value]...
   kRecord,      // index path ("" stops)
   kPosition,    // kfZero: index [xMm yMm]
+  kOpenMouse,   // index which backend profilePath [key value]...
+  kListMice,    // backend answerPath (no index)
 };
 
 struct CommandArgs {
@@ -66,6 +68,8 @@ struct CommandArgs {
   double overrideValues[kMaxOverrides];
   char path[kMaxPathChars];
   double positionMm[2] = {0.0, 0.0};  // kPosition: x, y
+  char which[kMaxPathChars];          // kOpenMouse: the mouse selector ("" the first)
+  char backend[kMaxKeyChars];         // kOpenMouse, kListMice: "hidapi", "evdev" ("" default)
 };
 
 // Storage for `count` hand script values (RTAlloc in the plugin); null: out of memory.

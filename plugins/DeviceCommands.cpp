@@ -11,10 +11,10 @@
 //   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
 //                                   default, for every reader, from the next block on)
 //
-// Replies follow the server's conventions: `/done cmdName` when a command succeeded; when it
-// failed, no /done but `/kfFail` to the notified clients (node 0, replyID = the slot index,
-// then the reason as character codes), and the reason is posted. The open commands refuse a
-// slot that holds a device unless given the setting `replace 1`. `/sync` works after all.
+// Replies follow the server's conventions (CommandRunner.hpp): `/done cmdName` when a command
+// succeeded; when it failed, no /done but `/kfFail` to the notified clients, and the reason is
+// posted. The open commands refuse a slot that holds a device unless given the setting
+// `replace 1`. `/sync` works after all. Real mice: MouseCommands.cpp; the board: BoardCommands.cpp.
 #include <algorithm>
 #include <cstdarg>
 #include <cstdio>
@@ -24,199 +24,17 @@
 
 #include "AudioClock.hpp"
 #include "BoardStatus.hpp"
-#include "CommandArgs.hpp"
-#include "DeviceFactory.hpp"
+#include "CommandRunner.hpp"
 #include "DeviceMessages.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
-#include "PostLimiter.hpp"
 
 namespace {
 
-using kf::sc::CommandShape;
-
-constexpr int kMaxReasonChars = 200;
-
-struct CommandData {
-  const char* name;
-  kf::sc::CommandArgs args;  // args.values: the hand script (kfOpenSim only), RTAlloc'd to its size
-  kf::Device* device;        // opened by stage 2, or the target of record/status
-  kf::Device* previous;      // swapped out of the slot, deleted in an NRT stage
-  bool replace;              // open commands: a device in the slot is closed, not refused
-  bool ownsDevice;           // open commands: `device` is theirs until published
-  bool failed;               // a stage failed; `reason` says why
-  char reason[kMaxReasonChars];
-  AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
-};
-
-// Records why the command failed; the stage wrappers post it and answer /kfFail with it.
-void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
-void failWith(CommandData* data, const char* format, ...) {
-  data->failed = true;
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(data->reason, kMaxReasonChars, format, args);
-  va_end(args);
-}
-
-// RT: the failure to the notified clients, as the node reply /kfFail from the root group.
-void replyFailure(World* world, const CommandData* data) {
-  float codes[kMaxReasonChars];
-  int n = 0;
-  for (; n < kMaxReasonChars && data->reason[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(data->reason[n]);
-  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfFail", n, codes);
-}
-
-// The same from an NRT stage: a copy of the reason travels to the RT thread.
-struct FailureCopy {
-  CommandData data;
-};
-
-void replyFailureFromNrt(World* world, const CommandData* data) {
-  auto* copy = static_cast<FailureCopy*>(NRTAlloc(sizeof(FailureCopy)));
-  if (copy == nullptr) return;
-  std::memcpy(&copy->data, data, sizeof(CommandData));
-  FifoMsg msg;
-  msg.Set(
-      world, [](FifoMsg* m) { replyFailure(m->mWorld, &static_cast<FailureCopy*>(m->mData)->data); },
-      [](FifoMsg* m) { NRTFree(m->mData); }, copy);
-  SendMsgToRT(world, msg);
-}
-
-double* allocValues(void* world, int count) {
-  return static_cast<double*>(RTAlloc(static_cast<World*>(world), sizeof(double) * static_cast<size_t>(count)));
-}
-
-void freeCommand(World* world, void* raw) {
-  auto* data = static_cast<CommandData*>(raw);
-  if (data->args.values != nullptr) RTFree(world, data->args.values);
-  RTFree(world, data);
-}
-
-// The arguments after the command name, bounded by the packet: scsynth's own iterator reads
-// strings to their terminator wherever it is.
-kf::sc::OscArgReader readerOf(sc_msg_iter* msg) {
-  if (msg->tags == nullptr || msg->rdpos > msg->endpos) return kf::sc::OscArgReader(nullptr, nullptr, nullptr, nullptr);
-  const char* tagsEnd = static_cast<const char*>(std::memchr(msg->tags, '\0', msg->endpos - msg->tags));
-  if (tagsEnd == nullptr || tagsEnd - msg->tags < msg->count)
-    return kf::sc::OscArgReader(nullptr, nullptr, nullptr, nullptr);
-  return kf::sc::OscArgReader(msg->tags + msg->count, msg->endpos, msg->rdpos, msg->endpos);
-}
-
-// Refused commands post one line each, and the same refusal at most once a second (a flood
-// of one bad command must not flood the post window; different problems all show).
-void postRefusal(World* world, const char* name, const char* error) {
-  constexpr int kCauses = 16;
-  static kf::sc::PostLimiter limiters[kCauses];
-  static uint32_t causes[kCauses] = {};
-  uint32_t hash = 2166136261u;  // FNV-1a of command and message: the cause
-  for (const char* c : {name, error})
-    for (; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
-  int slot = static_cast<int>(hash % kCauses);
-  if (causes[slot] != hash) {  // another cause had this slot: start afresh
-    causes[slot] = hash;
-    limiters[slot] = kf::sc::PostLimiter();
-  }
-  int suppressed = 0;
-  if (!limiters[slot].allow(kf::sc::blockStartTimeS(world), suppressed)) return;
-  if (suppressed > 0)
-    kf::sc::postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error, suppressed);
-  else
-    kf::sc::postFromRt(world, "%s: %s; refused\n", name, error);
-}
-
-CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_msg_iter* msg) {
-  auto* data = static_cast<CommandData*>(RTAlloc(world, sizeof(CommandData)));
-  if (data == nullptr) {
-    kf::sc::postFromRt(world, "%s: RT memory allocation failed\n", name);
-    return nullptr;
-  }
-  data->name = name;
-  data->device = data->previous = nullptr;
-  data->replace = data->failed = data->ownsDevice = false;
-  data->reason[0] = '\0';
-  kf::sc::OscArgReader reader = readerOf(msg);
-  char error[200];
-  if (!kf::sc::parseCommandArgs(shape, reader, kf::sc::kNumDeviceSlots, data->args, allocValues, world, error,
-                                sizeof error)) {
-    postRefusal(world, name, error);
-    freeCommand(world, data);
-    return nullptr;
-  }
-  return data;
-}
-
-// The stages every command runs, around its own: a failing NRT stage does not end the command
-// (so that the RT stage can answer /kfFail); the last stage sends /done only on success and
-// still runs after a refusal, to delete what was opened for nothing.
-bool wrappedStage2(World* world, void* raw) {  // NRT
-  auto* data = static_cast<CommandData*>(raw);
-  if (!data->stages[0](world, data) && !data->failed) failWith(data, "%s failed", data->name);
-  if (data->failed) Print("%s\n", data->reason);
-  return true;
-}
-
-bool wrappedStage3(World* world, void* raw) {  // RT
-  auto* data = static_cast<CommandData*>(raw);
-  const bool failedBefore = data->failed;
-  if (!failedBefore && !data->stages[1](world, data) && !data->failed) failWith(data, "%s failed", data->name);
-  if (data->failed && !failedBefore) kf::sc::postFromRt(world, "%s\n", data->reason);
-  if (data->failed) replyFailure(world, data);
-  return !data->failed || data->device != nullptr || data->previous != nullptr;
-}
-
-bool wrappedStage4(World* world, void* raw) {  // NRT
-  auto* data = static_cast<CommandData*>(raw);
-  if (data->failed) {
-    delete data->previous;                                                        // unpublished: nothing else holds it
-    if (data->ownsDevice && data->previous != data->device) delete data->device;  // never published
-    return false;
-  }
-  if (data->stages[2](world, data)) return true;
-  if (!data->failed) failWith(data, "%s failed", data->name);
-  Print("%s\n", data->reason);
-  replyFailureFromNrt(world, data);
-  return false;
-}
-
-void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
-         AsyncStageFn stage4) {
-  data->stages[0] = stage2;
-  data->stages[1] = stage3;
-  data->stages[2] = stage4;
-  DoAsynchronousCommand(world, replyAddr, data->name, data, wrappedStage2, wrappedStage3, wrappedStage4, freeCommand, 0,
-                        nullptr);
-}
-
-// Applies the overrides to a spec and simulation settings; false (and a message) on a bad key.
-bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim, kf::ReplayOptions* replay = nullptr) {
-  for (int i = 0; i < data->args.numOverrides; ++i) {
-    const char* key = data->args.keys[i];
-    const double value = data->args.overrideValues[i];
-    if (std::strcmp(key, "replace") == 0) {  // not a device setting: how to treat a taken slot
-      data->replace = value != 0.0;
-      continue;
-    }
-    std::string error;
-    if (spec.applyOverride(key, value, &error)) continue;
-    // Not a device setting: perhaps a simulation or replay one (a device setting out of range
-    // stays an error).
-    const bool unknown = error.rfind("unknown", 0) == 0;
-    if (unknown && sim != nullptr && sim->applyOverride(key, value, &error)) continue;
-    if (unknown && replay != nullptr && replay->applyOverride(key, value, &error)) continue;
-    failWith(data, "%s: %s; not opened", data->name, error.c_str());
-    return false;
-  }
-  std::string error;
-  if (!spec.isValid(&error)) {
-    failWith(data, "%s: the device settings do not fit together: %s; not opened", data->name, error.c_str());
-    return false;
-  }
-  return true;
-}
+using namespace kf::sc;
 
 kf::HandScript handScriptOf(const CommandData* data) {
-  const kf::sc::CommandArgs& args = data->args;
+  const CommandArgs& args = data->args;
   std::vector<std::pair<double, double>> pairs;
   for (int i = 0; i + 1 < args.numValues; i += 2) pairs.emplace_back(args.values[i], args.values[i + 1]);
   switch (args.kind) {
@@ -229,27 +47,6 @@ kf::HandScript handScriptOf(const CommandData* data) {
     default:
       return kf::HandScript::none();
   }
-}
-
-// --- stages shared by the open commands ----------------------------------------------------
-
-bool publishStage(World* world, void* raw) {  // RT
-  auto* data = static_cast<CommandData*>(raw);
-  // A lockstep device's time starts with the next block, as a realtime one's starts at open.
-  if (data->device != nullptr && data->device->isLockstep())
-    data->device->setLockstepOriginS(kf::sc::blockStartTimeS(world));
-  if (!data->replace && kf::sc::peekSlot(data->args.index) != nullptr) {
-    // Refused: the new device is deleted by the last stage; the open one stays.
-    failWith(data, "%s: device index %d is taken; close it first or open with replace", data->name, data->args.index);
-    return true;
-  }
-  data->previous = kf::sc::exchangeSlot(data->args.index, data->device);
-  return true;
-}
-
-bool deletePreviousStage(World*, void* raw) {  // NRT
-  kf::sc::deleteRetired(static_cast<CommandData*>(raw)->previous);
-  return true;
 }
 
 // --- kfOpenSim -----------------------------------------------------------------------------
@@ -299,22 +96,6 @@ void openReplayCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 }
 
 // --- kfRecord, kfStatus --------------------------------------------------------------------
-
-// Commands that act on the device a slot holds look it up in an RT stage that follows an NRT
-// stage: an open sent just before has published its device by then (stages run in order).
-bool nrtHop(World*, void*) { return true; }
-
-bool lookUpDeviceStage(World*, void* raw) {  // RT
-  auto* data = static_cast<CommandData*>(raw);
-  data->device = kf::sc::peekSlot(data->args.index);
-  return true;
-}
-
-bool unpublishStage(World*, void* raw) {  // RT
-  auto* data = static_cast<CommandData*>(raw);
-  data->previous = kf::sc::exchangeSlot(data->args.index, nullptr);
-  return true;
-}
 
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);

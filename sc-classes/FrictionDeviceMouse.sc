@@ -12,8 +12,7 @@
 
 	// The OSC message that opens the mouse (as openMsg of any device).
 	mouseMsg {
-		^['/cmd', \kfOpenMouse, index, source[\which], source[\backend].asString]
-		++ (source[\profilePath] !? { |p| [\profile, p] } ?? { [] })
+		^['/cmd', \kfOpenMouse, index, source[\which], source[\backend].asString, source[\profilePath] ? ""]
 		++ (if(source[\grab]) { [\grab, 1] } { [] })
 		++ this.prOverrideArgs
 	}

@@ -23,9 +23,12 @@ def test_list_and_open_without_a_mouse(jack):
         SynthDef(\kfMousePos, { SendReply.kr(Impulse.kr(20), '/kfMousePos', FrictionMouseIn.kr(0)) }).add;
         OSCdef(\kfMousePos, { |msg| "KF-POS %".format(msg[3..6].join(" ")).postln }, '/kfMousePos');
         s.sync;
-        if(found.isEmpty) { FrictionDevice.mouse(s, 0) };  // "the first mouse": there is none
-        FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none");
-        FrictionDevice.mouse(s, 2, "/dev/input/event-kf-none", \evdev, nil, true);
+        // Inside a Routine an open the server refuses is an Error, with the server's reason.
+        [
+            { if(found.isEmpty) { FrictionDevice.mouse(s, 0) } },  // "the first mouse": there is none
+            { FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none") },
+            { FrictionDevice.mouse(s, 2, "/dev/input/event-kf-none", \evdev, nil, true) }
+        ].do { |open| try(open) { |error| ("KF-REFUSED " ++ error.errorString).postln } };
         s.sendMsg('/cmd', 'kfReopenMouse', 3);
         s.sync;
         Synth(\kfMousePos);
@@ -41,6 +44,7 @@ def test_list_and_open_without_a_mouse(jack):
         assert "FrictionMouseIn: no device is open at index 0" in out
         rows = run.lines("KF-POS ")
         assert len(rows) >= 5 and all(float(v) == 0.0 for row in rows for v in row)
+    assert len(run.lines("KF-REFUSED ")) == (3 if count == 0 else 2), out[-3000:]
     assert "kfOpenMouse: /dev/hidraw-kf-none: " in out
     assert "kfOpenMouse: /dev/input/event-kf-none: " in out
     assert "kfReopenMouse: no mouse is open at index 3" in out

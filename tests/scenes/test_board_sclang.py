@@ -47,7 +47,7 @@ def test_board_messages_for_scores():
         [{ dev.addBoardMsg(42) }, { dev.addBoardMsg(nil, false, 9) }, { dev.calibrateMsg(table) },
          { dev.calibrateMsg(3) }].do { |f| try { f.value; errors.add("none") } { |e| errors.add(e.errorString) } };
         errors.do { |e| ("KF-ERROR " ++ e).postln };
-        ("KF-SPECS " ++ [FrictionDevice.paperSpecs[\\watchdog], FrictionDevice.paperSpecs[\\maxDrive]]).postln;
+        ("KF-SPECS " ++ [FrictionDevice.paperSpecs[\\watchdogS], FrictionDevice.paperSpecs[\\maxDriveLevel]]).postln;
     """)
     msgs = [l[len("KF-MSG "):] for l in out.splitlines() if l.startswith("KF-MSG ")]
     assert msgs == ["[ /cmd, kfBoardOpen, 3, , 0, 2 ]", "[ /cmd, kfBoardOpen, 3, KF-0001, 1, 3 ]",

@@ -1,0 +1,59 @@
+// The machinery every device plugin command shares (DeviceCommands.cpp, MouseCommands.cpp):
+// arguments read and checked in the RT stage by CommandArgs (never past the packet), refusals
+// posted at most once a second per cause, the stages run as SC's asynchronous commands with
+// `/done cmdName` on success and `/kfFail` (node 0, replyID = the slot, then the reason as
+// character codes) on failure, and the stages the open and slot commands have in common.
+#pragma once
+
+#include <SC_PlugIn.hpp>
+
+#include "CommandArgs.hpp"
+#include "DeviceFactory.hpp"
+
+namespace kf::sc {
+
+constexpr int kMaxReasonChars = 200;
+
+struct CommandData {
+  const char* name;
+  CommandArgs args;      // args.values: the hand script (kfOpenSim only), RTAlloc'd to its size
+  kf::Device* device;    // opened by stage 2, or the target of record/status
+  kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
+  bool replace;          // open commands: a device in the slot is closed, not refused
+  bool ownsDevice;       // open commands: `device` is theirs until published
+  bool failed;           // a stage failed; `reason` says why
+  char reason[kMaxReasonChars];
+  AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
+};
+
+// Records why the command failed; the stage wrappers post it and answer /kfFail with it.
+void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
+// RT: the failure to the notified clients.
+void replyFailure(World* world, const CommandData* data);
+
+// RT: a command with its arguments read and checked for `shape`; null (refusal posted) if
+// they do not fit or RT memory is short.
+CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_msg_iter* msg);
+// An SC asynchronous command from the command's own stages (2 and 4 NRT, 3 RT; see the
+// wrappers for what happens on failure); frees `data` at the end.
+void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, AsyncStageFn stage3,
+         AsyncStageFn stage4);
+void freeCommand(World* world, void* raw);
+
+// NRT: the command's settings applied to a spec, simulation and replay settings (null: not
+// taken), and `replace`; a setting named callerKey is left to the caller. False (failWith) on a
+// bad key or value.
+bool applyOverrides(CommandData* data, DeviceSpec& spec, SimParams* sim, ReplayOptions* replay = nullptr,
+                    const char* callerKey = nullptr);
+
+// Stages shared by the open commands: publish the opened device (RT; a taken slot is refused
+// unless replace), delete the one it replaced (NRT).
+bool publishStage(World* world, void* raw);
+bool deletePreviousStage(World* world, void* raw);
+// Stages of the commands that act on the slot's device: a hop to NRT, then the look-up (RT),
+// or its removal from the slot (RT).
+bool nrtHop(World* world, void* raw);
+bool lookUpDeviceStage(World* world, void* raw);
+bool unpublishStage(World* world, void* raw);
+
+}  // namespace kf::sc
