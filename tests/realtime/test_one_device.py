@@ -265,3 +265,34 @@ def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
     pos = [float(v) for v in run.lines("KF-POSITION-BUS ")[0]]
     print(f"KF-FIGURE position_bus {pos}")
     assert pos[0] > 50 and abs(pos[2] - 20) < 5, "x mm and speedX mm/s on the position bus"
+
+
+def test_every_pbind_note_reads_the_puck_where_it_is(jack):
+    run = rt.require_ok(rt.run_sclang(r"""
+        var dev, player;
+        ~notes = List.new;
+        OSCdef(\kfNote, { |msg| ~notes.add(msg[3..]) }, '/kfNote');
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[25, 6]]));
+        dev.positionBus;  // a long-running control-rate reader
+        SynthDef(\kfNote, { |posBus|
+            // This note's own reader, against the long-running one, in the note's first block.
+            SendReply.kr(Impulse.kr(0), '/kfNote', [FrictionMouseIn.kr(0)[0], In.kr(posBus)]);
+            Line.kr(0, 1, 0.05, doneAction: 2);
+        }).add;
+        s.sync;
+        0.5.wait;
+        player = Pbind(\instrument, \kfNote, \posBus, dev.positionBus.index, \dur, 0.1).play;
+        2.0.wait;
+        player.stop;
+        0.2.wait;
+        dev.close;
+        ~notes.do { |row| ("KF-NOTE " ++ row.join(" ")).postln };
+    """, jack, name="pbind"))
+    rows = floats(run, "KF-NOTE ")
+    assert len(rows) >= 10, run.output[-2000:]
+    diff = np.abs(rows[:, 0] - rows[:, 1]).max()
+    figure("pbind_notes", len(rows))
+    figure("pbind_note_x_mm_first_last", (rows[0, 0], rows[-1, 0]))
+    figure("pbind_note_vs_running_reader_max_abs_difference_mm", diff)
+    assert diff == 0.0
+    assert rows[0, 0] > 5 and np.all(np.diff(rows[:, 0]) > 0), "every note reads the moving puck, none reads 0"
