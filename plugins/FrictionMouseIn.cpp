@@ -55,9 +55,19 @@ class FrictionMouseIn : public SCUnit {
     } else {
       mWarnedOrigin = false;
     }
-    // Audio rate: the slot's own sample duration, so all readers compute the same times.
-    const double sampleDurS = mCalcRate == calc_FullRate ? clock.sampleDurS : 1.0 / sampleRate();
-    mTrajectory.render(clock.startS, sampleDurS, numSamples, originMm, out(0), out(1), out(2), out(3));
+    if (mCalcRate == calc_FullRate) {
+      // The slot's own sample duration, so all readers compute the same times.
+      mTrajectory.render(clock.startS, clock.sampleDurS, numSamples, originMm, out(0), out(1), out(2), out(3));
+    } else {
+      // Control rate: the block is rendered at audio rate as every reader renders it, and the
+      // output is its last sample, so kr and ar readers of a slot agree whenever they started.
+      mTrajectory.render(clock.startS, clock.sampleDurS, clock.numSamples, originMm, nullptr, nullptr, nullptr,
+                         nullptr);
+      out0(0) = static_cast<float>(mTrajectory.renderedXMm() - originMm);
+      out0(1) = static_cast<float>(mTrajectory.renderedYMm());
+      out0(2) = static_cast<float>(mTrajectory.renderedSpeedXMmPerS());
+      out0(3) = static_cast<float>(mTrajectory.renderedSpeedYMmPerS());
+    }
   }
 
   kf::TrajectoryReconstructor mTrajectory;

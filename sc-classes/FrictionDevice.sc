@@ -265,6 +265,13 @@ FrictionDevice {
 	}
 
 	// Sends msg and awaits /done cmd or /kfFail for this slot (answerTimeout s at most).
+	// Sends a command nothing waits for (the board's: the server posts their result).
+	prSend { |msg|
+		if(server.isNil) { ^this };
+		if(server.serverRunning.not) { Error("FrictionDevice: server % is not running".format(server)).throw };
+		server.listSendMsg(msg)
+	}
+
 	prSendAnswered { |cmd, msg, onDone, onFail, block = true|
 		var cond, answer, inRoutine = block and: { thisThread.isKindOf(Routine) };
 		if(server.isNil) { ^this };

