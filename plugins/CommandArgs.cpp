@@ -198,8 +198,7 @@ bool readOverrides(OscArgReader& args, CommandArgs& out, char* error, size_t err
     if (!args.readString(key, length))
       return fail(error, errorSize, "argument %d: a setting name was expected, it is %s", args.position() + 1,
                   describe(args));
-    if (out.numOverrides == kMaxOverrides)
-      return fail(error, errorSize, "more than %d settings", kMaxOverrides);
+    if (out.numOverrides == kMaxOverrides) return fail(error, errorSize, "more than %d settings", kMaxOverrides);
     if (length == 0 || length >= static_cast<size_t>(kMaxKeyChars))
       return fail(error, errorSize, "setting name of %zu characters (1..%d allowed)", length, kMaxKeyChars - 1);
     double value = 0.0;

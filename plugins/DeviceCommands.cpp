@@ -70,8 +70,7 @@ void postRefusal(World* world, const char* name, const char* error) {
   int suppressed = 0;
   if (!limiters[slot].allow(kf::sc::blockStartTimeS(world), suppressed)) return;
   if (suppressed > 0)
-    kf::sc::postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error,
-                       suppressed);
+    kf::sc::postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error, suppressed);
   else
     kf::sc::postFromRt(world, "%s: %s; refused\n", name, error);
 }
