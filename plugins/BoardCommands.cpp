@@ -1,6 +1,6 @@
-// Asynchronous plugin commands for the friction board (device/PROTOCOL.md) of a device slot.
-// As in DeviceCommands.cpp: the RT stage only looks the slot's device up; opening, arming,
-// loading and closing run in NRT stages.
+// Asynchronous plugin commands for the friction board (device/PROTOCOL.md) of a device slot, on
+// the machinery of CommandRunner.hpp (checked arguments, /done or /kfFail): the RT stage only
+// looks the slot's device up; opening, arming, loading and closing run in NRT stages.
 //
 //   kfBoardOpen      index serial emulate inFlight   serial "" = the first board; emulate 1 =
 //                                                    the board emulator instead of libusb
@@ -16,6 +16,7 @@
 
 #include "BoardStatus.hpp"
 #include "CalibrationTable.hpp"
+#include "CommandRunner.hpp"
 #include "DeviceSlots.hpp"
 #include "EmulatedUsb.hpp"
 #include "PluginShared.hpp"
@@ -23,7 +24,7 @@
 
 namespace {
 
-constexpr int kMaxTextChars = 1024;
+using namespace kf::sc;
 
 // The values of a /kfBoardStatus reply, in order (sclang: FrictionDevice.boardStatusOf).
 enum BoardStatusField {
@@ -48,145 +49,91 @@ enum BoardStatusField {
   kBoardStatusFields
 };
 
-struct BoardCommand {
-  const char* name;
-  int index;
-  int flag;                  // emulate (open), arm (arm)
-  int inFlight;              // open
-  char text[kMaxTextChars];  // serial or path
-  kf::Device* device;
-  float values[kBoardStatusFields];  // kfBoardStatus
-};
+static_assert(kBoardStatusFields <= static_cast<int>(sizeof(CommandData::replyValues) / sizeof(float)));
 
-BoardCommand* newCommand(World* world, const char* name, sc_msg_iter* args) {
-  auto* data = static_cast<BoardCommand*>(RTAlloc(world, sizeof(BoardCommand)));
-  if (data == nullptr) {
-    kf::sc::postFromRt(world, "%s: RT memory allocation failed\n", name);
-    return nullptr;
-  }
-  data->name = name;
-  data->index = args->geti(-1);
-  data->flag = 0;
-  data->inFlight = 2;
-  data->text[0] = '\0';
-  data->device = nullptr;
-  std::fill_n(data->values, static_cast<int>(kBoardStatusFields), 0.0f);
-  if (!kf::sc::isValidSlot(data->index)) {
-    kf::sc::postFromRt(world, "%s: device index %d is out of range 0..%d\n", name, data->index,
-                       kf::sc::kNumDeviceSlots - 1);
-    RTFree(world, data);
-    return nullptr;
-  }
-  return data;
-}
-
-void readText(sc_msg_iter* args, BoardCommand* data) {
-  const char* text = args->gets("");
-  std::snprintf(data->text, kMaxTextChars, "%s", text != nullptr ? text : "");
-}
-
-void freeCommand(World* world, void* raw) { RTFree(world, raw); }
-
-// An open sent just before has published its device by the RT stage after an NRT hop.
-bool nrtHop(World*, void*) { return true; }
-
-bool lookUpDeviceStage(World*, void* raw) {  // RT
-  auto* data = static_cast<BoardCommand*>(raw);
-  data->device = kf::sc::peekSlot(data->index);
-  return true;
-}
-
-void run(World* world, void* replyAddr, BoardCommand* data, AsyncStageFn stage4) {
-  DoAsynchronousCommand(world, replyAddr, data->name, data, nrtHop, lookUpDeviceStage, stage4, freeCommand, 0, nullptr);
-}
-
-bool haveDevice(const BoardCommand* data) {
+bool haveDevice(CommandData* data) {
   if (data->device != nullptr) return true;
-  Print("%s: no device is open at index %d\n", data->name, data->index);
+  failWith(data, "%s: no device is open at index %d", data->name, data->args.index);
   return false;
 }
 
-kf::UsbBoardBackend* boardOf(const BoardCommand* data, std::shared_ptr<kf::ForceBackend>& holder) {
+kf::UsbBoardBackend* boardOf(CommandData* data, std::shared_ptr<kf::ForceBackend>& holder) {
   holder = data->device->board();
   auto* board = dynamic_cast<kf::UsbBoardBackend*>(holder.get());
-  if (board == nullptr) Print("%s: device %d has no board (kfBoardOpen first)\n", data->name, data->index);
+  if (board == nullptr) failWith(data, "%s: device %d has no board (kfBoardOpen first)", data->name, data->args.index);
   return board;
 }
 
 // --- kfBoardOpen ---------------------------------------------------------------------------
 
 bool openStage(World*, void* raw) {  // NRT
-  auto* data = static_cast<BoardCommand*>(raw);
+  auto* data = static_cast<CommandData*>(raw);
   if (!haveDevice(data)) return false;
   kf::BoardOptions options;
-  options.ids.serial = data->text;
-  options.transfersInFlight = data->inFlight;
+  const bool emulate = data->args.numbers[0] != 0.0;
+  options.ids.serial = data->args.which;
+  options.transfersInFlight = static_cast<int>(data->args.numbers[1]);
   options.minForceN = data->device->spec().minForceN;
   options.maxForceN = data->device->spec().maxForceN;
   std::unique_ptr<kf::usb::Port> port;
-  if (data->flag != 0)
-    port = kf::board::EmulatedUsb::create(data->text[0] != '\0' ? data->text : "KF-EMU-0001")->makePort();
+  if (emulate)
+    port = kf::board::EmulatedUsb::create(data->args.which[0] != '\0' ? data->args.which : "KF-EMU-0001")->makePort();
   else
     port = kf::usb::makeLibusbPort();
   auto board = std::make_shared<kf::UsbBoardBackend>(std::move(port), options);
   std::string error;
   if (!board->open(error)) {
-    Print("kfBoardOpen: %s\n", error.c_str());
+    failWith(data, "kfBoardOpen: %s", error.c_str());
     return false;
   }
   // The board replaced, if any, closes here (NRT) as the last reference goes.
   data->device->attachBoard(board);
   const kf::BoardTelemetry t = board->telemetry();
-  Print("kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA) is disarmed\n", data->index,
-        t.serial.c_str(), data->flag != 0 ? " (emulated)" : "", t.version.protocolMajor, t.version.protocolMinor,
-        t.version.firmwareMajor, t.version.firmwareMinor, t.version.firmwarePatch, t.version.fullScaleCurrentMa);
+  Print("kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA) is disarmed\n",
+        data->args.index, t.serial.c_str(), emulate ? " (emulated)" : "", t.version.protocolMajor,
+        t.version.protocolMinor, t.version.firmwareMajor, t.version.firmwareMinor, t.version.firmwarePatch,
+        t.version.fullScaleCurrentMa);
   return true;
 }
 
 void openCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  BoardCommand* data = newCommand(world, "kfBoardOpen", args);
-  if (data == nullptr) return;
-  readText(args, data);
-  data->flag = args->geti(0);
-  data->inFlight = args->geti(2);
-  run(world, replyAddr, data, openStage);
+  CommandData* data = newCommand(world, "kfBoardOpen", CommandShape::kBoardOpen, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, openStage);
 }
 
 // --- kfBoardArm ----------------------------------------------------------------------------
 
 bool armStage(World*, void* raw) {  // NRT
-  auto* data = static_cast<BoardCommand*>(raw);
+  auto* data = static_cast<CommandData*>(raw);
   if (!haveDevice(data)) return false;
   std::shared_ptr<kf::ForceBackend> holder;
   kf::UsbBoardBackend* board = boardOf(data, holder);
   if (board == nullptr) return false;
   std::string error;
-  const bool ok = data->flag != 0 ? board->arm(error) : board->disarm(error);
-  if (!ok) {
-    Print("kfBoardArm: %s\n", error.c_str());
+  const bool arm = data->args.numbers[0] != 0.0;
+  if (!(arm ? board->arm(error) : board->disarm(error))) {
+    failWith(data, "kfBoardArm: %s", error.c_str());
     return false;
   }
-  Print("kfBoardArm %d board %s\n", data->index, data->flag != 0 ? "armed" : "disarmed");
+  Print("kfBoardArm %d board %s\n", data->args.index, arm ? "armed" : "disarmed");
   return true;
 }
 
 void armCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  BoardCommand* data = newCommand(world, "kfBoardArm", args);
-  if (data == nullptr) return;
-  data->flag = args->geti(0);
-  run(world, replyAddr, data, armStage);
+  CommandData* data = newCommand(world, "kfBoardArm", CommandShape::kFlag, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, armStage);
 }
 
 // --- kfBoardCalibrate ----------------------------------------------------------------------
 
 bool calibrateStage(World*, void* raw) {  // NRT
-  auto* data = static_cast<BoardCommand*>(raw);
+  auto* data = static_cast<CommandData*>(raw);
   if (!haveDevice(data)) return false;
   const kf::DeviceSpec& spec = data->device->spec();
   kf::CalibrationTable table = kf::CalibrationTable::linear(spec.minForceN, spec.maxForceN);
   std::string error;
-  if (data->text[0] != '\0' && !kf::CalibrationTable::load(data->text, table, error)) {
-    Print("kfBoardCalibrate: %s\n", error.c_str());
+  if (data->args.path[0] != '\0' && !kf::CalibrationTable::load(data->args.path, table, error)) {
+    failWith(data, "kfBoardCalibrate: %s", error.c_str());
     return false;
   }
   data->device->setCalibration(table);
@@ -194,41 +141,38 @@ bool calibrateStage(World*, void* raw) {  // NRT
 }
 
 void calibrateCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  BoardCommand* data = newCommand(world, "kfBoardCalibrate", args);
-  if (data == nullptr) return;
-  readText(args, data);
-  run(world, replyAddr, data, calibrateStage);
+  CommandData* data = newCommand(world, "kfBoardCalibrate", CommandShape::kRecord, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, calibrateStage);
 }
 
 // --- kfBoardClose --------------------------------------------------------------------------
 
 bool closeStage(World*, void* raw) {  // NRT
-  auto* data = static_cast<BoardCommand*>(raw);
+  auto* data = static_cast<CommandData*>(raw);
   if (data->device != nullptr) data->device->attachBoard(nullptr);  // the board closes here
   return true;
 }
 
 void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  BoardCommand* data = newCommand(world, "kfBoardClose", args);
-  if (data == nullptr) return;
-  run(world, replyAddr, data, closeStage);
+  CommandData* data = newCommand(world, "kfBoardClose", CommandShape::kIndex, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, closeStage);
 }
 
 // --- kfBoardStatus -------------------------------------------------------------------------
 
 bool collectStatusStage(World*, void* raw) {  // NRT
-  auto* data = static_cast<BoardCommand*>(raw);
-  std::fill_n(data->values, static_cast<int>(kBoardStatusFields), 0.0f);
+  auto* data = static_cast<CommandData*>(raw);
+  std::fill_n(data->replyValues, static_cast<int>(kBoardStatusFields), 0.0f);
   if (data->device == nullptr) return true;  // replies all zeros: no device, no board
   const kf::TelemetrySnapshot t = data->device->telemetry();
   const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
-  data->values[kOnePerPump] = pumps > 0 ? static_cast<float>(t.framesPerPump[1] / double(pumps)) : 0.0f;
-  data->values[kOffsetP50S] = static_cast<float>(t.frameOffset.p50S);
+  data->replyValues[kOnePerPump] = pumps > 0 ? static_cast<float>(t.framesPerPump[1] / double(pumps)) : 0.0f;
+  data->replyValues[kOffsetP50S] = static_cast<float>(t.frameOffset.p50S);
   const std::shared_ptr<kf::ForceBackend> holder = data->device->board();
   const auto* board = dynamic_cast<const kf::UsbBoardBackend*>(holder.get());
   if (board == nullptr) return true;
   const kf::BoardTelemetry b = board->telemetry();
-  float* v = data->values;
+  float* v = data->replyValues;
   v[kHasBoard] = 1.0f;
   v[kConnected] = b.connected ? 1.0f : 0.0f;
   v[kArmed] = b.armed ? 1.0f : 0.0f;
@@ -248,21 +192,20 @@ bool collectStatusStage(World*, void* raw) {  // NRT
   return true;
 }
 
-// RT, the last stage: the reply goes from the root group to every client that asked for
-// notifications (sclang's default), then the command is freed.
-void replyStatusAndFree(World* world, void* raw) {
-  auto* data = static_cast<BoardCommand*>(raw);
+// RT, at the end: the reply goes from the root group to every client that asked for
+// notifications (sclang's default).
+void replyStatus(World* world, CommandData* data) {
   // The plugin headers do not define Group; the server's starts with its Node (SC_Group.h).
-  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->index, "/kfBoardStatus", kBoardStatusFields,
-                data->values);
-  RTFree(world, raw);
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfBoardStatus", kBoardStatusFields,
+                data->replyValues);
 }
 
 void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  BoardCommand* data = newCommand(world, "kfBoardStatus", args);
+  CommandData* data = newCommand(world, "kfBoardStatus", CommandShape::kIndex, args);
   if (data == nullptr) return;
-  DoAsynchronousCommand(world, replyAddr, data->name, data, nrtHop, lookUpDeviceStage, collectStatusStage,
-                        replyStatusAndFree, 0, nullptr);
+  std::fill_n(data->replyValues, static_cast<int>(kBoardStatusFields), 0.0f);
+  data->onEnd = replyStatus;
+  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, collectStatusStage);
 }
 
 }  // namespace

@@ -192,6 +192,15 @@ bool readText(OscArgReader& args, char* to, size_t capacity, const char* what, c
   return true;
 }
 
+// A whole number within [min, max] into `to`; `what` names it in errors.
+bool readWhole(OscArgReader& args, double min, double max, const char* what, double& to, char* error,
+               size_t errorSize) {
+  if (!args.readNumber(to)) return fail(error, errorSize, "%s: %s", what, describe(args));
+  if (!isWholeIn(to, min, max))
+    return fail(error, errorSize, "%s %g is not a whole number %g..%g", what, shown(to), min, max);
+  return true;
+}
+
 bool readPath(OscArgReader& args, CommandArgs& out, char* error, size_t errorSize) {
   return readText(args, out.path, kMaxPathChars, "path", error, errorSize);
 }
@@ -250,6 +259,13 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
              readPath(args, out, error, errorSize) && readOverrides(args, out, error, errorSize);
     case CommandShape::kListMice:
       return true;  // read above
+    case CommandShape::kBoardOpen:
+      return readText(args, out.which, kMaxPathChars, "serial", error, errorSize) &&
+             readWhole(args, 0.0, 1.0, "emulate", out.numbers[0], error, errorSize) &&
+             readWhole(args, 1.0, 4.0, "transfers in flight", out.numbers[1], error, errorSize) &&
+             noneLeft(args, error, errorSize);
+    case CommandShape::kFlag:
+      return readWhole(args, 0.0, 1.0, "flag", out.numbers[0], error, errorSize) && noneLeft(args, error, errorSize);
     case CommandShape::kPosition:
       out.positionMm[0] = out.positionMm[1] = 0.0;
       for (int axis = 0; axis < 2 && !args.atEnd(); ++axis) {

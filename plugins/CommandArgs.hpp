@@ -56,6 +56,8 @@ enum class CommandShape {
   kPosition,    // kfZero: index [xMm yMm]
   kOpenMouse,   // index which backend profilePath [key value]...
   kListMice,    // backend answerPath (no index)
+  kBoardOpen,   // index serial emulate(0/1) inFlight(1..4)
+  kFlag,        // index flag(0/1)
 };
 
 struct CommandArgs {
@@ -70,6 +72,7 @@ struct CommandArgs {
   double positionMm[2] = {0.0, 0.0};  // kPosition: x, y
   char which[kMaxPathChars];          // kOpenMouse: the mouse selector ("" the first)
   char backend[kMaxKeyChars];         // kOpenMouse, kListMice: "hidapi", "evdev" ("" default)
+  double numbers[2] = {0.0, 0.0};     // kBoardOpen: emulate, inFlight; kFlag: the flag
 };
 
 // Storage for `count` hand script values (RTAlloc in the plugin); null: out of memory.

@@ -121,6 +121,7 @@ void replyFailure(World* world, const CommandData* data) {
 
 void freeCommand(World* world, void* raw) {
   auto* data = static_cast<CommandData*>(raw);
+  if (data->onEnd != nullptr) data->onEnd(world, data);
   if (data->args.values != nullptr) RTFree(world, data->args.values);
   RTFree(world, data);
 }
@@ -134,6 +135,7 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   data->name = name;
   data->device = data->previous = nullptr;
   data->replace = data->failed = data->ownsDevice = false;
+  data->onEnd = nullptr;
   data->reason[0] = '\0';
   OscArgReader reader = readerOf(msg);
   char error[200];

@@ -24,6 +24,9 @@ struct CommandData {
   bool failed;           // a stage failed; `reason` says why
   char reason[kMaxReasonChars];
   AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
+  // RT, at the very end (success or not), before the command is freed: e.g. a reply with values.
+  void (*onEnd)(World* world, CommandData* data);
+  float replyValues[32];
 };
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.
