@@ -9,19 +9,12 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET="${1:-20}"
 shift || true
 TARGETS=("$@")
-((${#TARGETS[@]})) || TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args)
+((${#TARGETS[@]})) || TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args
+                               fuzz_calibration_table)
 
 # clang and its libFuzzer runtime, installed when missing (as scripts/setup.sh does its packages).
-missing=()
-for p in clang libclang-rt-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "== installing: ${missing[*]}"
-  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+source scripts/packages.sh
+kf_install_missing clang libclang-rt-dev
 BUILD=build-fuzz
 echo "== configuring and building the fuzz targets ($BUILD/)"
 CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
@@ -34,9 +27,10 @@ rm -rf "$SEEDS"
 "$BUILD/tests/fuzz/make_fuzz_seeds" "$SEEDS" tests/data/hid/*.hid
 
 declare -A SEED_DIR=([fuzz_hid_descriptor]=hid_descriptor [fuzz_hid_recorder]=hid_recorder
-                     [fuzz_session_file]=session_file [fuzz_command_args]=command_args)
+                     [fuzz_session_file]=session_file [fuzz_command_args]=command_args
+                     [fuzz_calibration_table]=calibration_table)
 declare -A MAX_LEN=([fuzz_hid_descriptor]=4096 [fuzz_hid_recorder]=16384
-                    [fuzz_session_file]=16384 [fuzz_command_args]=4096)
+                    [fuzz_session_file]=16384 [fuzz_command_args]=4096 [fuzz_calibration_table]=4096)
 failed=()
 for target in "${TARGETS[@]}"; do
   corpus="$BUILD/corpus/$target"

@@ -11,16 +11,8 @@ PACKAGES=(
   libhidapi-dev libusb-1.0-0-dev catch2 libsndfile1-dev jackd2
   python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
 )
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "== installing: ${missing[*]}"
-  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+source scripts/packages.sh
+kf_install_missing "${PACKAGES[@]}"
 
 echo "== configuring and building (build/)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" > build-configure.log 2>&1 || { cat build-configure.log; exit 1; }

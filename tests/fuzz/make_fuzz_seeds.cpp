@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string out = argv[1];
-  for (const char* dir : {"", "/hid_descriptor", "/hid_recorder", "/session_file", "/command_args"})
+  for (const char* dir :
+       {"", "/hid_descriptor", "/hid_recorder", "/session_file", "/command_args", "/calibration_table"})
     ::mkdir((out + dir).c_str(), 0755);
 
   for (int i = 2; i < argc; ++i) {
@@ -107,5 +108,8 @@ int main(int argc, char** argv) {
       Osc().i(15).body(),
   };
   for (size_t i = 0; i < commands.size(); ++i) writeBytes(out + "/command_args/" + std::to_string(i), commands[i]);
+  writeBytes(out + "/calibration_table/board",
+             "kf-calibration 1\nserial KF-0001\n# drive force\n0 0.14\n0.25 0.41\n0.5 0.72\n1 1.3\n");
+  writeBytes(out + "/calibration_table/flat", "kf-calibration 1\n0 0.14\n0.5 0.14\n1 1.4\n");
   return 0;
 }

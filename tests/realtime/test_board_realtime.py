@@ -6,17 +6,10 @@ import re
 import pytest
 
 from kfharness import paths, sclang
-from kfharness.jack import JackServer
 
 BOARD_LINE = re.compile(r"^kfStatus 5: board (\S+) (connected|NOT CONNECTED), (armed|disarmed); board state (\w+), "
                         r"current ([0-9.]+) of full scale")
 TIMING_LINE = re.compile(r"^kfStatus 5: frames per 1 ms pump 0/1/2/3\+: ([0-9.]+)/([0-9.]+)/([0-9.]+)/([0-9.]+)")
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from kfharness import paths, procs, readers, sclang
-from kfharness.jack import JackServer
 
 HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 COUNT_MM = 0.021
@@ -43,12 +42,6 @@ def positions(run):
     rows = np.array([[float(v) for v in r] for r in run.lines("KF-POS ")])
     assert rows.ndim == 2 and rows.shape[1] == 5, f"no position replies:\n{run.output[-3000:]}"
     return rows
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def test_sim_device_moves_the_puck_and_receives_the_force(jack):

@@ -9,15 +9,8 @@ import signal
 import pytest
 
 from kfharness import paths, procs, readers, sclang
-from kfharness.jack import JackServer
 
 FORCE_N = 1.4
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def run_and_signal(jack, signal_number, record):

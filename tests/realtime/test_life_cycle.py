@@ -4,16 +4,8 @@ Cmd-., reboot and ProxySpace, as SuperCollider users expect them.
 Each test prints its measured figures on a line starting with KF-FIGURE.
 """
 import numpy as np
-import pytest
 
 from kfharness import paths, readers, sclang
-from kfharness.jack import JackServer
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def values(run, tag):

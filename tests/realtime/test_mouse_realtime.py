@@ -1,16 +1,7 @@
 """A realtime server asked for a real mouse on a machine that may have none (CI has none): the
 server answers listMice, and opening fails with a message naming what is wrong; the slot stays
 closed (FrictionMouseIn says so) - never a simulator in the mouse's place."""
-import pytest
-
 from kfharness import sclang
-from kfharness.jack import JackServer
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def test_list_and_open_without_a_mouse(jack):

@@ -9,15 +9,8 @@ import numpy as np
 import pytest
 
 from kfharness import paths, readers, sclang
-from kfharness.jack import JackServer
 
 COUNT_MM = 0.021
-
-
-@pytest.fixture
-def jack():
-    with JackServer() as server:
-        yield server
 
 
 def figure(name, value):
