@@ -169,11 +169,12 @@ bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim,
     if (callerKey != nullptr && std::strcmp(key, callerKey) == 0) continue;
     std::string error;
     if (spec.applyOverride(key, value, &error)) continue;
-    // Not a device setting: perhaps a simulation or replay one (a device setting out of range
-    // stays an error).
-    const bool unknown = error.rfind("unknown", 0) == 0;
-    if (unknown && sim != nullptr && sim->applyOverride(key, value, &error)) continue;
-    if (unknown && replay != nullptr && replay->applyOverride(key, value, &error)) continue;
+    // Not a device setting: perhaps a simulation or replay one. A setting one of them knows but
+    // whose value is out of range is an error with that one's message.
+    auto unknown = [&error] { return error.rfind("unknown", 0) == 0; };
+    if (unknown() && sim != nullptr && sim->applyOverride(key, value, &error)) continue;
+    if (unknown() && replay != nullptr && replay->applyOverride(key, value, &error)) continue;
+    if (unknown()) error = "unknown setting '" + std::string(key) + "'";
     failWith(data, "%s: %s; not opened", data->name, error.c_str());
     return false;
   }
