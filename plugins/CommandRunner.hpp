@@ -1,4 +1,4 @@
-// The machinery every device plugin command shares (DeviceCommands.cpp, MouseCommands.cpp):
+// The machinery every plugin command shares (DeviceCommands, MouseCommands, BoardCommands):
 // arguments read and checked in the RT stage by CommandArgs (never past the packet), refusals
 // posted at most once a second per cause, the stages run as SC's asynchronous commands with
 // `/done cmdName` on success and `/kfFail` (node 0, replyID = the slot, then the reason as
@@ -26,7 +26,7 @@ struct CommandData {
   AsyncStageFn stages[3];  // the command's own stages, run by the wrappers of run()
   // RT, at the very end (success or not), before the command is freed: e.g. a reply with values.
   void (*onEnd)(World* world, CommandData* data);
-  float replyValues[32];
+  float replyValues[32];  // for onEnd (kfBoardStatus)
 };
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.
