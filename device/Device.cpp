@@ -123,9 +123,13 @@ void Device::takeFramesLocked(double nowS) {
     double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
     if (!std::isfinite(startS)) startS = nowS;
     // A frame later than the latency allows raises it, so the frames after it keep their
-    // spacing instead of going out in a burst (a long audio period).
+    // spacing instead of going out in a burst (a long audio period). Frames on time let it come
+    // back down by kLatencyDecayPerFrameS each, never below the base or what they need: one
+    // stall must not hold the force latency up for the rest of the session.
     const double latenessS = nowS - startS;
-    if (latenessS > releaseLatencyS_) releaseLatencyS_ = std::min(latenessS, options_.maxForceLatencyS);
+    releaseLatencyS_ =
+        std::min(std::max({options_.forceLatencyS, latenessS, releaseLatencyS_ - kLatencyDecayPerFrameS}),
+                 options_.maxForceLatencyS);
     if (pendingCount_ == pending_.size()) {
       // Full: the oldest goes out now rather than being lost.
       applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);

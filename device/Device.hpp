@@ -31,8 +31,9 @@ struct DeviceOptions {
   // Realtime: each force frame goes to the magnet at its own device time, its start plus this
   // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
   // them. A frame that arrives later than that (a long audio period, a late audio thread)
-  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS, as long as
-  // the device is open: the frames after it keep their spacing instead of coming in bursts.
+  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS: the frames
+  // after it keep their spacing instead of coming in bursts. Frames on time bring it back down
+  // slowly (1 ms a second), so a stall does not keep it raised.
   double forceLatencyS = 0.002;
   double maxForceLatencyS = 0.1;
   // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
@@ -111,6 +112,7 @@ class Device {
 
  private:
   static constexpr int kPollBatch = 64;
+  static constexpr double kLatencyDecayPerFrameS = 1e-6;  // 1 ms a second at 1 kHz frames
 
   struct PendingFrame {
     ForceFrame frame;
