@@ -72,9 +72,17 @@ std::string lineError(const std::string& path, int lineNumber, const std::string
 
 namespace {
 
-// Files being recorded, by (device, inode): two paths to one file are one file.
-std::mutex gRecordingFilesMutex;
-std::vector<std::pair<unsigned long long, unsigned long long>> gRecordingFiles;
+// Files being recorded, by (device, inode): two paths to one file are one file. Never destroyed:
+// the plugin's exit hook, itself a static destructor, closes recorders after this file's own
+// statics may be gone.
+struct RecordingFiles {
+  std::mutex mutex;
+  std::vector<std::pair<unsigned long long, unsigned long long>> keys;
+};
+RecordingFiles& recordingFiles() {
+  static RecordingFiles* files = new RecordingFiles;
+  return *files;
+}
 
 constexpr size_t kRecorderBufferBytes = 64 * 1024;  // written out when a pump fills it
 
@@ -126,14 +134,15 @@ bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string
   else if (!S_ISREG(info.st_mode))
     problem = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
   if (problem.empty()) {
-    std::lock_guard<std::mutex> lock(gRecordingFilesMutex);
+    RecordingFiles& files = recordingFiles();
+    std::lock_guard<std::mutex> lock(files.mutex);
     const std::pair<unsigned long long, unsigned long long> key{info.st_dev, info.st_ino};
-    if (std::find(gRecordingFiles.begin(), gRecordingFiles.end(), key) != gRecordingFiles.end()) {
+    if (std::find(files.keys.begin(), files.keys.end(), key) != files.keys.end()) {
       problem = "cannot record to " + path + ": another device is recording to this file";
     } else if (::ftruncate(fd, 0) != 0 || ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
       problem = "cannot write " + path + ": " + std::strerror(errno);
     } else {
-      gRecordingFiles.push_back(key);
+      files.keys.push_back(key);
       fileDevice_ = key.first;
       fileInode_ = key.second;
     }
@@ -232,9 +241,10 @@ void Recorder::close() {
     error_ = "closing " + path_ + " failed (" + std::strerror(code) + ")";
     newFailure_ = true;
   }
-  std::lock_guard<std::mutex> lock(gRecordingFilesMutex);
+  RecordingFiles& files = recordingFiles();
+  std::lock_guard<std::mutex> lock(files.mutex);
   const std::pair<unsigned long long, unsigned long long> key{fileDevice_, fileInode_};
-  gRecordingFiles.erase(std::remove(gRecordingFiles.begin(), gRecordingFiles.end(), key), gRecordingFiles.end());
+  files.keys.erase(std::remove(files.keys.begin(), files.keys.end(), key), files.keys.end());
 }
 
 void Recorder::appendOffFromSignal(double hostTimeS) const {

@@ -112,4 +112,11 @@ Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;
 }
 
+void visitLiveDevices(void (*visit)(Device*)) {
+  for (Slot& slot : gSlots)
+    if (Device* device = slot.device.load(std::memory_order_acquire)) visit(device);
+  for (std::atomic<Device*>& entry : gRetired)
+    if (Device* device = entry.load(std::memory_order_acquire)) visit(device);
+}
+
 }  // namespace kf::sc

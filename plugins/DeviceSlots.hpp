@@ -57,6 +57,11 @@ Device* peekSlot(int index);
 
 bool isValidSlot(int index);
 
+// Signal handlers (ExitSafety.cpp): calls `visit` on every device in a slot and every retired
+// one (its close has not finished). Atomic loads only, so async-signal-safe; a device whose NRT
+// stage deletes it at that very moment is the one race this last-resort path accepts.
+void visitLiveDevices(void (*visit)(Device*));
+
 // The slot a UGen's device input names, or -1 for NaN, infinities and anything outside
 // 0..kNumDeviceSlots-1 (a cast of those to int would be undefined).
 inline int slotIndexOf(float input) {

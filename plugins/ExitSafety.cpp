@@ -2,12 +2,14 @@
 // (DeviceSlots' exit hook closes every device); a signal does not, so at plugin load this
 // installs handlers for the signals that end the process — SIGTERM, SIGINT, SIGHUP, SIGQUIT,
 // and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a thread
-// aborts). Each handler drives every open device's force backend off with async-signal-safe
-// work only (atomic slot loads, stores, write(2) of an off record to a recording), then hands
-// the signal on: to the handler installed before ours if there was one, else the original
+// aborts). Each handler drives the force backend of every open device, and of every device
+// whose close has not finished, off with async-signal-safe work only (atomic slot loads,
+// stores, write(2) of an off record to a recording), then hands the signal on: to the handler installed before ours if there was one, else the original
 // disposition is restored and the signal raised again, so the exit status is the signal's.
 // A signal ignored when the plugin loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be
 // caught: the device thread dies with the process and a real magnet's own watchdog must act.
+#include "ExitSafety.hpp"
+
 #include <signal.h>
 
 #include <atomic>
@@ -23,8 +25,7 @@ std::atomic<bool> gInstalled[NSIG];
 std::atomic<bool> gDrivenOff{false};
 
 void driveAllOff() {
-  for (int index = 0; index < kf::sc::kNumDeviceSlots; ++index)
-    if (kf::Device* device = kf::sc::peekSlot(index)) device->emergencyOff();
+  kf::sc::visitLiveDevices([](kf::Device* device) { device->emergencyOff(); });
 }
 
 void onExitSignal(int signalNumber, siginfo_t* info, void* context) {

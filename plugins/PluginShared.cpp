@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "ExitSafety.hpp"
+
 InterfaceTable* ft = nullptr;
 
 namespace kf::sc {

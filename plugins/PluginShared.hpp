@@ -61,5 +61,3 @@ void registerFrictionOut();
 void registerDeviceCommands();
 void registerBoardCommands();
 void registerMouseCommands();
-// Signal handlers that drive every open device's magnet off on the way out (ExitSafety.cpp).
-void installExitSafety();

@@ -2,11 +2,15 @@
 # The habits CI enforces, beside the tests (scripts/test.sh runs this first):
 #   format     every C++ file as clang-format (the root .clang-format) would write it
 #   pyflakes   no unused import or undefined name in the Python
-#   no-sc      dsp/ and device/ build and pass their tests without SuperCollider (build-nosc/)
-#   sanitize   the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/);
-#              any finding fails
+#   sanitize   dsp/ and device/ built without SuperCollider, their C++ tests under AddressSanitizer
+#              + UndefinedBehaviorSanitizer (build-asan/); any finding fails
 #   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh)
-# Usage: scripts/check.sh [format|pyflakes|no-sc|sanitize|fuzz]...   (none: all, in this order)
+#   sanitize-plugin
+#              the scene and realtime tests against the plugin built with both sanitizers
+#              (build-asan-plugin/), their runtimes preloaded into every scsynth the tests start
+#              (KF_SERVER_PRELOAD); any finding fails. KF_SANITIZED_TESTS: a ctest regex to run
+#              fewer of them.
+# Usage: scripts/check.sh [format|pyflakes|sanitize|fuzz|sanitize-plugin]...   (none: all, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/env.sh
@@ -24,26 +28,43 @@ check_pyflakes() {
   git ls-files '*.py' | xargs "$KF_PYTHON" -m pyflakes
 }
 
-# build_and_test <dir> <ctest regex> <cmake args...>
-build_and_test() {
-  local dir=$1 regex=$2
-  shift 2
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "$@" > "$dir.configure.log" 2>&1 ||
+# configure_and_build <dir> <cmake args...> [-- <build args...>]
+configure_and_build() {
+  local dir=$1
+  shift
+  local configure=() build=()
+  while (($#)) && [[ $1 != -- ]]; do configure+=("$1"); shift; done
+  (($#)) && shift && build=("$@")
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${configure[@]}" > "$dir.configure.log" 2>&1 ||
     { cat "$dir.configure.log"; return 1; }
   rm -f "$dir.configure.log"
-  cmake --build "$dir" -j "$(nproc)"
-  ctest --test-dir "$dir" --output-on-failure -j "$(nproc)" -R "$regex"
-}
-
-check_no_sc() {
-  echo "== dsp/ and device/ without SuperCollider (build-nosc/)"
-  build_and_test build-nosc 'dsp/|device/' -DKF_WITH_SC=OFF
+  cmake --build "$dir" -j "$(nproc)" "${build[@]}"
 }
 
 check_sanitize() {
-  echo "== C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)"
+  echo "== dsp/ and device/ without SuperCollider, C++ tests under ASan + UBSan (build-asan/)"
+  configure_and_build build-asan -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-    build_and_test build-asan 'dsp/|device/' -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined
+    ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/'
+}
+
+check_sanitize_plugin() {
+  echo "== scene and realtime tests against the plugin under ASan + UBSan (build-asan-plugin/)"
+  configure_and_build build-asan-plugin -DKF_SANITIZE=address,undefined -DKF_SUPERNOVA=OFF -- --target KineticFriction
+  # A finding aborts scsynth, which fails its test; the reports also go to files, so that one in
+  # a server whose test did not notice (at exit, say) fails the check too. The leak check stays
+  # off in the server: scsynth does not free its own allocations at exit.
+  local logs=$PWD/build-asan-plugin/sanitizer-logs
+  rm -rf "$logs" && mkdir -p "$logs"
+  KF_SERVER_PRELOAD="$(gcc -print-file-name=libasan.so) $(gcc -print-file-name=libubsan.so)" \
+    ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:log_path=$logs/asan \
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$logs/ubsan \
+    ctest --test-dir build-asan-plugin --output-on-failure -j 1 -R "${KF_SANITIZED_TESTS:-scenes/|realtime/}"
+  if compgen -G "$logs/*" >/dev/null; then
+    echo "sanitizer findings in servers:" >&2
+    cat "$logs"/* >&2
+    return 1
+  fi
 }
 
 check_fuzz() {
@@ -52,14 +73,14 @@ check_fuzz() {
 }
 
 checks=("$@")
-((${#checks[@]})) || checks=(format pyflakes no-sc sanitize fuzz)
+((${#checks[@]})) || checks=(format pyflakes sanitize fuzz sanitize-plugin)
 for check in "${checks[@]}"; do
   case "$check" in
     format) check_format ;;
     pyflakes) check_pyflakes ;;
-    no-sc) check_no_sc ;;
     sanitize) check_sanitize ;;
     fuzz) check_fuzz ;;
-    *) echo "unknown check: $check (format, pyflakes, no-sc, sanitize, fuzz)" >&2; exit 2 ;;
+    sanitize-plugin) check_sanitize_plugin ;;
+    *) echo "unknown check: $check (format, pyflakes, sanitize, fuzz, sanitize-plugin)" >&2; exit 2 ;;
   esac
 done

@@ -26,6 +26,23 @@ def environment(base=None):
     return env
 
 
+def server_preload():
+    """The libraries every server the harness starts gets in LD_PRELOAD (KF_SERVER_PRELOAD, e.g. the
+    ASan and UBSan runtimes for a sanitized plugin, which an uninstrumented scsynth cannot load
+    otherwise); empty: none. Only the server gets them, not sclang."""
+    return os.environ.get("KF_SERVER_PRELOAD", "").strip()
+
+
+def server_program_code():
+    """sclang that makes Server.program (booted servers) and Score.program start scsynth with
+    server_preload(); empty when there is nothing to preload."""
+    libs = server_preload()
+    if not libs:
+        return ""
+    return (f"Server.program = \"exec env LD_PRELOAD=\" ++ {sc_string(libs)}.shellQuote ++ \" scsynth\";\n"
+            "Score.program = Server.program;\n")
+
+
 def config(include_paths=None):
     """A language config (sclang -l) that adds the classes to the standard library; default: the
     extension folder's Classes."""
@@ -40,7 +57,7 @@ def config(include_paths=None):
 # of leaving sclang waiting.
 SCRIPT_WRAPPER = """var fn = File.readAllString(%(code)s).compile;
 if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
-  { fn.value; "KF-SCRIPT-OK".postln; 0.exit }.try { |error|
+  %(program)s{ fn.value; "KF-SCRIPT-OK".postln; 0.exit }.try { |error|
     error.reportError; "KF-SCRIPT-ERROR".postln; 1.exit } };
 """
 
@@ -57,7 +74,7 @@ def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="scri
     when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok)."""
     key, code_path = _script_files(code, name)
     script = paths.work_dir() / f"{key}.scd"
-    script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path)))
+    script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path), program=server_program_code()))
     proc = subprocess.run(["sclang", "-l", str(config(include_paths)), str(script)],
                           stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           env=environment(), timeout=timeout, text=True, errors="replace")
@@ -92,7 +109,7 @@ SERVER_WRAPPER = r"""
 var fn = File.readAllString(%(code)s).compile;
 if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 	var options, finish;
-	Server.local.addr = NetAddr("127.0.0.1", %(port)d);
+%(program)s	Server.local.addr = NetAddr("127.0.0.1", %(port)d);
 	Server.default = s = Server.local;
 	options = s.options;
 	options.sampleRate = %(rate)d;
@@ -141,7 +158,7 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
     key, code_path = _script_files(code, name)
     script = paths.work_dir() / f"{key}.scd"
     script.write_text(SERVER_WRAPPER % dict(code=sc_string(code_path), port=port, rate=jack.sample_rate,
-                                            period=jack.period, timeout=max(timeout - 10, 5),
+                                            period=jack.period, timeout=max(timeout - 10, 5), program=server_program_code(),
                                             options="".join(f"\toptions.{k} = {v};\n"
                                                             for k, v in (server_options or {}).items())))
     log_path = paths.work_dir() / f"{key}.log"
