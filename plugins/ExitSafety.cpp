@@ -4,10 +4,11 @@
 // and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a thread
 // aborts). Each handler drives the force backend of every open device, and of every device
 // whose close has not finished, off with async-signal-safe work only (atomic slot loads,
-// stores, write(2) of an off record to a recording), then hands the signal on: to the handler installed before ours if there was one, else the original
-// disposition is restored and the signal raised again, so the exit status is the signal's.
-// A signal ignored when the plugin loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be
-// caught: the device thread dies with the process and a real magnet's own watchdog must act.
+// stores, write(2) of an off record to a recording), then hands the signal on: to the handler
+// installed before ours if there was one, else the original disposition is restored and the
+// signal raised again, so the exit status is the signal's. A signal ignored when the plugin
+// loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be caught: the device thread dies with
+// the process and a real magnet's own watchdog must act.
 #include "ExitSafety.hpp"
 
 #include <signal.h>
