@@ -22,18 +22,11 @@ bool atFieldLimit(int32_t value) {
 
 std::unique_ptr<EvdevMouseBackend> EvdevMouseBackend::open(std::shared_ptr<EvdevApi> api, const std::string& which,
                                                            bool grab, std::string& error, OpenFailure* why) {
-  OpenFailure failure = OpenFailure::kOther;
-  if (why) *why = failure;
+  if (why) *why = OpenFailure::kOther;
   std::vector<MouseInfo> mice;
-  MouseInfo info;
-  if (!api->enumerateMice(mice, error) || !selectMouse(mice, which, info, error)) return nullptr;
+  if (!api->enumerateMice(mice, error)) return nullptr;
   std::unique_ptr<EvdevMouseBackend> backend(new EvdevMouseBackend(std::move(api), grab));
-  if (!backend->openInfo(info, error, failure)) {
-    if (why) *why = failure;
-    return nullptr;
-  }
-  if (why) *why = OpenFailure::kNone;
-  backend->startReader();
+  if (!backend->openSelected(mice, which, error, why)) return nullptr;
   return backend;
 }
 

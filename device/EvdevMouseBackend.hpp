@@ -31,7 +31,7 @@ class EvdevMouseBackend : public RealMouseBackend {
 
  private:
   EvdevMouseBackend(std::shared_ptr<EvdevApi> api, bool grab) : api_(std::move(api)), grab_(grab) {}
-  bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why);
+  bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) override;
   void take(const EvdevEvent& event);
 
   std::shared_ptr<EvdevApi> api_;

@@ -24,10 +24,6 @@ bool parseHexBytes(std::istringstream& fields, size_t count, std::vector<uint8_t
   return out.size() == count;
 }
 
-std::string lineError(const std::string& path, int lineNumber, const std::string& what) {
-  return path + ":" + std::to_string(lineNumber) + ": " + what;
-}
-
 std::string firstRecordTag(const std::string& path) {
   TextFileReader reader;
   std::string error, line;
@@ -55,26 +51,12 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
   int device = 0;
   bool haveDescriptor = false;
   for (;;) {
-    const TextFileReader::Line status = reader.next(line, kMaxHidRecorderLineChars);
-    const int lineNumber = reader.lineNumber();
-    if (status == TextFileReader::Line::kEnd) break;
-    if (status == TextFileReader::Line::kError) {
-      error = lineError(path, lineNumber, "read error");
-      return false;
-    }
-    if (status == TextFileReader::Line::kTooLong) {
-      error =
-          lineError(path, lineNumber, "line longer than " + std::to_string(kMaxHidRecorderLineChars) + " characters");
-      return false;
-    }
-    if (status == TextFileReader::Line::kCut && haveDescriptor) {
-      out.warning = lineError(
-          path, lineNumber, "the last line was cut; loaded the " + std::to_string(lineNumber - 1) + " lines before it");
-      break;
-    }
+    const auto record = reader.nextRecord(line, kMaxHidRecorderLineChars, haveDescriptor, error, out.warning);
+    if (record == TextFileReader::Record::kFailed) return false;
+    if (record == TextFileReader::Record::kEnd) break;
     if (line.empty() || line[0] == '#') continue;
     if (line.size() < 2 || line[1] != ':') {
-      error = lineError(path, lineNumber, "not a hid-recorder record");
+      error = reader.lineError("not a hid-recorder record");
       return false;
     }
     const char tag = line[0];
@@ -83,7 +65,7 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
     fields.imbue(std::locale::classic());
     if (tag == 'D') {
       if (!(fields >> device)) {
-        error = lineError(path, lineNumber, "bad D: record");
+        error = reader.lineError("bad D: record");
         return false;
       }
       continue;
@@ -92,7 +74,7 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
     if (tag == 'R') {
       size_t length = 0;
       if (!(fields >> length) || !parseHexBytes(fields, length, out.descriptor)) {
-        error = lineError(path, lineNumber, "R: length does not match its bytes, or bad hex");
+        error = reader.lineError("R: length does not match its bytes, or bad hex");
         return false;
       }
       haveDescriptor = true;
@@ -102,7 +84,7 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
       out.physicalPath = rest;
     } else if (tag == 'I') {
       if (!(fields >> std::hex >> out.bus >> out.vendorId >> out.productId)) {
-        error = lineError(path, lineNumber, "bad I: record");
+        error = reader.lineError("bad I: record");
         return false;
       }
     } else if (tag == 'E') {
@@ -110,14 +92,14 @@ bool readHidRecorderFile(const std::string& path, HidRecording& out, std::string
       size_t length = 0;
       std::string timeToken;
       if (!(fields >> timeToken >> length)) {
-        error = lineError(path, lineNumber, "bad E: record");
+        error = reader.lineError("bad E: record");
         return false;
       }
       char* end = nullptr;
       event.timeS = std::strtod(timeToken.c_str(), &end);
       if (end != timeToken.c_str() + timeToken.size() || !std::isfinite(event.timeS) ||
           !parseHexBytes(fields, length, event.bytes)) {
-        error = lineError(path, lineNumber, "E: time, length or bytes malformed");
+        error = reader.lineError("E: time, length or bytes malformed");
         return false;
       }
       out.events.push_back(std::move(event));

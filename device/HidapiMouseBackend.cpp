@@ -6,18 +6,11 @@ namespace kf {
 
 std::unique_ptr<HidapiMouseBackend> HidapiMouseBackend::open(std::shared_ptr<HidApi> api, const std::string& which,
                                                              std::string& error, OpenFailure* why) {
-  OpenFailure failure = OpenFailure::kOther;
-  if (why) *why = failure;
+  if (why) *why = OpenFailure::kOther;
   std::vector<MouseInfo> mice;
-  MouseInfo info;
-  if (!api->enumerateMice(mice, error) || !selectMouse(mice, which, info, error)) return nullptr;
+  if (!api->enumerateMice(mice, error)) return nullptr;
   std::unique_ptr<HidapiMouseBackend> backend(new HidapiMouseBackend(std::move(api)));
-  if (!backend->openInfo(info, error, failure)) {
-    if (why) *why = failure;
-    return nullptr;
-  }
-  if (why) *why = OpenFailure::kNone;
-  backend->startReader();
+  if (!backend->openSelected(mice, which, error, why)) return nullptr;
   return backend;
 }
 

@@ -30,7 +30,7 @@ class HidapiMouseBackend : public RealMouseBackend {
 
  private:
   explicit HidapiMouseBackend(std::shared_ptr<HidApi> api) : api_(std::move(api)) {}
-  bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why);
+  bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) override;
   void take(const uint8_t* bytes, int size, double arrivalS);
 
   std::shared_ptr<HidApi> api_;

@@ -2,11 +2,23 @@
 
 #include <cstdio>
 
+#include "MouseSelect.hpp"
+
 namespace kf {
 
 RealMouseBackend::RealMouseBackend() : originS_(monotonicNowS()), queue_(kQueueCapacity) {}
 
 RealMouseBackend::~RealMouseBackend() { stop(); }
+
+bool RealMouseBackend::openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error,
+                                    OpenFailure* why) {
+  OpenFailure failure = OpenFailure::kOther;
+  MouseInfo info;
+  const bool opened = selectMouse(mice, which, info, error) && openInfo(info, error, failure);
+  if (why) *why = opened ? OpenFailure::kNone : failure;
+  if (opened) startReader();
+  return opened;
+}
 
 void RealMouseBackend::startReader() {
   if (thread_.joinable()) return;

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "MouseBackend.hpp"
 #include "MouseIo.hpp"
@@ -77,6 +78,12 @@ class RealMouseBackend : public MouseBackend {
   virtual void closeHandle() = 0;
   // Reader thread: finds the same mouse again and opens it; false with a message.
   virtual bool reopenHandle(std::string& error) = 0;
+  // Opens the handle of this mouse (at open and re-open); false with a message and why.
+  virtual bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) = 0;
+
+  // Every kind's open(), once its API has listed `mice`: selects `which` (MouseSelect), opens
+  // it and starts the reader. False with a message; *why (if given) says why.
+  bool openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error, OpenFailure* why);
 
   void emit(MouseReport report);  // reader thread; counts, measures, queues
   void countLoss() { lossEvents_.fetch_add(1, std::memory_order_relaxed); }

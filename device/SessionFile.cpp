@@ -64,10 +64,6 @@ bool parseFloat(const std::string& token, float& value) {
   return true;
 }
 
-std::string lineError(const std::string& path, int lineNumber, const std::string& what) {
-  return path + ":" + std::to_string(lineNumber) + ": " + what;
-}
-
 }  // namespace
 
 namespace {
@@ -292,24 +288,9 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
   std::string line;
   bool haveHeader = false;
   for (;;) {
-    const TextFileReader::Line status = reader.next(line, kMaxSessionLineChars);
-    const int lineNumber = reader.lineNumber();
-    if (status == TextFileReader::Line::kEnd) break;
-    if (status == TextFileReader::Line::kError) {
-      error = lineError(path, lineNumber, "read error");
-      return false;
-    }
-    if (status == TextFileReader::Line::kTooLong) {
-      error = lineError(path, lineNumber, "line longer than " + std::to_string(kMaxSessionLineChars) + " characters");
-      return false;
-    }
-    if (status == TextFileReader::Line::kCut && haveHeader) {
-      // Recorder ends every line with '\n': a last line without it was cut (a crash, a full
-      // disk). Everything before it is kept.
-      out.warning = lineError(
-          path, lineNumber, "the last line was cut; loaded the " + std::to_string(lineNumber - 1) + " lines before it");
-      break;
-    }
+    const auto record = reader.nextRecord(line, kMaxSessionLineChars, haveHeader, error, out.warning);
+    if (record == TextFileReader::Record::kFailed) return false;
+    if (record == TextFileReader::Record::kEnd) break;
     if (line.empty() || line[0] == '#') continue;
     std::istringstream fields(line);
     fields.imbue(std::locale::classic());
@@ -318,24 +299,24 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
     if (!haveHeader) {
       int version = 0;
       if (tag != kSessionFormatName || !(fields >> version)) {
-        error = lineError(path, lineNumber, "not a kf-session file");
+        error = reader.lineError("not a kf-session file");
         return false;
       }
       if (version != kSessionFormatVersion) {
-        error = lineError(path, lineNumber, "unsupported kf-session version " + std::to_string(version));
+        error = reader.lineError("unsupported kf-session version " + std::to_string(version));
         return false;
       }
       std::string pair;
       while (fields >> pair) {
         const size_t equals = pair.find('=');
         if (equals == std::string::npos) {
-          error = lineError(path, lineNumber, "header field without '=': " + pair);
+          error = reader.lineError("header field without '=': " + pair);
           return false;
         }
         const std::string key = pair.substr(0, equals);
         double value = 0.0;
         if (!parseDouble(pair.substr(equals + 1), value)) {
-          error = lineError(path, lineNumber, "bad value in header field " + pair);
+          error = reader.lineError("bad value in header field " + pair);
           return false;
         }
         // Unknown keys are skipped so newer files still load; known ones must be in bounds.
@@ -343,17 +324,17 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
         std::string why;
         if (!out.spec.applyOverride(key, value, &why)) {
           if (why.rfind("unknown", 0) == 0) continue;  // a bounded name that is not a spec field
-          error = lineError(path, lineNumber, "header: " + why);
+          error = reader.lineError("header: " + why);
           return false;
         }
       }
       std::string why;
       if (!out.spec.isValid(&why)) {
-        error = lineError(path, lineNumber, "header: " + why);
+        error = reader.lineError("header: " + why);
         return false;
       }
       haveHeader = true;
-      if (status == TextFileReader::Line::kCut) break;  // a header alone, cut after its last field
+      if (reader.cut()) break;  // a header alone, cut after its last field
       continue;
     }
     std::vector<std::string> tokens;
@@ -378,11 +359,11 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
       ok = tokens.size() == 1 && parseDouble(tokens[0], timeS) && std::isfinite(timeS);
       if (ok) out.offTimesS.push_back(timeS);
     } else {
-      error = lineError(path, lineNumber, "unknown record '" + tag.substr(0, 32) + "'");
+      error = reader.lineError("unknown record '" + tag.substr(0, 32) + "'");
       return false;
     }
     if (!ok) {
-      error = lineError(path, lineNumber, "malformed '" + tag + "' record");
+      error = reader.lineError("malformed '" + tag + "' record");
       return false;
     }
   }

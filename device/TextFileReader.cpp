@@ -14,6 +14,7 @@ TextFileReader::~TextFileReader() {
 }
 
 bool TextFileReader::open(const std::string& path, std::string& error, uint64_t maxBytes) {
+  path_ = path;
   if (path.empty()) {
     error = "no file given (empty path)";
     return false;
@@ -75,6 +76,34 @@ TextFileReader::Line TextFileReader::next(std::string& line, size_t maxChars) {
   ++lineNumber_;
   if (!line.empty() && line.back() == '\r') line.pop_back();
   return c == EOF ? Line::kCut : Line::kOk;
+}
+
+TextFileReader::Record TextFileReader::nextRecord(std::string& line, size_t maxChars, bool keepBeforeCut,
+                                                  std::string& error, std::string& warning) {
+  const Line status = next(line, maxChars);
+  cut_ = status == Line::kCut;
+  switch (status) {
+    case Line::kEnd:
+      return Record::kEnd;
+    case Line::kError:
+      error = lineError("read error");
+      return Record::kFailed;
+    case Line::kTooLong:
+      error = lineError("line longer than " + std::to_string(maxChars) + " characters");
+      return Record::kFailed;
+    case Line::kCut:
+      // Writers end every line with '\n': a last line without it was cut (a crash, a full disk).
+      if (!keepBeforeCut) return Record::kLine;
+      warning = lineError("the last line was cut; loaded the " + std::to_string(lineNumber_ - 1) + " lines before it");
+      return Record::kEnd;
+    case Line::kOk:
+      break;
+  }
+  return Record::kLine;
+}
+
+std::string TextFileReader::lineError(const std::string& what) const {
+  return path_ + ":" + std::to_string(lineNumber_) + ": " + what;
 }
 
 }  // namespace kf

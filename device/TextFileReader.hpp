@@ -30,7 +30,19 @@ class TextFileReader {
   Line next(std::string& line, size_t maxChars);
   int lineNumber() const { return lineNumber_; }
 
+  // A recording's next line, with what every recording reader does about next()'s outcomes.
+  // kLine: use `line` (cut() says whether the file ended inside it). kEnd: the file ended; or
+  // its last line was cut once keepBeforeCut (the caller has what it needs), and `warning` says
+  // what was kept. kFailed: a read error or a line over maxChars, in `error`.
+  enum class Record { kLine, kEnd, kFailed };
+  Record nextRecord(std::string& line, size_t maxChars, bool keepBeforeCut, std::string& error, std::string& warning);
+  bool cut() const { return cut_; }
+  // "path:line: what", for the line read last.
+  std::string lineError(const std::string& what) const;
+
  private:
+  std::string path_;
+  bool cut_ = false;
   std::FILE* file_ = nullptr;
   int lineNumber_ = 0;
 };

@@ -287,14 +287,23 @@ FrictionDevice {
 		}, { |reason|
 			answer = reason;
 			onFail.value(reason);
-			if(inRoutine.not) { "ERROR: FrictionDevice %: %".format(cmd, reason).postln };
+			if(inRoutine.not) { ("ERROR: " ++ this.prFailText(cmd, reason)).postln };
 			cond.test = true; cond.signal;
 		});
 		server.listSendMsg(msg);
 		if(inRoutine) {
 			cond.wait;
-			if(answer != \done) { Error("FrictionDevice %: %".format(cmd, answer)).throw };
+			if(answer != \done) { Error(this.prFailText(cmd, answer)).throw };
 		};
+	}
+
+	// The server's reasons name their command already ("kfOpenSim: ..."); ours do not.
+	prFailText { |cmd, reason|
+		^if(reason.beginsWith(cmd.asString ++ ":")) {
+			"FrictionDevice " ++ reason
+		} {
+			"FrictionDevice %: %".format(cmd, reason)
+		}
 	}
 
 	prForget { |newState|

@@ -49,6 +49,7 @@ def test_a_rejected_open_is_an_error_and_a_taken_slot_is_refused_unless_replaced
     """, jack, name="answers"))
     rejected = run.lines("KF-REJECTED ")
     assert rejected and "unknown setting" in " ".join(rejected[0]) and "noSuchSetting" in " ".join(rejected[0])
+    assert " ".join(rejected[0]).count("kfOpenSim") == 1, f"the command is named once: {rejected[0]}"
     assert values(run, "KF-ALL-AFTER-REJECT ") == [["0"]]
     assert "is taken" in " ".join(run.lines("KF-TAKEN ")[0])
     assert "taken" in " ".join(run.lines("KF-SERVER-FAIL ")[0])
