@@ -123,13 +123,10 @@ void Device::takeFramesLocked(double nowS) {
     double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
     if (!std::isfinite(startS)) startS = nowS;
     // A frame later than the latency allows raises it, so the frames after it keep their
-    // spacing instead of going out in a burst (a long audio period). Frames on time let it come
-    // back down by kLatencyDecayPerFrameS each, never below the base or what they need: one
-    // stall must not hold the force latency up for the rest of the session.
+    // spacing instead of going out in a burst (a long audio period).
     const double latenessS = nowS - startS;
-    releaseLatencyS_ =
-        std::min(std::max({options_.forceLatencyS, latenessS, releaseLatencyS_ - kLatencyDecayPerFrameS}),
-                 options_.maxForceLatencyS);
+    windowLatenessS_ = std::max(windowLatenessS_, latenessS);
+    releaseLatencyS_ = std::max(releaseLatencyS_, std::min(latenessS, options_.maxForceLatencyS));
     if (pendingCount_ == pending_.size()) {
       // Full: the oldest goes out now rather than being lost.
       applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);
@@ -140,6 +137,19 @@ void Device::takeFramesLocked(double nowS) {
     pending_[(pendingHead_ + pendingCount_) % pending_.size()] = PendingFrame{frame, startS};
     ++pendingCount_;
   }
+}
+
+void Device::settleLatencyLocked(double nowS) {
+  if (nowS >= windowEndS_) {
+    previousWindowLatenessS_ = windowLatenessS_;
+    windowLatenessS_ = 0.0;
+    windowEndS_ = nowS + kLatencyWindowS;
+  }
+  // Down to what the frames of the last 0.5 to 1 s needed, never below the base, a step per
+  // pump: one stall must not hold the force latency up for the rest of the session.
+  const double neededS = std::min(std::max({options_.forceLatencyS, windowLatenessS_, previousWindowLatenessS_}),
+                                  options_.maxForceLatencyS);
+  if (releaseLatencyS_ > neededS) releaseLatencyS_ = std::max(neededS, releaseLatencyS_ - kLatencyDecayPerPumpS);
 }
 
 int Device::releaseFramesLocked(double nowS) {
@@ -177,6 +187,7 @@ void Device::pumpLocked(double nowS) {
     while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
   } else {
     takeFramesLocked(nowS);
+    settleLatencyLocked(nowS);
     const int released = releaseFramesLocked(nowS);
     if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
     telemetry_.setReleaseLatency(releaseLatencyS_);

@@ -32,8 +32,9 @@ struct DeviceOptions {
   // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
   // them. A frame that arrives later than that (a long audio period, a late audio thread)
   // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS: the frames
-  // after it keep their spacing instead of coming in bursts. Frames on time bring it back down
-  // slowly (1 ms a second), so a stall does not keep it raised.
+  // after it keep their spacing instead of coming in bursts. Once no frame of the last 0.5 to 1 s
+  // needed it, it comes back down by 50 us a pump (frames 0.95 ms apart meanwhile), so a stall
+  // does not keep it raised, while long audio periods, whose every burst needs it, keep it.
   double forceLatencyS = 0.002;
   double maxForceLatencyS = 0.1;
   // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
@@ -112,7 +113,8 @@ class Device {
 
  private:
   static constexpr int kPollBatch = 64;
-  static constexpr double kLatencyDecayPerFrameS = 1e-6;  // 1 ms a second at 1 kHz frames
+  static constexpr double kLatencyWindowS = 0.5;          // how long a frame's need is remembered
+  static constexpr double kLatencyDecayPerPumpS = 50e-6;  // 5 % of a 1 ms frame spacing
 
   struct PendingFrame {
     ForceFrame frame;
@@ -128,6 +130,7 @@ class Device {
   void applyLockstepFrameLocked(const ForceFrame& frame, double nowS);
   // Realtime jitter buffer: queue -> pending (with release times), then the due ones out.
   void takeFramesLocked(double nowS);
+  void settleLatencyLocked(double nowS);
   int releaseFramesLocked(double nowS);
 
   const DeviceSpec spec_;
@@ -152,6 +155,9 @@ class Device {
   size_t pendingHead_ = 0;
   size_t pendingCount_ = 0;
   double releaseLatencyS_;
+  // The largest lateness of the frames taken in this window and the one before (seconds).
+  double windowLatenessS_ = 0.0, previousWindowLatenessS_ = 0.0;
+  double windowEndS_ = 0.0;
   int64_t xCounts_ = 0;  // the puck's position since open (MouseReport::xCounts)
   int64_t yCounts_ = 0;
 

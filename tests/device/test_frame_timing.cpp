@@ -142,11 +142,17 @@ struct ExactRun {
   std::vector<TimelineSink::Event> commands;
   TelemetrySnapshot telemetry;
   int maxPerPump = 0;
+  std::vector<double> latencyS;  // after each pump
+};
+
+// An audio thread that delivers nothing from startS for stallS, then catches up at once.
+struct Stall {
+  double startS = 0.0, stallS = 0.0;
 };
 
 // Audio blocks of blockSamples at rateHz push their completed frames at each block's end; the
 // device is pumped every 1 ms, its pumps offset from the audio clock by pumpPhaseS.
-ExactRun runExact(int blockSamples, double rateHz, double seconds, double pumpPhaseS) {
+ExactRun runExact(int blockSamples, double rateHz, double seconds, double pumpPhaseS, Stall stall = {}) {
   DeviceOptions options;
   options.externalPump = true;
   auto sink = std::make_shared<TimelineSink>();
@@ -160,12 +166,14 @@ ExactRun runExact(int blockSamples, double rateHz, double seconds, double pumpPh
   ExactRun run;
   for (int pump = 1; pump * 0.001 + pumpPhaseS < seconds; ++pump) {
     const double pumpS = pump * 0.001 + pumpPhaseS;
-    for (; block * blockS <= pumpS; ++block)  // the audio blocks that ended before this pump
+    const bool stalled = pumpS >= stall.startS && pumpS < stall.startS + stall.stallS;
+    for (; !stalled && block * blockS <= pumpS; ++block)  // the audio blocks that ended before this pump
       for (; (frame + 1) * 0.001 <= block * blockS + 1e-12; ++frame)
         device.pushForceFrame({frame * 0.001, 0.2f + 0.001f * static_cast<float>(frame % 1000), (frame + 1) * 0.001});
     const size_t before = sink->commands().size();
     device.pump(nowS = pumpS);
     run.maxPerPump = std::max(run.maxPerPump, static_cast<int>(sink->commands().size() - before));
+    run.latencyS.push_back(device.telemetry().releaseLatencyS);
   }
   run.commands = sink->commands();
   run.telemetry = device.telemetry();
@@ -227,6 +235,30 @@ TEST_CASE("exact: long audio periods raise the latency once and the watchdog nev
       if (run.commands[j].timeS > 0.2 && run.commands[j].timeS - run.commands[j - 1].timeS < 0.0005) ++afterFirst;
     CHECK(afterFirst == 0);
   }
+}
+
+TEST_CASE("exact: a stall raises the latency, which comes back down within 1.5 s", "[timing]") {
+  // 48 kHz, 64-sample blocks; the audio thread stalls 8 ms at 1 s (below the 10 ms watchdog).
+  const ExactRun run = runExact(64, 48000.0, 4.0, 0.0004, Stall{1.0, 0.008});
+  CHECK(run.telemetry.watchdogTrips == 0);
+  const double steadyS = run.latencyS[900];  // before the stall
+  CHECK(steadyS <= 0.0035);
+  const double peakS = *std::max_element(run.latencyS.begin(), run.latencyS.end());
+  CHECK(peakS >= 0.008);  // the frames caught up after the stall needed it
+  // Back to the steady latency 1.5 s after the stall (pump 2508 is at 2.5084 s).
+  CHECK(run.latencyS[2508] == Approx(steadyS).margin(1e-9));
+  CHECK(run.latencyS.back() == Approx(steadyS).margin(1e-9));
+  // Coming down 1 ms means one frame more in some pump: as many shared pumps as milliseconds of
+  // excess latency, in the recovery alone, and never more than two frames in a pump.
+  int sharedPumps = 0;
+  for (size_t j = 1; j < run.commands.size(); ++j)
+    if (run.commands[j].timeS == run.commands[j - 1].timeS) {
+      ++sharedPumps;
+      CHECK(run.commands[j].timeS > 1.0);
+      CHECK(run.commands[j].timeS < 2.6);
+    }
+  CHECK(sharedPumps <= static_cast<int>(std::ceil((peakS - steadyS) / 0.001)));
+  CHECK(run.maxPerPump <= 2);
 }
 
 TEST_CASE("exact: the magnet goes off 10 ms after the last frame went out", "[timing]") {
