@@ -145,11 +145,12 @@ void Device::settleLatencyLocked(double nowS) {
     windowLatenessS_ = 0.0;
     windowEndS_ = nowS + kLatencyWindowS;
   }
-  // Down to what the frames of the last 0.5 to 1 s needed, never below the base, a step per
-  // pump: one stall must not hold the force latency up for the rest of the session.
+  // Down to what the frames of the last 0.5 to 1 s needed, never below the base, by 5 % of the
+  // time since the last pump: one stall must not hold the force latency up for the rest of the session.
   const double neededS = std::min(std::max({options_.forceLatencyS, windowLatenessS_, previousWindowLatenessS_}),
                                   options_.maxForceLatencyS);
-  if (releaseLatencyS_ > neededS) releaseLatencyS_ = std::max(neededS, releaseLatencyS_ - kLatencyDecayPerPumpS);
+  const double stepS = kLatencyDecayRate * std::max(nowS - lastPumpS_, 0.0);
+  if (releaseLatencyS_ > neededS) releaseLatencyS_ = std::max(neededS, releaseLatencyS_ - stepS);
 }
 
 int Device::releaseFramesLocked(double nowS) {

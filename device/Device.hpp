@@ -33,7 +33,7 @@ struct DeviceOptions {
   // them. A frame that arrives later than that (a long audio period, a late audio thread)
   // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS: the frames
   // after it keep their spacing instead of coming in bursts. Once no frame of the last 0.5 to 1 s
-  // needed it, it comes back down by 50 us a pump (frames 0.95 ms apart meanwhile), so a stall
+  // needed it, it comes back down by 5 % of the time passing (frames 0.95 ms apart meanwhile), so a stall
   // does not keep it raised, while long audio periods, whose every burst needs it, keep it.
   double forceLatencyS = 0.002;
   double maxForceLatencyS = 0.1;
@@ -113,8 +113,8 @@ class Device {
 
  private:
   static constexpr int kPollBatch = 64;
-  static constexpr double kLatencyWindowS = 0.5;          // how long a frame's need is remembered
-  static constexpr double kLatencyDecayPerPumpS = 50e-6;  // 5 % of a 1 ms frame spacing
+  static constexpr double kLatencyWindowS = 0.5;     // how long a frame's need is remembered
+  static constexpr double kLatencyDecayRate = 0.05;  // s per s: frames 5 % closer meanwhile
 
   struct PendingFrame {
     ForceFrame frame;

@@ -1,5 +1,7 @@
 #include "DeviceSlots.hpp"
 
+#include <algorithm>
+
 namespace kf::sc {
 
 namespace {
@@ -38,8 +40,13 @@ void retire(Device* device) {
 struct CloseAllAtExit {
   ~CloseAllAtExit() {
     gExiting.store(true);
-    for (Slot& slot : gSlots) delete slot.device.exchange(nullptr);
-    for (std::atomic<Device*>& entry : gRetired) delete entry.exchange(nullptr);
+    Device* closed[kNumDeviceSlots] = {};
+    for (int i = 0; i < kNumDeviceSlots; ++i) delete (closed[i] = gSlots[i].device.exchange(nullptr));
+    // A device both in its slot and retired (an exchange cut short) was deleted above.
+    for (std::atomic<Device*>& entry : gRetired)
+      if (Device* device = entry.exchange(nullptr);
+          std::find(closed, closed + kNumDeviceSlots, device) == closed + kNumDeviceSlots)
+        delete device;
   }
 } gCloseAllAtExit;
 
@@ -87,8 +94,11 @@ Device* exchangeSlot(int index, Device* device) {
   slot.generation.store(gNextGeneration.fetch_add(1, std::memory_order_relaxed), std::memory_order_release);
   slot.trajectory.reset(device != nullptr ? device->spec() : DeviceSpec{});
   slot.force.reset(device != nullptr ? device->spec() : DeviceSpec{});
-  Device* previous = slot.device.exchange(device, std::memory_order_acq_rel);
+  // Retired before it leaves the slot, so a signal handler in between still finds it (only this
+  // RT stage writes slots while the server runs).
+  Device* previous = slot.device.load(std::memory_order_acquire);
   retire(previous);
+  slot.device.store(device, std::memory_order_release);
   return previous;
 }
 
@@ -112,11 +122,14 @@ Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;
 }
 
-void visitLiveDevices(void (*visit)(Device*)) {
+void haltAllDevices(void (*halt)(Device*)) {
+  gExiting.store(true);
   for (Slot& slot : gSlots)
-    if (Device* device = slot.device.load(std::memory_order_acquire)) visit(device);
+    if (Device* device = slot.device.load(std::memory_order_acquire)) halt(device);
+  // Retired devices are taken, so that their NRT stage no longer deletes them while they are
+  // being halted (the process is ending: they are never deleted).
   for (std::atomic<Device*>& entry : gRetired)
-    if (Device* device = entry.load(std::memory_order_acquire)) visit(device);
+    if (Device* device = entry.exchange(nullptr, std::memory_order_acq_rel)) halt(device);
 }
 
 }  // namespace kf::sc

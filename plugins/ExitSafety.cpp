@@ -26,7 +26,7 @@ std::atomic<bool> gInstalled[NSIG];
 std::atomic<bool> gDrivenOff{false};
 
 void driveAllOff() {
-  kf::sc::visitLiveDevices([](kf::Device* device) { device->emergencyOff(); });
+  kf::sc::haltAllDevices([](kf::Device* device) { device->emergencyOff(); });
 }
 
 void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
@@ -36,8 +36,8 @@ void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
   if (previous.sa_flags & SA_SIGINFO) {
     if (previous.sa_sigaction != nullptr) return previous.sa_sigaction(signalNumber, info, context);
   } else if (previous.sa_handler != SIG_DFL && previous.sa_handler != SIG_IGN) {
-    // The host's own handler (it may shut down gracefully; the devices' next frames and the
-    // watchdog take over again if the process lives on).
+    // The host's own handler (it may shut down gracefully). Our devices stay halted, magnet
+    // off, should the process live on: they must be opened again.
     gDrivenOff.store(false);
     return previous.sa_handler(signalNumber);
   }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Sets everything up (scripts/setup.sh), checks the habits CI enforces (scripts/check.sh:
-# formatting, pyflakes, the build without SuperCollider, the sanitizer build), then runs every
+# Sets everything up (scripts/setup.sh), runs the checks CI enforces (scripts/check.sh:
+# formatting, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the fuzz targets,
+# the scene and realtime tests against the sanitized plugin), then runs every
 # test of build/: Catch2 (dsp, device), the NRT scene tests (with scsynth and, when installed,
 # supernova), the help files, and the realtime tests against JACK's dummy driver.
 # Extra arguments go to ctest, e.g. scripts/test.sh -R scenes/

@@ -245,7 +245,7 @@ TEST_CASE("exact: a stall raises the latency, which comes back down within 1.5 s
   CHECK(steadyS <= 0.0035);
   const double peakS = *std::max_element(run.latencyS.begin(), run.latencyS.end());
   CHECK(peakS >= 0.008);  // the frames caught up after the stall needed it
-  // Back to the steady latency 1.5 s after the stall (pump 2508 is at 2.5084 s).
+  // Back to the steady latency 1.5 s after the stall (pump 2509, at 2.5094 s).
   CHECK(run.latencyS[2508] == Approx(steadyS).margin(1e-9));
   CHECK(run.latencyS.back() == Approx(steadyS).margin(1e-9));
   // Coming down 1 ms means one frame more in some pump: as many shared pumps as milliseconds of

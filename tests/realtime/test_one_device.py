@@ -120,9 +120,12 @@ def test_zero_rebases_every_reader_at_once(jack):
 def frames_per_ms(frames, start, end):
     """Frames per millisecond of audio time (the frames' own times) in [start, end): (min, max)
     over the milliseconds, and the frames per 250 ms."""
-    audio_t = frames[:, 1]
-    ms = np.round(audio_t[(audio_t >= start) & (audio_t < end)] * 1000).astype(int)  # frames start on whole ms
-    per_ms = np.bincount(ms - int(round(start * 1000)), minlength=int(round((end - start) * 1000)))
+    # Frames start on whole ms: selected by their ms, not their times, which may fall a hair
+    # either side of `start` (1.994 against 1.9940000000000002).
+    ms = np.round(frames[:, 1] * 1000).astype(int)
+    first, last = int(round(start * 1000)), int(round(end * 1000))
+    ms = ms[(ms >= first) & (ms < last)]
+    per_ms = np.bincount(ms - first, minlength=last - first)
     per_250 = [int(per_ms[i:i + 250].sum()) for i in range(0, len(per_ms) - 249, 250)]
     return int(per_ms.min()), int(per_ms.max()), per_250
 
