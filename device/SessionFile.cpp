@@ -64,10 +64,6 @@ bool parseFloat(const std::string& token, float& value) {
   return true;
 }
 
-}  // namespace
-
-namespace {
-
 // Files being recorded, by (device, inode): two paths to one file are one file. Never destroyed:
 // the plugin's exit hook, itself a static destructor, closes recorders after this file's own
 // statics may be gone.

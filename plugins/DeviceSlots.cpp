@@ -122,14 +122,14 @@ Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;
 }
 
-void haltAllDevices(void (*halt)(Device*)) {
+void haltAllDevices() {
   gExiting.store(true);
   for (Slot& slot : gSlots)
-    if (Device* device = slot.device.load(std::memory_order_acquire)) halt(device);
+    if (Device* device = slot.device.load(std::memory_order_acquire)) device->emergencyOff();
   // Retired devices are taken, so that their NRT stage no longer deletes them while they are
   // being halted (the process is ending: they are never deleted).
   for (std::atomic<Device*>& entry : gRetired)
-    if (Device* device = entry.exchange(nullptr, std::memory_order_acq_rel)) halt(device);
+    if (Device* device = entry.exchange(nullptr, std::memory_order_acq_rel)) device->emergencyOff();
 }
 
 }  // namespace kf::sc

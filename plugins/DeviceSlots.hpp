@@ -57,11 +57,11 @@ Device* peekSlot(int index);
 
 bool isValidSlot(int index);
 
-// Signal handlers (ExitSafety.cpp): calls `halt` on every device in a slot and every retired
-// one (its close has not finished), taking the retired ones so that their NRT stage does not
-// delete them meanwhile. Atomic operations only, so async-signal-safe. A device whose NRT stage
-// is already deleting it is the one race this last-resort path accepts.
-void haltAllDevices(void (*halt)(Device*));
+// Signal handlers (ExitSafety.cpp): Device::emergencyOff on every device in a slot and every
+// retired one (its close has not finished), taking the retired ones so that their NRT stage does
+// not delete them meanwhile. Atomic operations only, so async-signal-safe. A device whose NRT
+// stage is already deleting it is the one race this last-resort path accepts.
+void haltAllDevices();
 
 // The slot a UGen's device input names, or -1 for NaN, infinities and anything outside
 // 0..kNumDeviceSlots-1 (a cast of those to int would be undefined).

@@ -25,13 +25,9 @@ struct sigaction gPrevious[NSIG];
 std::atomic<bool> gInstalled[NSIG];
 std::atomic<bool> gDrivenOff{false};
 
-void driveAllOff() {
-  kf::sc::haltAllDevices([](kf::Device* device) { device->emergencyOff(); });
-}
-
 void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
   // Once: a second signal (or a crash inside the first handler) goes straight on.
-  if (!gDrivenOff.exchange(true)) driveAllOff();
+  if (!gDrivenOff.exchange(true)) kf::sc::haltAllDevices();
   const struct sigaction& previous = gPrevious[signalNumber];
   if (previous.sa_flags & SA_SIGINFO) {
     if (previous.sa_sigaction != nullptr) return previous.sa_sigaction(signalNumber, info, context);

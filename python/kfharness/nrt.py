@@ -21,8 +21,9 @@ def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, t
            "-o", str(channels), "-i", "0", "-z", str(block_size), "-U", plugin_path(plugin_dirs),
            "-m", str(memory_kb), *map(str, extra_args)]
     env = dict(os.environ)
-    if sclang.server_preload():
-        env["LD_PRELOAD"] = sclang.server_preload()
+    preload = sclang.server_preload()
+    if preload:
+        env["LD_PRELOAD"] = preload
     proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           timeout=timeout, text=True, errors="replace", env=env)
     failed = proc.returncode != 0 or "FAILURE" in proc.stdout or "not installed" in proc.stdout

@@ -145,6 +145,22 @@ struct ExactRun {
   std::vector<double> latencyS;  // after each pump
 };
 
+// A realtime device (jitter buffer, watchdog) pumped by the test on a clock of its own, which
+// its sink reads too.
+struct PumpedDevice {
+  static DeviceOptions externalPump() {
+    DeviceOptions options;
+    options.externalPump = true;
+    return options;
+  }
+  double nowS = 0.0;
+  std::shared_ptr<TimelineSink> sink = std::make_shared<TimelineSink>();
+  Device device{DeviceSpec{}, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}), sink, false, externalPump()};
+  PumpedDevice() {
+    sink->setClock([this] { return nowS; });
+  }
+};
+
 // An audio thread that delivers nothing from startS for stallS, then catches up at once.
 struct Stall {
   double startS = 0.0, stallS = 0.0;
@@ -153,12 +169,8 @@ struct Stall {
 // Audio blocks of blockSamples at rateHz push their completed frames at each block's end; the
 // device is pumped every 1 ms, its pumps offset from the audio clock by pumpPhaseS.
 ExactRun runExact(int blockSamples, double rateHz, double seconds, double pumpPhaseS, Stall stall = {}) {
-  DeviceOptions options;
-  options.externalPump = true;
-  auto sink = std::make_shared<TimelineSink>();
-  Device device(DeviceSpec{}, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}), sink, false, options);
-  double nowS = 0.0;
-  sink->setClock([&nowS] { return nowS; });
+  PumpedDevice pumped;
+  auto& [nowS, sink, device] = pumped;
   device.start();
   const double blockS = blockSamples / rateHz;
   int frame = 0;
@@ -262,12 +274,8 @@ TEST_CASE("exact: a stall raises the latency, which comes back down within 1.5 s
 }
 
 TEST_CASE("exact: the magnet goes off 10 ms after the last frame went out", "[timing]") {
-  DeviceOptions options;
-  options.externalPump = true;
-  auto sink = std::make_shared<TimelineSink>();
-  Device device(DeviceSpec{}, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}), sink, false, options);
-  double nowS = 0.0;
-  sink->setClock([&nowS] { return nowS; });
+  PumpedDevice pumped;
+  auto& [nowS, sink, device] = pumped;
   for (int i = 0; i < 100; ++i) device.pushForceFrame({i * 0.001, 1.0f, (i + 1) * 0.001});
   for (int pump = 1; pump < 200; ++pump) device.pump(nowS = pump * 0.001);
   const auto commands = sink->commands();
