@@ -10,7 +10,6 @@
 
 namespace {
 
-using kf::HandScript;
 using kf::TrajectoryMode;
 
 // ns per rendered sample of a mode, with reports arriving as at 250 mm/s.
@@ -38,21 +37,10 @@ double renderNsPerSample(TrajectoryMode mode) {
 }  // namespace
 
 int main() {
-  struct Movement {
-    const char* name;
-    HandScript hand;
-    double seconds;
-  };
-  const Movement movements[] = {
-      {"slow 10 mm/s", HandScript::speeds({{10.0, 3.0}}), 3.0},
-      {"fast 250 mm/s", HandScript::speeds({{250.0, 1.0}}), 1.0},
-      {"reversing +-30 mm at 1 Hz", HandScript::path({{0, 0}, {0.5, 30}, {1.0, 0}, {1.5, 30}, {2.0, 0}, {2.5, 30}}),
-       2.5},
-  };
   const char* modeNames[] = {"hold", "linear", "predictive"};
   std::printf("{\n  \"accuracy\": [\n");
   bool first = true;
-  for (const Movement& m : movements) {
+  for (const kf::test::Movement& m : kf::test::reconstructionMovements()) {
     for (int mode = 0; mode < 3; ++mode) {
       const auto r = kf::test::reconstructAgainstSim(m.hand, m.seconds, static_cast<TrajectoryMode>(mode));
       std::printf(

@@ -1,7 +1,7 @@
 #include "DeviceFactory.hpp"
 
-#include "ReplayBackend.hpp"
-#include "SimDevice.hpp"
+#include "recordings/ReplayBackend.hpp"
+#include "sim/SimDevice.hpp"
 
 namespace kf {
 

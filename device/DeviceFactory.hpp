@@ -5,11 +5,11 @@
 #include <memory>
 #include <string>
 
-#include "Device.hpp"
-#include "DeviceSpec.hpp"
-#include "HandScript.hpp"
-#include "ReplayBackend.hpp"
-#include "SimParams.hpp"
+#include "core/Device.hpp"
+#include "core/spec/DeviceSpec.hpp"
+#include "recordings/ReplayBackend.hpp"
+#include "sim/HandScript.hpp"
+#include "sim/SimParams.hpp"
 
 namespace kf {
 

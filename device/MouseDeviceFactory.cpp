@@ -2,10 +2,10 @@
 
 #include <algorithm>
 
-#include "EvdevMouseBackend.hpp"
-#include "HidapiMouseBackend.hpp"
-#include "MouseSelect.hpp"
-#include "ReplayBackend.hpp"
+#include "mouse/EvdevMouseBackend.hpp"
+#include "mouse/HidapiMouseBackend.hpp"
+#include "mouse/MouseSelect.hpp"
+#include "recordings/ReplayBackend.hpp"
 
 namespace kf {
 

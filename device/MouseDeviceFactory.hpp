@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "Device.hpp"
-#include "MouseIo.hpp"
+#include "core/Device.hpp"
+#include "mouse/MouseIo.hpp"
 
 namespace kf {
 

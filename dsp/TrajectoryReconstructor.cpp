@@ -12,7 +12,7 @@ constexpr double kExtrapolateT = 1.5;  // predictive: carry the motion on this l
 constexpr double kStaleT = 2.0;        // no report for this long: the puck has stopped
 constexpr double kFadeT = 1.0;         // then speed (and extrapolation) go to 0 over this
 
-constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/Report.hpp)
+constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/core/spec/Report.hpp)
 
 }  // namespace
 

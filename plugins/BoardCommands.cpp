@@ -1,4 +1,4 @@
-// Asynchronous plugin commands for the friction board (device/PROTOCOL.md) of a device slot, on
+// Asynchronous plugin commands for the friction board (device/board/PROTOCOL.md) of a device slot, on
 // the machinery of CommandRunner.hpp (checked arguments, /done or /kfFail): the RT stage only
 // looks the slot's device up; opening, arming, loading and closing run in NRT stages.
 //
@@ -15,12 +15,12 @@
 #include <string>
 
 #include "BoardStatus.hpp"
-#include "CalibrationTable.hpp"
 #include "CommandRunner.hpp"
 #include "DeviceSlots.hpp"
-#include "EmulatedUsb.hpp"
 #include "PluginShared.hpp"
-#include "UsbBoardBackend.hpp"
+#include "board/EmulatedUsb.hpp"
+#include "board/UsbBoardBackend.hpp"
+#include "core/force/CalibrationTable.hpp"
 
 namespace {
 

@@ -25,9 +25,9 @@
 #include "AudioClock.hpp"
 #include "BoardStatus.hpp"
 #include "CommandRunner.hpp"
-#include "DeviceMessages.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
+#include "core/DeviceMessages.hpp"
 
 namespace {
 

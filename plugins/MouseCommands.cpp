@@ -20,10 +20,10 @@
 #include "CommandRunner.hpp"
 #include "DeviceSlots.hpp"
 #include "MouseDeviceFactory.hpp"
-#include "MouseProfile.hpp"
-#include "MouseSelect.hpp"
 #include "PluginShared.hpp"
-#include "RealMouseBackend.hpp"
+#include "mouse/MouseProfile.hpp"
+#include "mouse/MouseSelect.hpp"
+#include "mouse/RealMouseBackend.hpp"
 
 namespace {
 

@@ -2,7 +2,7 @@
 # The habits CI enforces, beside the tests (scripts/test.sh runs this first):
 #   format     every C++ file as clang-format (the root .clang-format) would write it
 #   pyflakes   no unused import or undefined name in the Python
-#   sanitize   dsp/ and device/ built without SuperCollider, their C++ tests under AddressSanitizer
+#   sanitize   dsp/, device/ and host/ built without SuperCollider, their C++ tests under AddressSanitizer
 #              + UndefinedBehaviorSanitizer (build-asan/); any finding fails
 #   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh)
 #   sanitize-plugin
@@ -42,10 +42,10 @@ configure_and_build() {
 }
 
 check_sanitize() {
-  echo "== dsp/ and device/ without SuperCollider, C++ tests under ASan + UBSan (build-asan/)"
+  echo "== dsp/, device/ and host/ without SuperCollider, C++ tests under ASan + UBSan (build-asan/)"
   configure_and_build build-asan -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-    ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/'
+    ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/|host/'
 }
 
 check_sanitize_plugin() {

@@ -14,15 +14,15 @@
 #include <vector>
 
 #include "DeviceFactory.hpp"
-#include "DeviceSpec.hpp"
-#include "HandScript.hpp"
-#include "HidMouseDecoder.hpp"
-#include "HidRecorderFile.hpp"
-#include "HidReportDescriptor.hpp"
-#include "ReplayBackend.hpp"
-#include "SessionFile.hpp"
-#include "SettingBounds.hpp"
-#include "SimParams.hpp"
+#include "core/files/SessionFile.hpp"
+#include "core/spec/DeviceSpec.hpp"
+#include "core/spec/SettingBounds.hpp"
+#include "hid/HidMouseDecoder.hpp"
+#include "hid/HidReportDescriptor.hpp"
+#include "recordings/HidRecorderFile.hpp"
+#include "recordings/ReplayBackend.hpp"
+#include "sim/HandScript.hpp"
+#include "sim/SimParams.hpp"
 
 using namespace kf;
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "CalibrationTable.hpp"
+#include "core/force/CalibrationTable.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "HidMouseDecoder.hpp"
-#include "HidReportDescriptor.hpp"
+#include "hid/HidMouseDecoder.hpp"
+#include "hid/HidReportDescriptor.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   kf::HidReportDescriptor descriptor;

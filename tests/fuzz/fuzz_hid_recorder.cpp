@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "FuzzFile.hpp"
-#include "HidRecorderFile.hpp"
-#include "ReplayBackend.hpp"
+#include "recordings/HidRecorderFile.hpp"
+#include "recordings/ReplayBackend.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = kf::fuzz::writeScratch(data, size);

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "FuzzFile.hpp"
-#include "ReplayBackend.hpp"
-#include "SessionFile.hpp"
+#include "core/files/SessionFile.hpp"
+#include "recordings/ReplayBackend.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = kf::fuzz::writeScratch(data, size);

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "DeviceFactory.hpp"
-#include "HidRecorderFile.hpp"
+#include "recordings/HidRecorderFile.hpp"
 
 namespace {
 

@@ -1,0 +1,279 @@
+#include "board/EmulatedUsb.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+
+namespace kf::board {
+
+namespace {
+double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+constexpr double kFrameS = 0.001;
+}  // namespace
+
+std::shared_ptr<EmulatedUsb> EmulatedUsb::create(std::string serial) {
+  return std::shared_ptr<EmulatedUsb>(new EmulatedUsb(std::move(serial)));
+}
+
+EmulatedUsb::EmulatedUsb(std::string serial) : serial_(std::move(serial)), originS_(steadyS()), board_(0.0) {}
+
+double EmulatedUsb::nowS() const { return steadyS() - originS_; }
+
+// The host side: what libusb would be, on this bus.
+class EmulatedPort : public usb::Port {
+ public:
+  explicit EmulatedPort(std::shared_ptr<EmulatedUsb> bus) : bus_(std::move(bus)) {}
+  ~EmulatedPort() override { close(); }
+
+  usb::Result init() override { return usb::Result::kOk; }
+  void exit() override {}
+
+  usb::Result open(const usb::DeviceIds& ids) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (!bus_->plugged_ || ids.vendorId != kVendorId || ids.productId != kProductId ||
+        (!ids.serial.empty() && ids.serial != bus_->serial_))
+      return usb::Result::kNotFound;
+    if (bus_->denyAccess_) return usb::Result::kAccess;
+    if (generation_ == 0) ++bus_->openHandles_;
+    generation_ = bus_->generation_;
+    return usb::Result::kOk;
+  }
+
+  std::string openSerial() const override { return bus_->serial_; }
+
+  usb::Result claimInterface(int number) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (!alive()) return usb::Result::kNoDevice;
+    if (number != kInterfaceNumber) return usb::Result::kNotFound;
+    ++bus_->claims_;
+    return usb::Result::kOk;
+  }
+
+  void releaseInterface(int) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (alive()) ++bus_->releases_;
+  }
+
+  void close() override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (generation_ != 0) --bus_->openHandles_;
+    generation_ = 0;
+  }
+
+  usb::Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data,
+                      uint16_t length, unsigned, int* transferred) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (!alive()) return usb::Result::kNoDevice;
+    if (index != kInterfaceNumber) return usb::Result::kPipe;
+    return bus_->board_.control(requestType, request, value, data, length, transferred, bus_->nowS());
+  }
+
+  usb::Result clearHalt(uint8_t endpoint) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (!alive()) return usb::Result::kNoDevice;
+    if (endpoint == kSetPointEndpoint) bus_->outHalted_ = false;
+    ++bus_->clearHalts_;
+    return usb::Result::kOk;
+  }
+
+  usb::Result submit(usb::Transfer& transfer) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    if (!alive()) return usb::Result::kNoDevice;
+    const double nowS = bus_->nowS();
+    EmulatedUsb::Pending pending{&transfer, nowS, generation_, false, false, false};
+    if (transfer.endpoint == kSetPointEndpoint) {
+      if (bus_->timeOutOut_ > 0) {
+        --bus_->timeOutOut_;
+        pending.timeOut = true;
+        pending.dueS = nowS + transfer.timeoutMs * 1e-3;
+      } else {
+        // One transfer per 1 ms frame on an interrupt endpoint.
+        bus_->nextOutS_ = std::max(nowS, bus_->nextOutS_ + kFrameS);
+        pending.dueS = bus_->nextOutS_;
+        if (bus_->partialOut_ > 0) {
+          --bus_->partialOut_;
+          pending.partial = true;
+        }
+      }
+    } else if (transfer.endpoint == kStatusEndpoint) {
+      bus_->nextInS_ = std::max(nowS, bus_->nextInS_ + kFrameS);
+      pending.dueS = bus_->nextInS_;
+      if (bus_->partialIn_ > 0) {
+        --bus_->partialIn_;
+        pending.partial = true;
+      }
+    } else {
+      return usb::Result::kInvalid;
+    }
+    bus_->pending_.push_back(pending);
+    bus_->changed_.notify_all();
+    return usb::Result::kOk;
+  }
+
+  usb::Result cancel(usb::Transfer& transfer) override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    for (EmulatedUsb::Pending& pending : bus_->pending_)
+      if (pending.transfer == &transfer) {
+        pending.cancelled = true;
+        bus_->changed_.notify_all();
+        return usb::Result::kOk;
+      }
+    return usb::Result::kNotFound;
+  }
+
+  usb::Result handleEvents(int timeoutMs) override {
+    const double deadlineS = bus_->nowS() + timeoutMs * 1e-3;
+    std::unique_lock<std::mutex> lock(bus_->mutex_);
+    while (true) {
+      const double nowS = bus_->nowS();
+      bus_->board_.advance(nowS);
+      // The earliest transfer that is done by now (cancelled and dead ones are done at once).
+      auto next = bus_->pending_.end();
+      double nextDueS = 0.0;
+      double earliestS = deadlineS;
+      for (auto it = bus_->pending_.begin(); it != bus_->pending_.end(); ++it) {
+        const bool dead = it->generation != bus_->generation_ || !bus_->plugged_;
+        const double dueS = (it->cancelled || dead) ? nowS : it->dueS;
+        if (dueS <= nowS && (next == bus_->pending_.end() || dueS < nextDueS)) {
+          next = it;
+          nextDueS = dueS;
+        }
+        earliestS = std::min(earliestS, dueS);
+      }
+      if (next != bus_->pending_.end()) {
+        EmulatedUsb::Pending done = *next;
+        bus_->pending_.erase(next);
+        complete(done, nowS);
+        lock.unlock();
+        if (done.transfer->callback != nullptr) done.transfer->callback(*done.transfer);
+        return usb::Result::kOk;
+      }
+      if (nowS >= deadlineS) return usb::Result::kOk;
+      bus_->changed_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, earliestS - nowS)));
+    }
+  }
+
+ private:
+  bool alive() const { return generation_ != 0 && generation_ == bus_->generation_ && bus_->plugged_; }
+
+  // Under the lock: what the transfer did.
+  void complete(const EmulatedUsb::Pending& pending, double nowS) {
+    usb::Transfer& transfer = *pending.transfer;
+    transfer.actualLength = 0;
+    if (pending.generation != bus_->generation_ || !bus_->plugged_) {
+      transfer.status = usb::TransferStatus::kNoDevice;
+    } else if (pending.cancelled) {
+      transfer.status = usb::TransferStatus::kCancelled;
+    } else if (pending.timeOut) {
+      transfer.status = usb::TransferStatus::kTimedOut;
+    } else if (transfer.endpoint == kSetPointEndpoint) {
+      if (bus_->outHalted_) {
+        transfer.status = usb::TransferStatus::kStall;
+        return;
+      }
+      transfer.status = usb::TransferStatus::kCompleted;
+      transfer.actualLength = pending.partial ? transfer.length / 2 : transfer.length;
+      bus_->board_.receiveSetPoint(transfer.buffer, static_cast<size_t>(transfer.actualLength), pending.dueS);
+    } else {
+      uint8_t frame[kStatusSize];
+      encodeStatus(bus_->board_.status(nowS), frame);
+      const int size = std::min<int>(transfer.length, kStatusSize);
+      transfer.actualLength = pending.partial ? size / 2 : size;
+      std::memcpy(transfer.buffer, frame, static_cast<size_t>(transfer.actualLength));
+      transfer.status = usb::TransferStatus::kCompleted;
+    }
+  }
+
+  std::shared_ptr<EmulatedUsb> bus_;
+  int generation_ = 0;  // of the plug-in it was opened on; 0: not open
+};
+
+std::unique_ptr<usb::Port> EmulatedUsb::makePort() { return std::make_unique<EmulatedPort>(shared_from_this()); }
+
+void EmulatedUsb::unplug() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  plugged_ = false;
+  board_.powerLoss(nowS());
+  changed_.notify_all();
+}
+
+void EmulatedUsb::replug() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (plugged_) return;
+  plugged_ = true;
+  ++generation_;  // handles of the old plug-in stay dead
+  outHalted_ = false;
+  board_.powerOn(nowS());
+  changed_.notify_all();
+}
+
+void EmulatedUsb::setDenyAccess(bool deny) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  denyAccess_ = deny;
+}
+void EmulatedUsb::setRefuseArm(bool refuse) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.setRefuseArm(refuse);
+}
+void EmulatedUsb::timeOutNextOut(int count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  timeOutOut_ += count;
+}
+void EmulatedUsb::partialNextOut(int count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  partialOut_ += count;
+}
+void EmulatedUsb::partialNextIn(int count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  partialIn_ += count;
+}
+void EmulatedUsb::stallOut() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  outHalted_ = true;
+}
+
+std::vector<BoardEmulator::Change> EmulatedUsb::timeline() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.advance(nowS());
+  return board_.timeline();
+}
+Status EmulatedUsb::status() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return board_.status(nowS());
+}
+uint64_t EmulatedUsb::validFrames() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return board_.validFrames();
+}
+uint64_t EmulatedUsb::rejectedFrames() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return board_.rejectedFrames();
+}
+BoardState EmulatedUsb::state() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.advance(nowS());
+  return board_.state();
+}
+uint16_t EmulatedUsb::drive() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.advance(nowS());
+  return board_.drive();
+}
+int EmulatedUsb::interfaceClaims() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return claims_;
+}
+int EmulatedUsb::interfaceReleases() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return releases_;
+}
+int EmulatedUsb::clearHalts() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return clearHalts_;
+}
+bool EmulatedUsb::isOpen() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return openHandles_ > 0;
+}
+
+}  // namespace kf::board

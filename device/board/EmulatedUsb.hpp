@@ -1,0 +1,77 @@
+// EmulatedUsb: one emulated friction board (BoardEmulator) on an emulated bus, reached through
+// usb::Port like the real one, on the steady clock: interrupt endpoints serve one transfer
+// per 1 ms frame each, control requests at once. It fails as USB fails, on request: transfers
+// that time out, partial transfers, a stalled endpoint, unplugging (transfers in flight end
+// with kNoDevice) and plugging back in, permission denied at open, a board that never arms.
+#pragma once
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "board/BoardEmulator.hpp"
+#include "board/UsbPort.hpp"
+
+namespace kf::board {
+
+class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
+ public:
+  static std::shared_ptr<EmulatedUsb> create(std::string serial = "KF-EMU-0001");
+
+  // A host-side port on this bus (the driver's side).
+  std::unique_ptr<usb::Port> makePort();
+
+  double nowS() const;  // the bus clock: seconds since create()
+
+  // Failures.
+  void unplug();
+  void replug();
+  void setDenyAccess(bool deny);
+  void setRefuseArm(bool refuse);
+  void timeOutNextOut(int count);  // these OUT transfers are never taken: kTimedOut
+  void partialNextOut(int count);  // only 4 of 8 bytes arrive (the board rejects them)
+  void partialNextIn(int count);   // short status transfers
+  void stallOut();                 // EP 0x01 halts until the host clears it
+
+  // What the board did (copies, under the lock).
+  std::vector<BoardEmulator::Change> timeline();
+  Status status();
+  uint64_t validFrames();
+  uint64_t rejectedFrames();
+  BoardState state();
+  uint16_t drive();
+  int interfaceClaims();
+  int interfaceReleases();
+  int clearHalts();
+  bool isOpen();  // a host holds it open
+
+ private:
+  friend class EmulatedPort;
+  struct Pending {
+    usb::Transfer* transfer;
+    double dueS;
+    int generation;  // of the plug-in it was submitted on
+    bool cancelled;
+    bool timeOut;
+    bool partial;
+  };
+
+  explicit EmulatedUsb(std::string serial);
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  const std::string serial_;
+  const double originS_;
+  BoardEmulator board_;
+  bool plugged_ = true;
+  int generation_ = 1;
+  bool denyAccess_ = false;
+  bool outHalted_ = false;
+  int timeOutOut_ = 0, partialOut_ = 0, partialIn_ = 0;
+  double nextOutS_ = 0.0, nextInS_ = 0.0;  // the next free frame of each endpoint
+  std::vector<Pending> pending_;
+  int claims_ = 0, releases_ = 0, clearHalts_ = 0, openHandles_ = 0;
+};
+
+}  // namespace kf::board

@@ -1,0 +1,390 @@
+#include "board/UsbBoardBackend.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace kf {
+
+namespace {
+
+constexpr uint8_t kVendorOut = 0x41;  // vendor, interface, host to device
+constexpr uint8_t kVendorIn = 0xC1;
+constexpr unsigned kControlTimeoutMs = 200;
+
+double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+std::string idsText(const usb::DeviceIds& ids) {
+  char text[80];
+  std::snprintf(text, sizeof text, "USB %04x:%04x", ids.vendorId, ids.productId);
+  return ids.serial.empty() ? std::string(text) : std::string(text) + " serial " + ids.serial;
+}
+
+}  // namespace
+
+UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions options)
+    : port_(std::move(port)), options_(options) {
+  for (usb::Transfer& transfer : outTransfers_) {
+    transfer.endpoint = board::kSetPointEndpoint;
+    transfer.length = board::kSetPointSize;
+  }
+  zeroTransfer_.endpoint = board::kSetPointEndpoint;
+  zeroTransfer_.length = board::kSetPointSize;
+  statusTransfer_.endpoint = board::kStatusEndpoint;
+  statusTransfer_.length = board::kStatusSize;
+  for (usb::Transfer* transfer :
+       {&outTransfers_[0], &outTransfers_[1], &outTransfers_[2], &outTransfers_[3], &statusTransfer_, &zeroTransfer_}) {
+    transfer->timeoutMs = options_.transferTimeoutMs;
+    transfer->callback = &UsbBoardBackend::onTransfer;
+    transfer->user = this;
+  }
+}
+
+UsbBoardBackend::~UsbBoardBackend() { close(); }
+
+void UsbBoardBackend::setError(const std::string& error) {
+  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  telemetry_.lastError = error;
+}
+
+bool UsbBoardBackend::connectLocked(std::string& error) {
+  usb::Result result = port_->open(options_.ids);
+  if (result == usb::Result::kNotFound) {
+    error = "no friction board found (" + idsText(options_.ids) + "); is it plugged in?";
+    return false;
+  }
+  if (result != usb::Result::kOk) {
+    error = "cannot open the friction board (" + idsText(options_.ids) + "): " + usb::describe(result);
+    return false;
+  }
+  result = port_->claimInterface(board::kInterfaceNumber);
+  if (result != usb::Result::kOk) {
+    error = std::string("cannot claim the friction board's interface: ") + usb::describe(result);
+    port_->close();
+    return false;
+  }
+  uint8_t reply[board::kVersionSize] = {};
+  int moved = 0;
+  result = port_->control(kVendorIn, static_cast<uint8_t>(board::Request::kGetVersion), 0, board::kInterfaceNumber,
+                          reply, board::kVersionSize, kControlTimeoutMs, &moved);
+  board::VersionReply version;
+  if (result != usb::Result::kOk || !board::decodeVersion(reply, static_cast<size_t>(moved), version)) {
+    error = std::string("the board did not answer GET_VERSION: ") + usb::describe(result);
+  } else if (version.protocolMajor != board::kProtocolMajor) {
+    error = "the board speaks protocol " + std::to_string(version.protocolMajor) + "." +
+            std::to_string(version.protocolMinor) + ", this host " + std::to_string(board::kProtocolMajor) + ".x";
+  } else {
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    telemetry_.version = version;
+    telemetry_.serial = port_->openSerial();
+    telemetry_.haveStatus = false;
+    return true;
+  }
+  port_->releaseInterface(board::kInterfaceNumber);
+  port_->close();
+  return false;
+}
+
+bool UsbBoardBackend::open(std::string& error) {
+  if (opened_.load()) return true;
+  std::lock_guard<std::mutex> lock(portMutex_);
+  const usb::Result init = port_->init();
+  if (init != usb::Result::kOk) {
+    error = std::string("libusb could not start: ") + usb::describe(init);
+    return false;
+  }
+  if (!connectLocked(error)) {
+    port_->exit();
+    return false;
+  }
+  armed_.store(false);
+  connected_.store(true);
+  stopping_.store(false);
+  opened_.store(true);
+  thread_ = std::thread([this] { run(); });
+  return true;
+}
+
+void UsbBoardBackend::close() {
+  if (!opened_.exchange(false)) return;
+  stopping_.store(true);
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+bool UsbBoardBackend::arm(std::string& error) {
+  std::lock_guard<std::mutex> lock(portMutex_);
+  if (!connected_.load()) {
+    error = "the friction board is not connected";
+    return false;
+  }
+  const usb::Result result = port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kArm), board::kArmKey,
+                                            board::kInterfaceNumber, nullptr, 0, kControlTimeoutMs, nullptr);
+  if (result == usb::Result::kPipe) {
+    error = "the board refused to arm (a fault, over temperature or no coil supply: see its error flags)";
+    return false;
+  }
+  if (result != usb::Result::kOk) {
+    error = std::string("arming failed: ") + usb::describe(result);
+    return false;
+  }
+  armed_.store(true);
+  return true;
+}
+
+bool UsbBoardBackend::disarm(std::string& error) {
+  armed_.store(false);  // set-points carry 0 from now on, whatever the board answers
+  std::lock_guard<std::mutex> lock(portMutex_);
+  if (!connected_.load()) return true;
+  const usb::Result result = port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0,
+                                            board::kInterfaceNumber, nullptr, 0, kControlTimeoutMs, nullptr);
+  if (result != usb::Result::kOk) {
+    error = std::string("disarming failed: ") + usb::describe(result);
+    return false;
+  }
+  return true;
+}
+
+void UsbBoardBackend::commandForce(double timeS, float forceN) {
+  const double span = options_.maxForceN - options_.minForceN;
+  const double drive = span > 0.0 ? (forceN - options_.minForceN) / span : 0.0;
+  commandDrive(timeS, forceN, static_cast<float>(drive));
+}
+
+void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
+  const double level = std::isfinite(driveLevel) ? std::clamp(static_cast<double>(driveLevel), 0.0, 1.0) : 0.0;
+  latestDrive_.store(static_cast<uint16_t>(std::lround(level * board::kDriveFull)), std::memory_order_relaxed);
+}
+
+void UsbBoardBackend::driveOff() { latestDrive_.store(0, std::memory_order_relaxed); }
+
+BoardTelemetry UsbBoardBackend::telemetry() const {
+  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  BoardTelemetry copy = telemetry_;
+  copy.connected = connected_.load();
+  copy.armed = armed_.load();
+  return copy;
+}
+
+// --- event thread ---------------------------------------------------------------------------
+
+void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
+  auto* self = static_cast<UsbBoardBackend*>(transfer.user);
+  if (transfer.endpoint == board::kStatusEndpoint)
+    self->onStatus(transfer);
+  else
+    self->onSetPoint(transfer);
+}
+
+void UsbBoardBackend::submitSetPoint(int slot) {
+  usb::Transfer& transfer = outTransfers_[slot];
+  const uint16_t drive = armed_.load(std::memory_order_relaxed) ? latestDrive_.load(std::memory_order_relaxed) : 0;
+  board::encodeSetPoint({++sequence_, drive}, transfer.buffer);
+  const usb::Result result = port_->submit(transfer);
+  if (result == usb::Result::kOk) {
+    outBusy_[slot] = true;
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    telemetry_.lastSequenceSent = sequence_;
+    telemetry_.lastDriveSent = drive;
+  } else if (result == usb::Result::kNoDevice) {
+    markUnplugged();
+  } else {
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    ++telemetry_.lostTransfers;
+  }
+}
+
+void UsbBoardBackend::submitStatus() {
+  const usb::Result result = port_->submit(statusTransfer_);
+  if (result == usb::Result::kOk)
+    statusBusy_ = true;
+  else if (result == usb::Result::kNoDevice)
+    markUnplugged();
+}
+
+void UsbBoardBackend::submitIdle() {
+  if (stopping_.load() || unplugged_ || !connected_.load()) return;
+  const int inFlight = std::clamp(options_.transfersInFlight, 1, kMaxInFlight);
+  for (int slot = 0; slot < inFlight && !stallPending_ && !unplugged_; ++slot)
+    if (!outBusy_[slot]) submitSetPoint(slot);
+  if (!statusBusy_ && !unplugged_) submitStatus();
+}
+
+void UsbBoardBackend::markUnplugged() {
+  if (unplugged_) return;
+  unplugged_ = true;
+  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  ++telemetry_.unplugs;
+  telemetry_.lastError = "the friction board was unplugged";
+}
+
+void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
+  if (&transfer == &zeroTransfer_) {
+    zeroBusy_ = false;
+    return;
+  }
+  const int slot = static_cast<int>(&transfer - outTransfers_);
+  outBusy_[slot] = false;
+  const double nowS = steadyS();
+  {
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    switch (transfer.status) {
+      case usb::TransferStatus::kCompleted:
+        if (transfer.actualLength == transfer.length) {
+          ++telemetry_.setPointsSent;
+          if (lastOutDoneS_ >= 0.0 && nowS - lastOutDoneS_ > options_.lateTransferS) ++telemetry_.lateTransfers;
+          lastOutDoneS_ = nowS;
+        } else {
+          ++telemetry_.partials;
+          ++telemetry_.lostTransfers;
+        }
+        break;
+      case usb::TransferStatus::kTimedOut:
+        ++telemetry_.timeouts;
+        ++telemetry_.lostTransfers;
+        break;
+      case usb::TransferStatus::kStall:
+        ++telemetry_.stalls;
+        stallPending_ = true;
+        return;  // resubmitted once the halt is cleared
+      case usb::TransferStatus::kNoDevice:
+        break;
+      case usb::TransferStatus::kCancelled:
+        return;
+      default:
+        ++telemetry_.lostTransfers;
+        break;
+    }
+  }
+  if (transfer.status == usb::TransferStatus::kNoDevice) {
+    markUnplugged();
+    return;
+  }
+  if (!stopping_.load() && !unplugged_ && !stallPending_) submitSetPoint(slot);
+}
+
+void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
+  statusBusy_ = false;
+  if (transfer.status == usb::TransferStatus::kNoDevice) {
+    markUnplugged();
+    return;
+  }
+  if (transfer.status == usb::TransferStatus::kCancelled) return;
+  if (transfer.status == usb::TransferStatus::kStall) {
+    // A halted status endpoint is cleared in the loop like the set-point one.
+    stallPending_ = true;
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    ++telemetry_.stalls;
+    return;
+  }
+  board::Status status;
+  const bool valid = transfer.status == usb::TransferStatus::kCompleted &&
+                     board::decodeStatus(transfer.buffer, static_cast<size_t>(transfer.actualLength), status);
+  {
+    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    if (valid) {
+      telemetry_.status = status;
+      telemetry_.haveStatus = true;
+    } else if (transfer.status != usb::TransferStatus::kTimedOut) {
+      ++telemetry_.badStatus;
+    }
+  }
+  if (!stopping_.load() && !unplugged_) submitStatus();
+}
+
+bool UsbBoardBackend::anyOutInFlight() const {
+  if (zeroBusy_) return true;
+  for (bool busy : outBusy_)
+    if (busy) return true;
+  return false;
+}
+
+bool UsbBoardBackend::anyInFlight() const { return statusBusy_ || anyOutInFlight(); }
+
+void UsbBoardBackend::waitForTransfers(double timeoutS) {
+  const double deadlineS = steadyS() + timeoutS;
+  while (anyInFlight() && steadyS() < deadlineS) port_->handleEvents(5);
+}
+
+void UsbBoardBackend::dropHandle() {
+  std::lock_guard<std::mutex> lock(portMutex_);
+  connected_.store(false);
+  armed_.store(false);
+  port_->releaseInterface(board::kInterfaceNumber);
+  port_->close();
+}
+
+void UsbBoardBackend::run() {
+  submitIdle();
+  while (!stopping_.load()) {
+    if (connected_.load()) {
+      port_->handleEvents(5);
+      if (unplugged_) {
+        waitForTransfers(0.5);  // they come back with kNoDevice
+        dropHandle();
+        for (bool& busy : outBusy_) busy = false;
+        statusBusy_ = zeroBusy_ = false;  // whatever did not come back is gone with the handle
+        nextReopenS_ = steadyS() + options_.reopenPeriodS;
+        continue;
+      }
+      if (stallPending_ && !anyOutInFlight()) {
+        const usb::Result cleared = port_->clearHalt(board::kSetPointEndpoint);
+        port_->clearHalt(board::kStatusEndpoint);
+        if (cleared == usb::Result::kNoDevice) markUnplugged();
+        stallPending_ = false;
+      }
+      submitIdle();
+    } else {
+      {
+        std::unique_lock<std::mutex> lock(wakeMutex_);
+        wake_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, nextReopenS_ - steadyS())),
+                       [this] { return stopping_.load(); });
+      }
+      if (stopping_.load()) break;
+      std::string error;
+      std::lock_guard<std::mutex> lock(portMutex_);
+      if (connectLocked(error)) {
+        // Found again: a fresh board, disarmed until armed again.
+        armed_.store(false);
+        unplugged_ = false;
+        stallPending_ = false;
+        lastOutDoneS_ = -1.0;
+        connected_.store(true);
+        std::lock_guard<std::mutex> telemetryLock(telemetryMutex_);
+        ++telemetry_.reopens;
+        telemetry_.lastError.clear();
+      } else {
+        nextReopenS_ = steadyS() + options_.reopenPeriodS;
+      }
+    }
+  }
+  shutdownLink();
+}
+
+void UsbBoardBackend::shutdownLink() {
+  if (connected_.load() && !unplugged_) {
+    // Cancel what is queued and wait for every callback, so no transfer is left in flight.
+    for (int slot = 0; slot < kMaxInFlight; ++slot)
+      if (outBusy_[slot]) port_->cancel(outTransfers_[slot]);
+    if (statusBusy_) port_->cancel(statusTransfer_);
+    waitForTransfers(0.5);
+    // The last set-point: drive 0. Then DISARM, release, close.
+    board::encodeSetPoint({++sequence_, 0}, zeroTransfer_.buffer);
+    if (port_->submit(zeroTransfer_) == usb::Result::kOk) {
+      zeroBusy_ = true;
+      waitForTransfers(0.1);
+    }
+    armed_.store(false);
+    std::lock_guard<std::mutex> lock(portMutex_);
+    port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0, board::kInterfaceNumber, nullptr, 0,
+                   kControlTimeoutMs, nullptr);
+  } else if (connected_.load()) {
+    waitForTransfers(0.5);
+  }
+  if (connected_.load()) dropHandle();
+  std::lock_guard<std::mutex> lock(portMutex_);
+  port_->exit();
+}
+
+}  // namespace kf

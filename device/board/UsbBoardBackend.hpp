@@ -1,0 +1,129 @@
+// UsbBoardBackend: the friction board (device/board/PROTOCOL.md) as a ForceBackend, through a
+// usb::Port (libusb, or the emulator in tests). One event thread of its own keeps a few
+// set-point OUT transfers in flight, each filled with the latest drive level when it is
+// (re)submitted, and one status IN transfer. Partial, stalled and timed-out transfers are
+// counted and retried (a stall after clearing the halt); kNoDevice is an unplug: the handle
+// is dropped and the board looked for again, and a board found again stays disarmed until
+// armed again. close(): cancel, wait for the callbacks, one set-point of drive 0, DISARM,
+// release, close. commandDrive/driveOff are lock-free (the device thread, or the audio thread
+// in lockstep); open, close, arm and disarm run on a non-realtime thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "board/BoardProtocol.hpp"
+#include "board/UsbPort.hpp"
+#include "core/ForceBackend.hpp"
+
+namespace kf {
+
+struct BoardOptions {
+  usb::DeviceIds ids{board::kVendorId, board::kProductId, ""};
+  int transfersInFlight = 2;  // set-points queued on EP 0x01 (1..4): each ~1 ms of latency
+  unsigned transferTimeoutMs = 20;
+  double reopenPeriodS = 0.25;   // after an unplug, how often to look for the board
+  double lateTransferS = 0.002;  // a set-point completing later than this after the previous
+  // commandForce (no drive given): the linear map of an uncalibrated board.
+  double minForceN = 0.14;
+  double maxForceN = 1.4;
+};
+
+struct BoardTelemetry {
+  bool connected = false;
+  bool armed = false;       // the host's side: set-points carry the drive only when armed
+  bool haveStatus = false;  // a valid status frame arrived since (re)connecting
+  board::Status status;     // the last valid one
+  board::VersionReply version;
+  std::string serial;
+  std::string lastError;
+  uint16_t lastSequenceSent = 0;
+  uint16_t lastDriveSent = 0;
+  uint64_t setPointsSent = 0;  // completed OUT transfers
+  uint64_t lateTransfers = 0;  // completed later than lateTransferS after the previous one
+  uint64_t lostTransfers = 0;  // timed out, partial or failed
+  uint64_t timeouts = 0;
+  uint64_t partials = 0;
+  uint64_t stalls = 0;
+  uint64_t badStatus = 0;  // short or damaged status frames
+  uint64_t unplugs = 0;
+  uint64_t reopens = 0;
+};
+
+class UsbBoardBackend : public ForceBackend {
+ public:
+  UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions options = {});
+  ~UsbBoardBackend() override;
+  UsbBoardBackend(const UsbBoardBackend&) = delete;
+  UsbBoardBackend& operator=(const UsbBoardBackend&) = delete;
+
+  // Finds, opens and claims the board, checks its protocol version, starts the event thread.
+  // Disarmed. False with a message (no board, permission denied, busy, wrong version).
+  bool open(std::string& error);
+  // The clean shutdown above. Idempotent; also from the destructor.
+  void close();
+  bool arm(std::string& error);
+  bool disarm(std::string& error);
+
+  void commandForce(double timeS, float forceN) override;
+  void commandDrive(double timeS, float forceN, float driveLevel) override;
+  void driveOff() override;
+
+  BoardTelemetry telemetry() const;
+  uint16_t latestDrive() const { return latestDrive_.load(std::memory_order_relaxed); }
+
+ private:
+  static constexpr int kMaxInFlight = 4;
+
+  static void onTransfer(usb::Transfer& transfer);
+  void onSetPoint(usb::Transfer& transfer);
+  void onStatus(usb::Transfer& transfer);
+  void run();
+  bool connectLocked(std::string& error);  // portMutex_ held
+  void submitSetPoint(int slot);
+  void submitStatus();
+  void submitIdle();
+  void markUnplugged();
+  void dropHandle();
+  bool anyInFlight() const;
+  bool anyOutInFlight() const;
+  void waitForTransfers(double timeoutS);
+  void shutdownLink();
+  void setError(const std::string& error);
+
+  std::unique_ptr<usb::Port> port_;
+  const BoardOptions options_;
+  std::mutex portMutex_;  // open/claim/control/release/close between the event and NRT threads
+
+  // Event thread only.
+  usb::Transfer outTransfers_[kMaxInFlight];
+  bool outBusy_[kMaxInFlight] = {};
+  usb::Transfer statusTransfer_;
+  bool statusBusy_ = false;
+  usb::Transfer zeroTransfer_;
+  bool zeroBusy_ = false;
+  uint16_t sequence_ = 0;
+  double lastOutDoneS_ = -1.0;
+  bool stallPending_ = false;
+  bool unplugged_ = false;
+  double nextReopenS_ = 0.0;
+
+  std::atomic<uint16_t> latestDrive_{0};
+  std::atomic<bool> armed_{false};
+  std::atomic<bool> connected_{false};
+  std::atomic<bool> stopping_{false};
+  std::atomic<bool> opened_{false};
+  std::thread thread_;
+  std::mutex wakeMutex_;
+  std::condition_variable wake_;
+
+  mutable std::mutex telemetryMutex_;
+  BoardTelemetry telemetry_;
+};
+
+}  // namespace kf

@@ -1,0 +1,343 @@
+#include "core/Device.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <string>
+
+#include "core/DeviceMessages.hpp"
+
+namespace kf {
+
+Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std::shared_ptr<ForceBackend> force,
+               bool lockstep, DeviceOptions options)
+    : spec_(spec),
+      lockstep_(lockstep),
+      options_(options),
+      mouse_(std::move(mouse)),
+      force_(std::move(force)),
+      reportQueue_(options.reportQueueCapacity),
+      frameQueue_(options.frameQueueCapacity),
+      safety_(spec),
+      pending_(std::max<size_t>(options.frameQueueCapacity, 1)),
+      releaseLatencyS_(options.forceLatencyS),
+      startTime_(std::chrono::steady_clock::now()) {
+  telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
+  telemetry_.setReleaseLatency(releaseLatencyS_);
+}
+
+Device::~Device() { close(); }
+
+void Device::start() {
+  if (lockstep_ || options_.externalPump || thread_.joinable() || isClosed()) return;
+  stopRequested_.store(false);
+  startTime_ = std::chrono::steady_clock::now();
+  thread_ = std::thread([this] { threadMain(); });
+}
+
+void Device::threadMain() {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point openTime = startTime_;
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.pumpPeriodS));
+  Clock::time_point next = openTime;
+  while (!stopRequested_.load(std::memory_order_acquire)) {
+    next += period;
+    std::this_thread::sleep_until(next);
+    const Clock::time_point now = Clock::now();
+    // After a long stall, do not try to catch up with a burst of pumps.
+    if (now - next > 10 * period) next = now;
+    const double nowS = std::chrono::duration<double>(now - openTime).count();
+    if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    try {
+      pumpLocked(nowS);
+    } catch (const std::exception& e) {
+      failThread(e.what());
+      return;
+    } catch (...) {
+      failThread("unknown exception");
+      return;
+    }
+  }
+}
+
+void Device::failThread(const char* what) noexcept {
+  // A backend threw: nothing pumps this device any more, so its magnet goes off now.
+  try {
+    force_->driveOff();
+    if (board_) board_->driveOff();
+  } catch (...) {
+    force_->driveOffFromSignal();
+    if (ForceBackend* board = board_.get()) board->driveOffFromSignal();
+  }
+  safety_.resetToOff();
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  try {
+    recorder_.writeOff(std::max(lastPumpS_, 0.0));
+    recorder_.close();
+    postDeviceMessage((std::string("device thread stopped (") + what + "); magnet off, reopen the device").c_str());
+  } catch (...) {
+  }
+}
+
+void Device::pump(double nowS) {
+  if (options_.externalPump && !lockstep_ && !isClosed()) {
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    pumpLocked(nowS);
+    return;
+  }
+  if (!lockstep_ || isClosed()) return;
+  // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
+  std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;
+  pumpLocked(nowS - lockstepOriginS_);
+}
+
+void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double nowS) {
+  const float commandedN = safety_.applyFrame(frame, nowS);
+  if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
+  force_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  if (board_) board_->commandDrive(commandS, commandedN, safety_.driveLevel());
+  telemetry_.countFrame(commandedN);
+  recorder_.writeFrame(nowS, frame, commandedN);
+}
+
+void Device::applyLockstepFrameLocked(const ForceFrame& frame, double nowS) {
+  // Device and audio time are one clock, so the frame is stamped with its own time (never
+  // before an earlier command, never in the future); a backend that has already passed that
+  // time (the sim, pumped to the end of the block) applies it at once, as a realtime device
+  // would.
+  double commandS = nowS;
+  if (std::isfinite(frame.timeS)) commandS = std::clamp(frame.timeS, std::min(lastCommandS_, nowS), nowS);
+  lastCommandS_ = commandS;
+  applyFrameLocked(frame, commandS, nowS);
+}
+
+void Device::takeFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  ForceFrame frame;
+  while (frameQueue_.pop(frame)) {
+    double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
+    if (!std::isfinite(startS)) startS = nowS;
+    // A frame later than the latency allows raises it, so the frames after it keep their
+    // spacing instead of going out in a burst (a long audio period).
+    const double latenessS = nowS - startS;
+    windowLatenessS_ = std::max(windowLatenessS_, latenessS);
+    releaseLatencyS_ = std::max(releaseLatencyS_, std::min(latenessS, options_.maxForceLatencyS));
+    if (pendingCount_ == pending_.size()) {
+      // Full: the oldest goes out now rather than being lost.
+      applyFrameLocked(pending_[pendingHead_].frame, nowS, nowS);
+      telemetry_.countLateFrame();
+      pendingHead_ = (pendingHead_ + 1) % pending_.size();
+      --pendingCount_;
+    }
+    pending_[(pendingHead_ + pendingCount_) % pending_.size()] = PendingFrame{frame, startS};
+    ++pendingCount_;
+  }
+}
+
+void Device::settleLatencyLocked(double nowS) {
+  if (nowS >= windowEndS_) {
+    previousWindowLatenessS_ = windowLatenessS_;
+    windowLatenessS_ = 0.0;
+    windowEndS_ = nowS + kLatencyWindowS;
+  }
+  // Down to what the frames of the last 0.5 to 1 s needed, never below the base, by 5 % of the
+  // time since the last pump: one stall must not hold the force latency up for the rest of the session.
+  const double neededS = std::min(std::max({options_.forceLatencyS, windowLatenessS_, previousWindowLatenessS_}),
+                                  options_.maxForceLatencyS);
+  const double stepS = kLatencyDecayRate * std::max(nowS - lastPumpS_, 0.0);
+  if (releaseLatencyS_ > neededS) releaseLatencyS_ = std::max(neededS, releaseLatencyS_ - stepS);
+}
+
+int Device::releaseFramesLocked(double nowS) {
+  const double periodS = spec_.forceFramePeriodS;
+  int released = 0;
+  while (pendingCount_ > 0) {
+    const PendingFrame& pending = pending_[pendingHead_];
+    const double dueS = pending.startS + releaseLatencyS_;
+    // The pump nearest the due time releases it: due times on the pump grid would otherwise
+    // split between two pumps at the slightest wake-up jitter.
+    if (dueS > nowS + 0.5 * options_.pumpPeriodS) break;
+    telemetry_.frameOffset.record(std::abs(nowS - dueS));
+    if (nowS - dueS > periodS) telemetry_.countLateFrame();
+    applyFrameLocked(pending.frame, nowS, nowS);
+    pendingHead_ = (pendingHead_ + 1) % pending_.size();
+    --pendingCount_;
+    ++released;
+  }
+  return released;
+}
+
+void Device::pumpLocked(double nowS) {
+  // Announce the pump before looking at halted_ (both sequentially consistent): either
+  // emergencyOff() sees this pump and waits for it, or this pump sees the halt.
+  pumping_.store(true);
+  struct PumpDone {
+    std::atomic<bool>& flag;
+    ~PumpDone() { flag.store(false); }
+  } done{pumping_};
+  if (halted_.load()) return;
+  if (!(nowS > lastPumpS_)) return;
+
+  if (lockstep_) {
+    ForceFrame frame;  // only frames whose push found the state busy
+    while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
+  } else {
+    takeFramesLocked(nowS);
+    settleLatencyLocked(nowS);
+    const int released = releaseFramesLocked(nowS);
+    if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
+    telemetry_.setReleaseLatency(releaseLatencyS_);
+  }
+  // Frames still waiting in the jitter buffer are coming: no trip while there are any, so a
+  // long audio period does not make the watchdog chatter.
+  if (pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
+    force_->driveOff();
+    if (board_) board_->driveOff();
+    telemetry_.countWatchdogTrip();
+    telemetry_.setCommandedForce(safety_.commandedForceN());
+    recorder_.writeOff(nowS);
+  }
+
+  int polled = 0;
+  do {
+    polled = mouse_->pollReports(nowS, pollBuffer_, kPollBatch);
+    for (int i = 0; i < polled; ++i) {
+      pollBuffer_[i].hostTimeS = nowS;
+      xCounts_ += pollBuffer_[i].dxCounts;
+      yCounts_ += pollBuffer_[i].dyCounts;
+      pollBuffer_[i].xCounts = xCounts_;
+      pollBuffer_[i].yCounts = yCounts_;
+      telemetry_.countReport(pollBuffer_[i].deviceTimeS);
+      recorder_.writeReport(nowS, pollBuffer_[i]);
+      reportQueue_.push(pollBuffer_[i]);  // a full queue counts the overflow
+    }
+  } while (polled == kPollBatch);
+
+  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+  lastPumpS_ = nowS;
+  lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
+  telemetry_.countPump();
+}
+
+void Device::close() {
+  if (closed_.exchange(true, std::memory_order_acq_rel)) return;
+  stopRequested_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  force_->driveOff();
+  if (board_) board_->driveOff();
+  safety_.resetToOff();
+  pendingCount_ = 0;
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  recorder_.writeOff(std::max(lastPumpS_, 0.0));
+  recorder_.close();
+}
+
+int Device::popReports(MouseReport* out, int capacity) {
+  int popped = 0;
+  while (popped < capacity && reportQueue_.pop(out[popped])) ++popped;
+  if (!lockstep_ && popped > 0) {
+    const double now = nowS();
+    for (int i = 0; i < popped; ++i) telemetry_.reportLatency.record(now - out[i].hostTimeS);
+  }
+  return popped;
+}
+
+double Device::nowS() const {
+  if (lockstep_ || options_.externalPump) return lastPumpAtomicS_.load(std::memory_order_relaxed);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - startTime_).count();
+}
+
+bool Device::pushForceFrame(const ForceFrame& frame) {
+  if (lockstep_ && !isClosed()) {
+    std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+    if (lock.owns_lock() && lastPumpS_ >= 0.0) {
+      // Lockstep has one thread for both ends of the queue: earlier frames first.
+      ForceFrame queued;
+      while (frameQueue_.pop(queued)) applyLockstepFrameLocked(queued, lastPumpS_);
+      applyLockstepFrameLocked(frame, lastPumpS_);
+      return true;
+    }
+  }
+  return frameQueue_.push(frame);
+}
+
+std::shared_ptr<ForceBackend> Device::attachBoard(std::shared_ptr<ForceBackend> board) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  if (board_) board_->driveOff();
+  if (board && !isClosed()) board->driveOff();  // from off; the next frame drives it
+  std::swap(board_, board);
+  return board;
+}
+
+std::shared_ptr<ForceBackend> Device::board() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return board_;
+}
+
+void Device::setCalibration(const CalibrationTable& table) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  safety_.setCalibration(table);
+}
+
+uint64_t Device::driveLimitedFrames() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.driveLimitedFrames();
+}
+
+double Device::heatEstimate() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return safety_.heat();
+}
+
+TelemetrySnapshot Device::telemetry() const {
+  TelemetrySnapshot snapshot = telemetry_.snapshot();
+  snapshot.reportQueueOverflows = reportQueue_.overflows();
+  snapshot.frameQueueOverflows = frameQueue_.overflows();
+  return snapshot;
+}
+
+bool Device::startRecording(const std::string& path, std::string& error) {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  if (isClosed()) {
+    error = "the device is closed";
+    return false;
+  }
+  return recorder_.open(path, spec_, error);
+}
+
+void Device::stopRecording() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  recorder_.close();
+  if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+}
+
+std::string Device::recordingError() {
+  std::lock_guard<std::mutex> lock(stateMutex_);
+  return recorder_.error();
+}
+
+void Device::emergencyOff() noexcept {
+  halted_.store(true);
+  // A pump running on another thread may still command a force and write records: let it
+  // finish first, for at most 50 ms (the handler may be running on that very thread).
+  timespec start{}, now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &start);
+  while (pumping_.load()) {
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    if ((now.tv_sec - start.tv_sec) * 1e9 + (now.tv_nsec - start.tv_nsec) > 50e6) break;
+  }
+  force_->driveOffFromSignal();
+  // The board's off set-point is queued for its event thread; if the process dies first, the
+  // board's own watchdog turns the current off 20 ms after the last frame (PROTOCOL.md).
+  if (ForceBackend* board = board_.get()) board->driveOffFromSignal();
+  telemetry_.setCommandedForce(static_cast<float>(spec_.minForceN));
+  recorder_.appendOffFromSignal(nowS());
+}
+
+}  // namespace kf

@@ -1,0 +1,174 @@
+// Device: one opened device slot — a mouse backend, a force backend, the two SPSC queues to
+// and from the audio thread, ForceSafety, Telemetry and an optional Recorder — and the
+// device thread that pumps it every 1 ms in realtime. In lockstep mode (NRT rendering) there
+// is no thread: the audio side calls pump(audioTimeS) itself, through the same code.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/ForceBackend.hpp"
+#include "core/MouseBackend.hpp"
+#include "core/SpscQueue.hpp"
+#include "core/Telemetry.hpp"
+#include "core/files/SessionFile.hpp"
+#include "core/force/CalibrationTable.hpp"
+#include "core/force/ForceSafety.hpp"
+#include "core/spec/DeviceSpec.hpp"
+#include "core/spec/Report.hpp"
+
+namespace kf {
+
+struct DeviceOptions {
+  size_t reportQueueCapacity = 1024;  // 8 s of 125 Hz reports
+  size_t frameQueueCapacity = 1024;   // 1 s of 1 kHz frames
+  double pumpPeriodS = 0.001;         // realtime: how often the thread pumps
+  // Realtime: each force frame goes to the magnet at its own device time, its start plus this
+  // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
+  // them. A frame that arrives later than that (a long audio period, a late audio thread)
+  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS: the frames
+  // after it keep their spacing instead of coming in bursts. Once no frame of the last 0.5 to 1 s
+  // needed it, it comes back down by 5 % of the time passing (frames 0.95 ms apart meanwhile), so a stall
+  // does not keep it raised, while long audio periods, whose every burst needs it, keep it.
+  double forceLatencyS = 0.002;
+  double maxForceLatencyS = 0.1;
+  // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
+  // caller through pump(nowS) on a clock of its own (nowS() is the last pumped time).
+  bool externalPump = false;
+};
+
+class Device {
+ public:
+  // The mouse and force backends may be one object (SimDevice) or two.
+  Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std::shared_ptr<ForceBackend> force,
+         bool lockstep, DeviceOptions options = {});
+  // Closes: stops and joins the thread, drives the magnet off.
+  ~Device();
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  // Realtime: starts the device thread; device time 0 is now. Lockstep: nothing.
+  void start();
+  // Stop flag, join, magnet off, recording closed. Idempotent; not from the audio thread.
+  void close();
+
+  // One round of work at device time nowS (lockstep: audio time, less the origin): force frames from the audio queue
+  // through ForceSafety to the force backend, the watchdog, reports up to nowS into the audio queue, recording. Does
+  // nothing for nowS <= the last pumped time (several UGens may call it), while the state is being changed (recording
+  // started/stopped), after close, and in realtime mode (where the device thread is the only pumper).
+  void pump(double nowS);
+
+  // Audio side (one consumer / one producer thread): never allocate, lock or wait.
+  // popReports also measures, in realtime, how long each report waited in the queue.
+  int popReports(MouseReport* out, int capacity);
+  // Realtime: queued for the device thread. Lockstep: the audio thread is the pumper, so the
+  // frame goes through the safety path at once (try_lock; queued when that fails), and
+  // commandedForceN() tells at once what it became.
+  bool pushForceFrame(const ForceFrame& frame);
+  // The force last sent to the magnet after the safety path (watchdog trips and close too).
+  float commandedForceN() const { return telemetry_.commandedForceN(); }
+  // The device clock: seconds since start() in realtime (steady clock, any thread, no lock);
+  // in lockstep the last pumped time.
+  double nowS() const;
+
+  const DeviceSpec& spec() const { return spec_; }
+  bool isLockstep() const { return lockstep_; }
+  // Lockstep: the audio time at which the device opened, its time 0 (as a realtime device's
+  // clock starts at open). pump() takes audio time and subtracts it. Set before first use.
+  void setLockstepOriginS(double audioTimeS) { lockstepOriginS_ = audioTimeS; }
+  double lockstepOriginS() const { return lockstepOriginS_; }
+  bool isClosed() const { return closed_.load(std::memory_order_acquire); }
+  TelemetrySnapshot telemetry() const;
+
+  // From a non-realtime thread. Starts a kf-session file with the spec in its header.
+  bool startRecording(const std::string& path, std::string& error);
+  void stopRecording();
+  // Why the last recording stopped by itself (a write error, also posted), or empty.
+  std::string recordingError();
+
+  // Async-signal-safe, from any thread (the handlers of host/ExitSafety.cpp): drives the
+  // magnet off without a lock and appends an off record to the recording; no pump runs after
+  // it (one under way on another thread is waited for, at most 50 ms). The process is on its
+  // way out; nothing else is cleaned up.
+  void emergencyOff() noexcept;
+
+  // From a non-realtime thread: an extra force backend (the friction board) that gets every
+  // command and drive-off the device's own backend gets, from the next frame on. Null
+  // detaches the board, after driving it off. Returns the board attached before.
+  std::shared_ptr<ForceBackend> attachBoard(std::shared_ptr<ForceBackend> board);
+  std::shared_ptr<ForceBackend> board();
+  // From a non-realtime thread: the board's calibration table for the force path.
+  void setCalibration(const CalibrationTable& table);
+  // Frames the hard drive limit or the heat estimate lowered, and the heat estimate now.
+  uint64_t driveLimitedFrames();
+  double heatEstimate();
+
+  MouseBackend& mouseBackend() { return *mouse_; }
+  ForceBackend& forceBackend() { return *force_; }
+
+ private:
+  static constexpr int kPollBatch = 64;
+  static constexpr double kLatencyWindowS = 0.5;     // how long a frame's need is remembered
+  static constexpr double kLatencyDecayRate = 0.05;  // s per s: frames 5 % closer meanwhile
+
+  struct PendingFrame {
+    ForceFrame frame;
+    double startS;  // the frame's start on the device clock
+  };
+
+  void pumpLocked(double nowS);
+  void threadMain();
+  // The device thread caught an exception from a backend: magnet off, recording closed.
+  void failThread(const char* what) noexcept;
+  // One frame through ForceSafety to the backend, telemetry and recording.
+  void applyFrameLocked(const ForceFrame& frame, double commandS, double nowS);
+  void applyLockstepFrameLocked(const ForceFrame& frame, double nowS);
+  // Realtime jitter buffer: queue -> pending (with release times), then the due ones out.
+  void takeFramesLocked(double nowS);
+  void settleLatencyLocked(double nowS);
+  int releaseFramesLocked(double nowS);
+
+  const DeviceSpec spec_;
+  const bool lockstep_;
+  double lockstepOriginS_ = 0.0;
+  const DeviceOptions options_;
+  std::shared_ptr<MouseBackend> mouse_;
+  std::shared_ptr<ForceBackend> force_;
+  std::shared_ptr<ForceBackend> board_;  // under stateMutex_
+  SpscQueue<MouseReport> reportQueue_;
+  SpscQueue<ForceFrame> frameQueue_;
+  Telemetry telemetry_;
+
+  // Guards the pumped state below against start/stopRecording and close.
+  std::mutex stateMutex_;
+  ForceSafety safety_;
+  Recorder recorder_;
+  double lastPumpS_ = -1.0;
+  double lastCommandS_ = 0.0;
+  MouseReport pollBuffer_[kPollBatch];
+  std::vector<PendingFrame> pending_;  // ring, frameQueueCapacity
+  size_t pendingHead_ = 0;
+  size_t pendingCount_ = 0;
+  double releaseLatencyS_;
+  // The largest lateness of the frames taken in this window and the one before (seconds).
+  double windowLatenessS_ = 0.0, previousWindowLatenessS_ = 0.0;
+  double windowEndS_ = 0.0;
+  int64_t xCounts_ = 0;  // the puck's position since open (MouseReport::xCounts)
+  int64_t yCounts_ = 0;
+
+  std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
+  std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads
+  std::thread thread_;
+  std::atomic<bool> stopRequested_{false};
+  std::atomic<bool> closed_{false};
+  // emergencyOff(): no pump runs any more (halted_), and none is under way (pumping_).
+  std::atomic<bool> halted_{false};
+  std::atomic<bool> pumping_{false};
+};
+
+}  // namespace kf

@@ -1,0 +1,373 @@
+#include "core/files/SessionFile.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <utility>
+
+#include "core/files/TextFileReader.hpp"
+#include "core/spec/SettingBounds.hpp"
+
+namespace kf {
+
+namespace {
+
+// The DeviceSpec fields, in header order.
+struct SpecField {
+  const char* name;
+  double (*get)(const DeviceSpec&);
+};
+const SpecField kSpecFields[] = {
+    {"countMm", [](const DeviceSpec& s) { return s.countMm; }},
+    {"updateRateHz", [](const DeviceSpec& s) { return s.updateRateHz; }},
+    {"maxCountsPerReport", [](const DeviceSpec& s) { return double(s.maxCountsPerReport); }},
+    {"minForceN", [](const DeviceSpec& s) { return s.minForceN; }},
+    {"maxForceN", [](const DeviceSpec& s) { return s.maxForceN; }},
+    {"audioLatencyS", [](const DeviceSpec& s) { return s.audioLatencyS; }},
+    {"tactileLatencyS", [](const DeviceSpec& s) { return s.tactileLatencyS; }},
+    {"forceFramePeriodS", [](const DeviceSpec& s) { return s.forceFramePeriodS; }},
+    {"maxForceSlewNPerS", [](const DeviceSpec& s) { return s.maxForceSlewNPerS; }},
+    {"watchdogS", [](const DeviceSpec& s) { return s.watchdogS; }},
+    {"magnetLagS", [](const DeviceSpec& s) { return s.magnetLagS; }},
+};
+
+// strtod, unlike istream, reads back the "nan" and "inf" a requested force may hold.
+bool parseDouble(const std::string& token, double& value) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(token.c_str(), &end);
+  return end == token.c_str() + token.size();
+}
+
+template <typename Integer>
+bool parseInteger(const std::string& token, Integer& value) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  const long long parsed = std::strtoll(token.c_str(), &end, 10);
+  if (end != token.c_str() + token.size()) return false;
+  value = static_cast<Integer>(parsed);
+  return static_cast<long long>(value) == parsed;
+}
+
+bool parseFloat(const std::string& token, float& value) {
+  double parsed = 0.0;
+  if (!parseDouble(token, parsed)) return false;
+  value = static_cast<float>(parsed);
+  return true;
+}
+
+// Files being recorded, by (device, inode): two paths to one file are one file. Never destroyed:
+// the plugin's exit hook, itself a static destructor, closes recorders after this file's own
+// statics may be gone.
+struct RecordingFiles {
+  std::mutex mutex;
+  std::vector<std::pair<unsigned long long, unsigned long long>> keys;
+};
+RecordingFiles& recordingFiles() {
+  static RecordingFiles* files = new RecordingFiles;
+  return *files;
+}
+
+constexpr size_t kRecorderBufferBytes = 64 * 1024;  // written out when a pump fills it
+
+bool writeAll(int fd, const char* data, size_t size, int& code) {
+  while (size > 0) {
+    const ssize_t written = ::write(fd, data, size);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      code = errno;
+      return false;
+    }
+    if (written == 0) {
+      code = EIO;
+      return false;
+    }
+    data += written;
+    size -= static_cast<size_t>(written);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string& error) {
+  close();
+  error_.clear();
+  newFailure_ = false;
+  if (path.empty()) {
+    error = "no file given (empty path)";
+    return false;
+  }
+  // No O_TRUNC yet: a file another Recorder writes must not be cut. O_NONBLOCK: a FIFO
+  // without a reader must not block the command thread.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int code = errno;
+    if (code == ENXIO)  // a FIFO without a reader, a device without its driver
+      error = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
+    else
+      error = "cannot write " + path + ": " + std::strerror(code);
+    return false;
+  }
+  struct stat info {};
+  std::string problem;
+  if (::fstat(fd, &info) != 0)
+    problem = "cannot write " + path + ": " + std::strerror(errno);
+  else if (S_ISDIR(info.st_mode))
+    problem = path + " is a directory";
+  else if (!S_ISREG(info.st_mode))
+    problem = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
+  if (problem.empty()) {
+    RecordingFiles& files = recordingFiles();
+    std::lock_guard<std::mutex> lock(files.mutex);
+    const std::pair<unsigned long long, unsigned long long> key{info.st_dev, info.st_ino};
+    if (std::find(files.keys.begin(), files.keys.end(), key) != files.keys.end()) {
+      problem = "cannot record to " + path + ": another device is recording to this file";
+    } else if (::ftruncate(fd, 0) != 0 || ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
+      problem = "cannot write " + path + ": " + std::strerror(errno);
+    } else {
+      files.keys.push_back(key);
+      fileDevice_ = key.first;
+      fileInode_ = key.second;
+    }
+  }
+  if (!problem.empty()) {
+    ::close(fd);
+    error = problem;
+    return false;
+  }
+  path_ = path;
+  bytesWritten_ = 0;
+  buffer_.clear();
+  buffer_.reserve(kRecorderBufferBytes + 512);
+  fd_.store(fd, std::memory_order_release);
+  std::string header = std::string(kSessionFormatName) + " " + std::to_string(kSessionFormatVersion);
+  char field[96];
+  for (const SpecField& entry : kSpecFields) {
+    const int length = std::snprintf(field, sizeof field, " %s=%.17g", entry.name, entry.get(spec));
+    header.append(field, static_cast<size_t>(std::min<int>(length, sizeof field - 1)));
+  }
+  header += '\n';
+  append(header.data(), static_cast<int>(header.size()));
+  // The header reaches the file now: a recording that cannot even write that fails here.
+  if (!flush()) {
+    error = error_;
+    newFailure_ = false;
+    return false;
+  }
+  return true;
+}
+
+void Recorder::append(const char* text, int length) {
+  if (!isOpen() || length <= 0) return;
+  buffer_.append(text, static_cast<size_t>(length));
+  if (buffer_.size() >= kRecorderBufferBytes) flush();  // whole lines only: `text` is one
+}
+
+void Recorder::writeReport(double hostTimeS, const MouseReport& r) {
+  if (!isOpen()) return;
+  // %.17g: doubles read back bit for bit.
+  char line[160];
+  const int length = std::snprintf(line, sizeof line, "R %.17g %.17g %d %d %u %u\n", hostTimeS, r.deviceTimeS,
+                                   r.dxCounts, r.dyCounts, r.buttons, r.flags);
+  append(line, std::min<int>(length, sizeof line - 1));
+}
+
+void Recorder::writeFrame(double hostTimeS, const ForceFrame& frame, float commandedForceN) {
+  if (!isOpen()) return;
+  char line[160];
+  const int length = std::snprintf(line, sizeof line, "F %.17g %.17g %.9g %.9g\n", hostTimeS, frame.timeS,
+                                   static_cast<double>(frame.forceN), static_cast<double>(commandedForceN));
+  append(line, std::min<int>(length, sizeof line - 1));
+}
+
+void Recorder::writeOff(double hostTimeS) {
+  if (!isOpen()) return;
+  char line[64];
+  const int length = std::snprintf(line, sizeof line, "O %.17g\n", hostTimeS);
+  append(line, std::min<int>(length, sizeof line - 1));
+}
+
+bool Recorder::flush() {
+  const int fd = fd_.load(std::memory_order_acquire);
+  if (fd < 0) return error_.empty();
+  if (buffer_.empty()) return true;
+  int code = 0;
+  if (!writeAll(fd, buffer_.data(), buffer_.size(), code)) {
+    // Part of the chunk may be in the file: cut it back to the last whole line written.
+    if (::ftruncate(fd, static_cast<off_t>(bytesWritten_)) != 0) {
+    }
+    fail("writing", code);
+    return false;
+  }
+  bytesWritten_ += buffer_.size();
+  buffer_.clear();
+  return true;
+}
+
+void Recorder::fail(const char* what, int code) {
+  buffer_.clear();  // never written; what is in the file stays
+  error_ = std::string(what) + " " + path_ + " failed (" + std::strerror(code) + "); recording stopped, " +
+           std::to_string(bytesWritten_) + " bytes kept";
+  newFailure_ = true;
+  close();
+}
+
+void Recorder::close() {
+  const int fd = fd_.load(std::memory_order_acquire);
+  if (fd < 0) return;
+  flush();
+  if (!isOpen()) return;  // flush failed and closed
+  fd_.store(-1, std::memory_order_release);
+  int code = 0;
+  if (::close(fd) != 0 && error_.empty()) {
+    code = errno;
+    error_ = "closing " + path_ + " failed (" + std::strerror(code) + ")";
+    newFailure_ = true;
+  }
+  RecordingFiles& files = recordingFiles();
+  std::lock_guard<std::mutex> lock(files.mutex);
+  const std::pair<unsigned long long, unsigned long long> key{fileDevice_, fileInode_};
+  files.keys.erase(std::remove(files.keys.begin(), files.keys.end(), key), files.keys.end());
+}
+
+void Recorder::appendOffFromSignal(double hostTimeS) const {
+  const int fd = fd_.load(std::memory_order_acquire);
+  if (fd < 0) return;
+  // "\nO <seconds>.<nanoseconds>\n" by hand: snprintf is not async-signal-safe.
+  char text[48];
+  int n = 0;
+  text[n++] = '\n';
+  text[n++] = 'O';
+  text[n++] = ' ';
+  if (!(hostTimeS >= 0.0) || hostTimeS > 4e9) hostTimeS = 0.0;
+  const auto whole = static_cast<uint64_t>(hostTimeS);
+  const auto nanos = static_cast<uint64_t>((hostTimeS - static_cast<double>(whole)) * 1e9);
+  char digits[24];
+  int d = 0;
+  uint64_t value = whole;
+  do {
+    digits[d++] = static_cast<char>('0' + value % 10);
+    value /= 10;
+  } while (value > 0);
+  while (d > 0) text[n++] = digits[--d];
+  text[n++] = '.';
+  for (uint64_t scale = 100000000; scale > 0; scale /= 10) text[n++] = static_cast<char>('0' + (nanos / scale) % 10);
+  text[n++] = '\n';
+  ssize_t ignored = ::write(fd, text, static_cast<size_t>(n));
+  (void)ignored;
+}
+
+bool isSessionFile(const std::string& path) {
+  TextFileReader reader;
+  std::string error, line;
+  if (!reader.open(path, error)) return false;
+  const TextFileReader::Line status = reader.next(line, kMaxSessionLineChars);
+  if (status != TextFileReader::Line::kOk && status != TextFileReader::Line::kCut) return false;
+  return line.compare(0, std::strlen(kSessionFormatName), kSessionFormatName) == 0 &&
+         (line.size() == std::strlen(kSessionFormatName) || line[std::strlen(kSessionFormatName)] == ' ');
+}
+
+bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionData& out, std::string& error) {
+  out = SessionData{};
+  out.spec = spec;
+  TextFileReader reader;
+  if (!reader.open(path, error)) return false;
+  std::string line;
+  bool haveHeader = false;
+  for (;;) {
+    const auto record = reader.nextRecord(line, kMaxSessionLineChars, haveHeader, error, out.warning);
+    if (record == TextFileReader::Record::kFailed) return false;
+    if (record == TextFileReader::Record::kEnd) break;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    fields.imbue(std::locale::classic());
+    std::string tag;
+    fields >> tag;
+    if (!haveHeader) {
+      int version = 0;
+      if (tag != kSessionFormatName || !(fields >> version)) {
+        error = reader.lineError("not a kf-session file");
+        return false;
+      }
+      if (version != kSessionFormatVersion) {
+        error = reader.lineError("unsupported kf-session version " + std::to_string(version));
+        return false;
+      }
+      std::string pair;
+      while (fields >> pair) {
+        const size_t equals = pair.find('=');
+        if (equals == std::string::npos) {
+          error = reader.lineError("header field without '=': " + pair);
+          return false;
+        }
+        const std::string key = pair.substr(0, equals);
+        double value = 0.0;
+        if (!parseDouble(pair.substr(equals + 1), value)) {
+          error = reader.lineError("bad value in header field " + pair);
+          return false;
+        }
+        // Unknown keys are skipped so newer files still load; known ones must be in bounds.
+        if (findSettingBounds(key) == nullptr) continue;
+        std::string why;
+        if (!out.spec.applyOverride(key, value, &why)) {
+          if (why.rfind("unknown", 0) == 0) continue;  // a bounded name that is not a spec field
+          error = reader.lineError("header: " + why);
+          return false;
+        }
+      }
+      std::string why;
+      if (!out.spec.isValid(&why)) {
+        error = reader.lineError("header: " + why);
+        return false;
+      }
+      haveHeader = true;
+      if (reader.cut()) break;  // a header alone, cut after its last field
+      continue;
+    }
+    std::vector<std::string> tokens;
+    for (std::string token; tokens.size() < 8 && fields >> token;) tokens.push_back(token);
+    bool ok = false;
+    if (tag == "R") {
+      TimedReport timed;
+      MouseReport& r = timed.report;
+      ok = tokens.size() == 6 && parseDouble(tokens[0], timed.hostTimeS) && parseDouble(tokens[1], r.deviceTimeS) &&
+           parseInteger(tokens[2], r.dxCounts) && parseInteger(tokens[3], r.dyCounts) &&
+           parseInteger(tokens[4], r.buttons) && parseInteger(tokens[5], r.flags) && std::isfinite(timed.hostTimeS) &&
+           std::isfinite(r.deviceTimeS);  // replay waits for hostTimeS
+      if (ok) out.reports.push_back(timed);
+    } else if (tag == "F") {
+      RecordedFrame recorded;
+      ok = tokens.size() == 4 && parseDouble(tokens[0], recorded.hostTimeS) &&
+           parseDouble(tokens[1], recorded.frame.timeS) && parseFloat(tokens[2], recorded.frame.forceN) &&
+           parseFloat(tokens[3], recorded.commandedForceN);
+      if (ok) out.frames.push_back(recorded);
+    } else if (tag == "O") {
+      double timeS = 0.0;
+      ok = tokens.size() == 1 && parseDouble(tokens[0], timeS) && std::isfinite(timeS);
+      if (ok) out.offTimesS.push_back(timeS);
+    } else {
+      error = reader.lineError("unknown record '" + tag.substr(0, 32) + "'");
+      return false;
+    }
+    if (!ok) {
+      error = reader.lineError("malformed '" + tag + "' record");
+      return false;
+    }
+  }
+  if (!haveHeader) {
+    error = path + ": no kf-session header (only comments or blank lines)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace kf

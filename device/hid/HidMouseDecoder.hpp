@@ -1,0 +1,66 @@
+// HidMouseDecoder: finds, in a parsed report descriptor, the relative Generic Desktop X/Y
+// inputs and the buttons of each report ID, and decodes raw input reports to dx, dy, buttons.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hid/HidReportDescriptor.hpp"
+
+namespace kf {
+
+struct HidMouseDelta {
+  uint8_t reportId = 0;
+  int32_t dxCounts = 0;
+  int32_t dyCounts = 0;
+  uint32_t buttons = 0;  // bit i = Button usage i + 1
+};
+
+class HidMouseDecoder {
+ public:
+  // Buttons are 1..32, so no report needs more button bits or array elements than this.
+  static constexpr size_t kMaxButtonElements = 32;
+
+  // False (with a message) when no report carries a relative X or Y input.
+  bool build(const HidReportDescriptor& descriptor, std::string& error);
+
+  // Decodes one raw input report (report ID byte first when the descriptor uses IDs). False
+  // when the report is not a mouse report (other report ID) or too short for its fields.
+  bool decode(const uint8_t* bytes, size_t size, HidMouseDelta& out) const;
+
+  bool usesReportIds() const { return usesReportIds_; }
+  // Report IDs that carry X/Y (0 when the descriptor has no IDs).
+  std::vector<uint8_t> mouseReportIds() const;
+
+ private:
+  struct Element {
+    uint32_t bitOffset = 0;
+    uint32_t bitSize = 0;
+    bool isSigned = false;
+  };
+  // One element of an array item; its selectable usages are shared by all elements of the
+  // item (arrayUsages_[usagesIndex]), never copied per element.
+  struct ButtonArray {
+    Element element;
+    int64_t logicalMin = 0;
+    size_t usagesIndex = 0;
+  };
+  struct Layout {
+    uint8_t reportId = 0;
+    size_t minBytes = 0;  // without the ID byte
+    bool haveX = false, haveY = false;
+    Element x, y;
+    std::vector<std::pair<Element, uint32_t>> buttonBits;  // element, button number (1-based)
+    std::vector<ButtonArray> buttonArrays;
+  };
+
+  void noteExtent(Layout& layout, const Element& element);
+
+  std::vector<Layout> layouts_;
+  std::vector<std::vector<HidUsage>> arrayUsages_;
+  bool usesReportIds_ = false;
+};
+
+}  // namespace kf

@@ -1,0 +1,285 @@
+#include "hid/HidReportDescriptor.hpp"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+namespace kf {
+
+namespace {
+
+constexpr size_t kMaxPushDepth = 16;
+constexpr uint32_t kMaxReportSizeBits = 1024;
+constexpr uint64_t kMaxReportBits = 8u * 4096u;  // a HID report larger than 4 KiB is malformed
+constexpr uint32_t kMaxUsageRange = 65536;       // one whole usage page
+constexpr size_t kMaxTotalUsages = 1u << 18;     // over all fields: 1 MiB of usages at most
+constexpr size_t kMaxDescriptorBytes = 65535;    // the USB descriptor length is 16 bits
+
+struct GlobalState {
+  uint16_t usagePage = 0;
+  uint32_t logicalMinRaw = 0;
+  int logicalMinBytes = 0;
+  uint32_t logicalMaxRaw = 0;
+  int logicalMaxBytes = 0;
+  uint32_t reportSize = 0;
+  uint32_t reportCount = 0;
+  uint8_t reportId = 0;
+};
+
+struct LocalUsage {
+  uint32_t value = 0;
+  int bytes = 0;  // 4: value carries its own page
+};
+
+struct LocalState {
+  std::vector<LocalUsage> usages;
+  bool haveMin = false, haveMax = false;
+  LocalUsage usageMin, usageMax;
+};
+
+int64_t signExtend(uint32_t raw, int bytes) {
+  if (bytes == 0) return 0;
+  if (bytes >= 4) return static_cast<int32_t>(raw);
+  const uint32_t signBit = 1u << (bytes * 8 - 1);
+  return raw & signBit ? static_cast<int64_t>(raw) - (int64_t(1) << (bytes * 8)) : raw;
+}
+
+HidUsage fullUsage(const LocalUsage& usage, uint16_t page) {
+  return usage.bytes == 4 ? usage.value : hidUsage(page, static_cast<uint16_t>(usage.value));
+}
+
+std::string at(size_t offset, const std::string& what) {
+  return "HID report descriptor, byte " + std::to_string(offset) + ": " + what;
+}
+
+}  // namespace
+
+HidUsage HidField::usageOfElement(uint32_t index) const {
+  if (usages.empty()) return 0;
+  return usages[std::min<size_t>(index, usages.size() - 1)];
+}
+
+size_t HidReportDescriptor::inputReportBytes(uint8_t reportId) const {
+  uint64_t bits = 0;
+  for (const HidField& field : fields)
+    if (field.kind == HidField::Kind::kInput && field.reportId == reportId)
+      bits = std::max<uint64_t>(bits, field.bitOffset + uint64_t(field.bitSize) * field.count);
+  return static_cast<size_t>((bits + 7) / 8) + (usesReportIds ? 1 : 0);
+}
+
+bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out, std::string& error) {
+  out = HidReportDescriptor{};
+  GlobalState global;
+  std::vector<GlobalState> pushed;
+  LocalState local;
+  std::vector<int> openCollections;
+  std::map<std::pair<int, int>, uint64_t> nextBit;  // (kind, report ID) -> bit offset
+  bool haveFieldWithoutId = false;
+  size_t totalUsages = 0;
+  if (size > kMaxDescriptorBytes) {
+    error =
+        "HID report descriptor of " + std::to_string(size) + " bytes, more than " + std::to_string(kMaxDescriptorBytes);
+    return false;
+  }
+
+  size_t pos = 0;
+  while (pos < size) {
+    const size_t itemStart = pos;
+    const uint8_t prefix = bytes[pos++];
+    if (prefix == 0xFE) {  // long item: skip its data
+      if (size - pos < 2) {
+        error = at(itemStart, "truncated long item");
+        return false;
+      }
+      const size_t dataBytes = bytes[pos];
+      pos += 2;
+      if (size - pos < dataBytes) {
+        error = at(itemStart, "truncated long item");
+        return false;
+      }
+      pos += dataBytes;
+      continue;
+    }
+    const int dataBytes = (prefix & 3) == 3 ? 4 : (prefix & 3);
+    const int type = (prefix >> 2) & 3;
+    const int tag = prefix >> 4;
+    if (size - pos < static_cast<size_t>(dataBytes)) {
+      static const char digits[] = "0123456789abcdef";
+      const std::string hex{digits[prefix >> 4], digits[prefix & 15]};
+      error = at(itemStart, "truncated item (prefix 0x" + hex + " needs " + std::to_string(dataBytes) + " data bytes)");
+      return false;
+    }
+    uint32_t data = 0;
+    for (int i = 0; i < dataBytes; ++i) data |= uint32_t(bytes[pos + i]) << (8 * i);
+    pos += dataBytes;
+
+    if (type == 0) {  // main
+      if (tag == 0x8 || tag == 0x9 || tag == 0xB) {
+        const HidField::Kind kind = tag == 0x8   ? HidField::Kind::kInput
+                                    : tag == 0x9 ? HidField::Kind::kOutput
+                                                 : HidField::Kind::kFeature;
+        if (global.reportSize > kMaxReportSizeBits) {
+          error = at(itemStart, "report size " + std::to_string(global.reportSize) + " too large");
+          return false;
+        }
+        uint64_t& bit = nextBit[{static_cast<int>(kind), global.reportId}];
+        const uint64_t fieldBits = uint64_t(global.reportSize) * global.reportCount;
+        if (bit + fieldBits > kMaxReportBits) {
+          error = at(itemStart, "report longer than 4096 bytes");
+          return false;
+        }
+        if (global.reportId == 0) haveFieldWithoutId = true;
+        if (fieldBits > 0) {
+          HidField field;
+          field.kind = kind;
+          field.reportId = global.reportId;
+          field.bitOffset = static_cast<uint32_t>(bit);
+          field.bitSize = global.reportSize;
+          field.count = global.reportCount;
+          field.flags = data;
+          field.logicalMin = signExtend(global.logicalMinRaw, global.logicalMinBytes);
+          // A maximum is signed only when the minimum is negative (as the Linux parser does).
+          field.logicalMax = field.logicalMin < 0 ? signExtend(global.logicalMaxRaw, global.logicalMaxBytes)
+                                                  : int64_t(global.logicalMaxRaw);
+          uint64_t rangeCount = 0;
+          HidUsage first = 0;
+          if (local.haveMin && local.haveMax) {
+            first = fullUsage(local.usageMin, global.usagePage);
+            const HidUsage last = fullUsage(local.usageMax, global.usagePage);
+            if (last < first || last - first >= kMaxUsageRange) {
+              error = at(itemStart, "bad usage minimum/maximum range");
+              return false;
+            }
+            rangeCount = uint64_t(last) - first + 1;
+          }
+          totalUsages += local.usages.size() + rangeCount;
+          if (totalUsages > kMaxTotalUsages) {
+            error = at(itemStart, "more than " + std::to_string(kMaxTotalUsages) + " usages in all");
+            return false;
+          }
+          for (const LocalUsage& usage : local.usages) field.usages.push_back(fullUsage(usage, global.usagePage));
+          // Counted, not compared with `last`: a range ending at 0xFFFFFFFF must not wrap.
+          for (uint64_t i = 0; i < rangeCount; ++i) field.usages.push_back(static_cast<HidUsage>(first + i));
+          field.collection = openCollections.empty() ? -1 : openCollections.back();
+          out.fields.push_back(std::move(field));
+        }
+        bit += fieldBits;
+      } else if (tag == 0xA) {  // collection
+        HidCollection collection;
+        collection.type = static_cast<uint8_t>(data);
+        if (!local.usages.empty()) collection.usage = fullUsage(local.usages.front(), global.usagePage);
+        collection.parent = openCollections.empty() ? -1 : openCollections.back();
+        out.collections.push_back(collection);
+        openCollections.push_back(static_cast<int>(out.collections.size()) - 1);
+      } else if (tag == 0xC) {  // end collection
+        if (openCollections.empty()) {
+          error = at(itemStart, "End Collection without an open collection");
+          return false;
+        }
+        openCollections.pop_back();
+      } else {
+        error = at(itemStart, "unknown main item tag " + std::to_string(tag));
+        return false;
+      }
+      local = LocalState{};
+    } else if (type == 1) {  // global
+      switch (tag) {
+        case 0x0:
+          global.usagePage = static_cast<uint16_t>(data);
+          break;
+        case 0x1:
+          global.logicalMinRaw = data;
+          global.logicalMinBytes = dataBytes;
+          break;
+        case 0x2:
+          global.logicalMaxRaw = data;
+          global.logicalMaxBytes = dataBytes;
+          break;
+        case 0x3:
+        case 0x4:
+        case 0x5:
+        case 0x6:
+          break;  // physical range, unit: not needed
+        case 0x7:
+          global.reportSize = data;
+          break;
+        case 0x8:
+          if (data == 0 || data > 255) {
+            error = at(itemStart, "report ID " + std::to_string(data) + " out of 1..255");
+            return false;
+          }
+          if (haveFieldWithoutId) {
+            error = at(itemStart, "Report ID after fields without a report ID");
+            return false;
+          }
+          global.reportId = static_cast<uint8_t>(data);
+          out.usesReportIds = true;
+          break;
+        case 0x9:
+          global.reportCount = data;
+          break;
+        case 0xA:
+          if (pushed.size() >= kMaxPushDepth) {
+            error = at(itemStart, "Push nested deeper than " + std::to_string(kMaxPushDepth));
+            return false;
+          }
+          pushed.push_back(global);
+          break;
+        case 0xB:
+          if (pushed.empty()) {
+            error = at(itemStart, "Pop without Push");
+            return false;
+          }
+          global = pushed.back();
+          pushed.pop_back();
+          break;
+        default:
+          error = at(itemStart, "unknown global item tag " + std::to_string(tag));
+          return false;
+      }
+    } else if (type == 2) {  // local
+      const LocalUsage usage{data, dataBytes};
+      if (tag == 0x0) {
+        if (local.usages.size() >= kMaxUsageRange) {
+          error = at(itemStart, "more than " + std::to_string(kMaxUsageRange) + " usages before one main item");
+          return false;
+        }
+        local.usages.push_back(usage);
+      } else if (tag == 0x1) {
+        local.usageMin = usage;
+        local.haveMin = true;
+      } else if (tag == 0x2) {
+        local.usageMax = usage;
+        local.haveMax = true;
+      }
+      // Designators, strings and delimiters do not matter for decoding.
+    } else {
+      error = at(itemStart, "reserved item type");
+      return false;
+    }
+  }
+  if (!openCollections.empty()) {
+    error = "HID report descriptor: " + std::to_string(openCollections.size()) + " collection(s) not closed at the end";
+    return false;
+  }
+  return true;
+}
+
+bool extractHidBits(const uint8_t* data, size_t sizeBytes, uint32_t bitOffset, uint32_t bitSize, bool isSigned,
+                    int64_t& value) {
+  if (bitSize == 0 || bitSize > 32) return false;
+  if (uint64_t(bitOffset) + bitSize > uint64_t(sizeBytes) * 8) return false;
+  uint64_t raw = 0;
+  for (uint32_t i = 0; i < bitSize; ++i) {
+    const uint32_t bit = bitOffset + i;
+    raw |= uint64_t((data[bit / 8] >> (bit % 8)) & 1u) << i;
+  }
+  if (isSigned && (raw >> (bitSize - 1)) & 1u) {
+    value = static_cast<int64_t>(raw) - (int64_t(1) << bitSize);
+  } else {
+    value = static_cast<int64_t>(raw);
+  }
+  return true;
+}
+
+}  // namespace kf

@@ -1,0 +1,177 @@
+// The real EvdevApi: Linux input event nodes. Enumeration reads sysfs (names, ids, the REL
+// capability bits), which needs no permission on the nodes themselves.
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "mouse/MouseIo.hpp"
+
+#ifdef __linux__
+#include <dirent.h>
+#include <fcntl.h>
+#include <linux/input.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <ctime>
+#endif
+
+namespace kf {
+
+#ifdef __linux__
+namespace {
+
+std::string readLine(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+uint16_t readHex(const std::string& path) {
+  return static_cast<uint16_t>(std::strtoul(readLine(path).c_str(), nullptr, 16));
+}
+
+// sysfs capability bitmaps: hex words, most significant first; bit 0 of the last word is code 0.
+bool hasRelXY(const std::string& bitmap) {
+  std::istringstream words(bitmap);
+  std::string word, last;
+  while (words >> word) last = word;
+  if (last.empty()) return false;
+  const unsigned long bits = std::strtoul(last.c_str(), nullptr, 16);
+  return (bits & (1ul << REL_X)) && (bits & (1ul << REL_Y));
+}
+
+class RealEvdevHandle : public EvdevHandle {
+ public:
+  explicit RealEvdevHandle(int fd) : fd_(fd) {}
+  ~RealEvdevHandle() override { ::close(fd_); }
+
+  bool setMonotonicClock(std::string& error) override {
+    int clockId = CLOCK_MONOTONIC;
+    if (::ioctl(fd_, EVIOCSCLOCKID, &clockId) == 0) return true;
+    error = std::string("EVIOCSCLOCKID: ") + std::strerror(errno);
+    return false;
+  }
+  bool grab(bool on, std::string& error) override {
+    if (::ioctl(fd_, EVIOCGRAB, on ? 1 : 0) == 0) return true;
+    error = std::string("EVIOCGRAB: ") + std::strerror(errno);
+    return false;
+  }
+  std::string name() override {
+    char buffer[256] = {};
+    if (::ioctl(fd_, EVIOCGNAME(sizeof(buffer) - 1), buffer) < 0) return {};
+    return buffer;
+  }
+  bool id(uint16_t& vendorId, uint16_t& productId) override {
+    input_id ids{};
+    if (::ioctl(fd_, EVIOCGID, &ids) < 0) return false;
+    vendorId = ids.vendor;
+    productId = ids.product;
+    return true;
+  }
+  int read(EvdevEvent* out, int capacity, int timeoutMs, int* errnoOut) override {
+    pollfd waitFor{fd_, POLLIN, 0};
+    const int ready = ::poll(&waitFor, 1, timeoutMs);
+    if (ready == 0 || (ready < 0 && errno == EINTR)) return 0;
+    if (ready < 0 || (waitFor.revents & (POLLERR | POLLHUP | POLLNVAL))) {
+      *errnoOut = ready < 0 ? errno : ENODEV;
+      return -1;
+    }
+    input_event events[64];
+    const int want = capacity < 64 ? capacity : 64;
+    const ssize_t bytes = ::read(fd_, events, sizeof(input_event) * static_cast<size_t>(want));
+    if (bytes < 0) {
+      if (errno == EAGAIN || errno == EINTR) return 0;
+      *errnoOut = errno;
+      return -1;
+    }
+    const int count = static_cast<int>(bytes / static_cast<ssize_t>(sizeof(input_event)));
+    for (int i = 0; i < count; ++i) {
+      out[i].timeS = events[i].input_event_sec + events[i].input_event_usec * 1e-6;
+      out[i].type = events[i].type;
+      out[i].code = events[i].code;
+      out[i].value = events[i].value;
+    }
+    return count;
+  }
+
+ private:
+  int fd_;
+};
+
+class RealEvdevApi : public EvdevApi {
+ public:
+  bool enumerateMice(std::vector<MouseInfo>& out, std::string& error) override {
+    out.clear();
+    DIR* dir = ::opendir("/sys/class/input");
+    if (dir == nullptr) {
+      error = std::string("/sys/class/input: ") + std::strerror(errno);
+      return errno == ENOENT;  // no input subsystem: no mice, not an error
+    }
+    while (const dirent* entry = ::readdir(dir)) {
+      const std::string node = entry->d_name;
+      if (node.rfind("event", 0) != 0) continue;
+      const std::string sys = "/sys/class/input/" + node + "/device/";
+      if (!hasRelXY(readLine(sys + "capabilities/rel"))) continue;
+      MouseInfo info;
+      info.path = "/dev/input/" + node;
+      info.product = readLine(sys + "name");
+      info.vendorId = readHex(sys + "id/vendor");
+      info.productId = readHex(sys + "id/product");
+      info.serial = readLine(sys + "uniq");
+      out.push_back(std::move(info));
+    }
+    ::closedir(dir);
+    return true;
+  }
+
+  std::unique_ptr<EvdevHandle> open(const std::string& path, std::string& error, OpenFailure& why) override {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+      const int code = errno;
+      why = code == EACCES || code == EPERM    ? OpenFailure::kPermission
+            : code == ENOENT || code == ENODEV ? OpenFailure::kNotFound
+                                               : OpenFailure::kOther;
+      error = why == OpenFailure::kPermission ? permissionFix(path) : path + ": " + std::strerror(code);
+      return nullptr;
+    }
+    why = OpenFailure::kNone;
+    return std::make_unique<RealEvdevHandle>(fd);
+  }
+};
+
+}  // namespace
+
+std::shared_ptr<EvdevApi> realEvdevApi() {
+  static std::shared_ptr<EvdevApi> api = std::make_shared<RealEvdevApi>();
+  return api;
+}
+
+#else
+
+namespace {
+class NoEvdevApi : public EvdevApi {
+ public:
+  bool enumerateMice(std::vector<MouseInfo>& out, std::string&) override {
+    out.clear();
+    return true;
+  }
+  std::unique_ptr<EvdevHandle> open(const std::string&, std::string& error, OpenFailure& why) override {
+    error = "evdev is Linux only; use the hidapi backend";
+    why = OpenFailure::kOther;
+    return nullptr;
+  }
+};
+}  // namespace
+
+std::shared_ptr<EvdevApi> realEvdevApi() {
+  static std::shared_ptr<EvdevApi> api = std::make_shared<NoEvdevApi>();
+  return api;
+}
+
+#endif
+
+}  // namespace kf

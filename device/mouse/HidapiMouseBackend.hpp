@@ -1,0 +1,44 @@
+// HidapiMouseBackend: any USB/Bluetooth HID mouse through hidapi. Reports are decoded through
+// the device's own report descriptor (never the boot layout) and stamped on arrival with the
+// monotonic clock. The kernel keeps at most 64 reports per hidraw reader and drops new ones
+// when full, so a read that finds a full queue counts a loss and flags the next report.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "hid/HidMouseDecoder.hpp"
+#include "mouse/RealMouseBackend.hpp"
+
+namespace kf {
+
+class HidapiMouseBackend : public RealMouseBackend {
+ public:
+  static constexpr int kKernelQueueReports = 64;  // hidraw's HIDRAW_BUFFER_SIZE
+
+  // Enumerates, selects (MouseSelect's `which`), opens, reads the descriptor, starts the
+  // reader. Null with a message (and why) on failure.
+  static std::unique_ptr<HidapiMouseBackend> open(std::shared_ptr<HidApi> api, const std::string& which,
+                                                  std::string& error, OpenFailure* why = nullptr);
+  ~HidapiMouseBackend() override { stop(); }
+  std::string kindName() const override { return "hidapi"; }
+
+ protected:
+  int readSome(int timeoutMs) override;
+  void closeHandle() override { handle_.reset(); }
+  bool reopenHandle(std::string& error) override;
+
+ private:
+  explicit HidapiMouseBackend(std::shared_ptr<HidApi> api) : api_(std::move(api)) {}
+  bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) override;
+  void take(const uint8_t* bytes, int size, double arrivalS);
+
+  std::shared_ptr<HidApi> api_;
+  std::unique_ptr<HidHandle> handle_;
+  HidMouseDecoder decoder_;
+  int64_t xMin_ = 0, xMax_ = 0, yMin_ = 0, yMax_ = 0;  // logical limits: a delta there saturated
+  bool afterLoss_ = false;
+  MouseInfo current_;  // the reader thread's (and open's) own
+};
+
+}  // namespace kf

@@ -1,0 +1,101 @@
+#include "mouse/MouseSelect.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+
+namespace kf {
+
+namespace {
+
+bool allDigits(const std::string& text) {
+  if (text.empty()) return false;
+  for (char c : text)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  return true;
+}
+
+bool parseHexId(const std::string& text, uint16_t& out) {
+  if (text.empty() || text.size() > 4) return false;
+  char* end = nullptr;
+  const unsigned long value = std::strtoul(text.c_str(), &end, 16);
+  if (*end != '\0') return false;
+  out = static_cast<uint16_t>(value);
+  return true;
+}
+
+std::string listOf(const std::vector<MouseInfo>& mice) {
+  if (mice.empty()) return " (no mouse found)";
+  std::string out;
+  for (size_t i = 0; i < mice.size(); ++i) out += "\n  " + describeMouse(static_cast<int>(i), mice[i]);
+  return out;
+}
+
+}  // namespace
+
+bool selectMouse(const std::vector<MouseInfo>& mice, const std::string& which, MouseInfo& out, std::string& error) {
+  if (which.empty() || which == "first") {
+    if (mice.empty()) {
+      error = "no mouse found: plug one in (and see the udev rule if it is there but not listed)";
+      return false;
+    }
+    out = mice.front();
+    return true;
+  }
+  if (allDigits(which)) {
+    const size_t index = std::strtoul(which.c_str(), nullptr, 10);
+    if (index < mice.size()) {
+      out = mice[index];
+      return true;
+    }
+    error = "no mouse " + which + "; there are:" + listOf(mice);
+    return false;
+  }
+  if (which[0] == '/') {
+    for (const MouseInfo& info : mice)
+      if (info.path == which) {
+        out = info;
+        return true;
+      }
+    out = MouseInfo{};
+    out.path = which;
+    return true;
+  }
+  const size_t colon = which.find(':');
+  const size_t second = colon == std::string::npos ? std::string::npos : which.find(':', colon + 1);
+  uint16_t vendorId = 0, productId = 0;
+  if (colon == std::string::npos || !parseHexId(which.substr(0, colon), vendorId) ||
+      !parseHexId(which.substr(colon + 1, second == std::string::npos ? std::string::npos : second - colon - 1),
+                  productId)) {
+    error =
+        "cannot read the mouse selector '" + which + "': give an index, a device path, or VVVV:PPPP[:serial] in hex";
+    return false;
+  }
+  const std::string serial = second == std::string::npos ? std::string() : which.substr(second + 1);
+  for (const MouseInfo& info : mice)
+    if (info.vendorId == vendorId && info.productId == productId && (serial.empty() || info.serial == serial)) {
+      out = info;
+      return true;
+    }
+  error = "no mouse " + which + "; there are:" + listOf(mice);
+  return false;
+}
+
+std::string reselector(const MouseInfo& info) {
+  if (info.vendorId == 0 && info.productId == 0) return info.path;
+  char ids[16];
+  std::snprintf(ids, sizeof(ids), "%04x:%04x", info.vendorId, info.productId);
+  return info.serial.empty() ? std::string(ids) : std::string(ids) + ":" + info.serial;
+}
+
+std::string describeMouse(int index, const MouseInfo& info) {
+  char ids[16];
+  std::snprintf(ids, sizeof(ids), "%04x:%04x", info.vendorId, info.productId);
+  std::string out = std::to_string(index) + ": " + info.path + " " + ids + " ";
+  out += info.manufacturer.empty() ? info.product : info.manufacturer + " " + info.product;
+  if (!info.serial.empty()) out += " (serial " + info.serial + ")";
+  if (info.interfaceNumber >= 0) out += " interface " + std::to_string(info.interfaceNumber);
+  return out;
+}
+
+}  // namespace kf

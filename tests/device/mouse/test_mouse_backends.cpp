@@ -1,0 +1,455 @@
+// The hidapi and evdev mouse backends against fakes that replay a real mouse's hid-recorder
+// file in real time (FakeMouseIo.hpp), and the real hidapi/evdev enumeration on this machine.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <thread>
+
+#include "FakeMouseIo.hpp"
+#include "MouseDeviceFactory.hpp"
+#include "mouse/EvdevMouseBackend.hpp"
+#include "mouse/HidapiMouseBackend.hpp"
+#include "mouse/MouseSelect.hpp"
+#include "recordings/ReplayBackend.hpp"
+
+using namespace kf;
+using kf::test::FakeEvdevApi;
+using kf::test::FakeEvdevHandle;
+using kf::test::FakeHidApi;
+using kf::test::FakeMouseScript;
+
+namespace {
+
+HidRecording genius() {
+  HidRecording recording;
+  std::string error;
+  REQUIRE(readHidRecorderFile(KF_HID_RECORDING, recording, error));
+  return recording;
+}
+
+// The Genius recording, played with a kernel queue that loses nothing: for the tests that are
+// not about loss (see FakeMouseScript).
+FakeMouseScript geniusScript() {
+  FakeMouseScript script;
+  script.recording = genius();
+  script.kernelQueue = 4096;
+  return script;
+}
+
+// Independent of the decoder: the Genius mouse's report 1 is ID, buttons, int16 X and Y.
+struct Sums {
+  long long x = 0, y = 0;
+  int reports = 0;
+};
+Sums sumOf(const std::vector<std::vector<uint8_t>>& reports) {
+  Sums s;
+  for (const auto& b : reports) {
+    if (b.size() < 6 || b[0] != 1) continue;
+    s.x += static_cast<int16_t>(b[2] | b[3] << 8);
+    s.y += static_cast<int16_t>(b[4] | b[5] << 8);
+    ++s.reports;
+  }
+  return s;
+}
+Sums sumOfPlayed(const kf::test::FakeTimeline& timeline) {
+  std::vector<std::vector<uint8_t>> bytes;
+  for (const auto& due : timeline.played()) bytes.push_back(due.bytes);
+  return sumOf(bytes);
+}
+
+// Polls like the device thread (every 1 ms) until the timeline is `untilS` past plug-in.
+std::vector<MouseReport> collect(MouseBackend& backend, const kf::test::FakeTimeline& timeline, double untilS) {
+  std::vector<MouseReport> all;
+  MouseReport buffer[64];
+  while (timeline.nowSincePlugS() < untilS) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    int n = 0;
+    while ((n = backend.pollReports(0.0, buffer, 64)) > 0) all.insert(all.end(), buffer, buffer + n);
+  }
+  return all;
+}
+
+// Everything the fake plays, with room for a late reader on a loaded machine.
+std::vector<MouseReport> collectAll(MouseBackend& backend, const kf::test::FakeTimeline& timeline) {
+  return collect(backend, timeline, timeline.played().back().sincePlugS + 0.3);
+}
+
+Sums sumOf(const std::vector<MouseReport>& reports) {
+  Sums s;
+  for (const MouseReport& r : reports) s.x += r.dxCounts, s.y += r.dyCounts, ++s.reports;
+  return s;
+}
+
+double quantile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  return values[static_cast<size_t>(q * (values.size() - 1))];
+}
+
+}  // namespace
+
+TEST_CASE("hidapi backend: a real mouse's whole recording, in real time, sums to its counts", "[mouse][hid]") {
+  FakeMouseScript script = geniusScript();
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  CHECK(backend->info().vendorId == 0x0458);
+  const auto reports = collectAll(*backend, *api->timeline);
+  const Sums expected = sumOfPlayed(*api->timeline);
+  const Sums got = sumOf(reports);
+  CHECK(expected.reports == 738);
+  CHECK(got.reports == expected.reports);
+  CHECK(got.x == expected.x);  // -67 and -40 counts (HidRecordingTest decodes the same by hand)
+  CHECK(got.y == expected.y);
+  CHECK(got.x == -67);
+  CHECK(got.y == -40);
+  const MouseCounters c = backend->counters();
+  CHECK(c.state == MouseState::kRunning);
+  CHECK(c.lossEvents == 0);
+  CHECK(c.malformed == 0);
+  CHECK(c.saturated == 0);
+  // The file's 2 ms intervals (a 500 Hz mouse), measured from the arrival stamps: as exact as
+  // the reader thread's wake-ups on this (loaded) machine allow (the evdev test checks the rate
+  // exactly), and from exactly the stamps passed on.
+  ReportRateEstimator fromStamps;
+  for (const MouseReport& r : reports) fromStamps.addReport(r.deviceTimeS);
+  CHECK(c.measuredRateHz == fromStamps.rateHz());
+  CHECK(c.measuredRateHz > 250);
+  CHECK(c.measuredRateHz < 1000);
+}
+
+TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 7.0;
+  // +-0.8 ms, deterministic (the recording's intervals are >= 1.9 ms, so order holds).
+  for (int i = 0; i < 97; ++i) script.jitterS.push_back(0.0008 * std::sin(i * 2.3999));
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  const auto& played = api->timeline->played();
+  REQUIRE(reports.size() == played.size());
+  // stamp = due time on the same clock + the reader's wake-up latency (>= 0, small).
+  const double offsetS = api->timeline->plugS() - backend->originS();
+  std::vector<double> lateS;
+  for (size_t i = 0; i < reports.size(); ++i)
+    lateS.push_back(reports[i].deviceTimeS - (played[i].sincePlugS + offsetS));
+  CHECK(*std::min_element(lateS.begin(), lateS.end()) > -20e-6);  // never before it was due
+  INFO("median late " << quantile(lateS, 0.5) * 1e3 << " ms, p95 " << quantile(lateS, 0.95) * 1e3 << " ms");
+  // A thread wake-up: ~0.1 ms on a quiet machine; with other builds on both cores the tail
+  // (the reader descheduled) reaches tens of ms, so only the bulk is bounded.
+  CHECK(quantile(lateS, 0.5) < 2e-3);
+  CHECK(quantile(lateS, 0.75) < 5e-3);
+  for (size_t i = 1; i < reports.size(); ++i) CHECK(reports[i].deviceTimeS >= reports[i - 1].deviceTimeS);
+}
+
+TEST_CASE("evdev backend: kernel timestamps come through exactly, jitter and all", "[mouse][evdev]") {
+  FakeMouseScript script = geniusScript();
+  for (int i = 0; i < 97; ++i) script.jitterS.push_back(0.0008 * std::sin(i * 2.3999));
+  auto api = std::make_shared<FakeEvdevApi>(script);
+  std::string error;
+  auto backend = EvdevMouseBackend::open(api, "", true, error);
+  REQUIRE(backend);
+  CHECK(backend->hasKernelTimestamps());
+  CHECK(api->lastHandle->grabbed);
+  CHECK(backend->info().product == "Genius Gila Gaming Mouse");
+  const auto& played = api->timeline->played();
+  const auto reports = collectAll(*backend, *api->timeline);
+  // Every report with motion or a button change is one evdev packet.
+  std::vector<const kf::test::FakeTimeline::Due*> packets;
+  uint8_t buttons = 0;
+  for (const auto& due : played) {
+    const auto& b = due.bytes;
+    if ((b[2] | b[3] | b[4] | b[5]) != 0 || b[1] != buttons) packets.push_back(&due);
+    buttons = b[1];
+  }
+  REQUIRE(reports.size() == packets.size());
+  const Sums got = sumOf(reports);
+  CHECK(got.x == -67);
+  CHECK(got.y == -40);
+  double worstS = 0;
+  for (size_t i = 0; i < reports.size(); ++i) {
+    const double kernelS = FakeEvdevHandle::stampS(*api->timeline, packets[i]->sincePlugS) - backend->originS();
+    worstS = std::max(worstS, std::fabs(reports[i].deviceTimeS - kernelS));
+  }
+  CHECK(worstS < 1e-9);  // the kernel's stamp, not the arrival
+  CHECK(backend->counters().lossEvents == 0);
+}
+
+TEST_CASE("a still mouse is silent, not a fault", "[mouse]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 1.95;  // 2.0 .. 3.0 s of the recording: two reports in a second
+  script.endS = 2.95;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  CHECK(reports.size() == api->timeline->played().size());
+  const MouseCounters c = backend->counters();
+  CHECK(c.state == MouseState::kRunning);
+  CHECK(c.lossEvents == 0);
+  CHECK(backend->lastError().empty());
+}
+
+TEST_CASE("hidapi backend: short reads are counted and skipped, the rest decode", "[mouse][hid]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 6.6;
+  script.shortReportEvery = 10;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  const auto& played = api->timeline->played();
+  std::vector<std::vector<uint8_t>> intact;
+  for (size_t i = 0; i < played.size(); ++i)
+    if ((i + 1) % 10 != 0) intact.push_back(played[i].bytes);
+  const Sums expected = sumOf(intact);
+  CHECK(backend->counters().malformed == played.size() / 10);
+  CHECK(sumOf(reports).reports == expected.reports);
+  CHECK(sumOf(reports).x == expected.x);
+  CHECK(sumOf(reports).y == expected.y);
+}
+
+TEST_CASE("evdev backend: packets split between reads are put back together", "[mouse][evdev]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 6.6;
+  script.maxEventsPerRead = 1;
+  auto api = std::make_shared<FakeEvdevApi>(script);
+  std::string error;
+  auto backend = EvdevMouseBackend::open(api, "", false, error);
+  REQUIRE(backend);
+  CHECK_FALSE(api->lastHandle->grabbed);
+  const auto reports = collectAll(*backend, *api->timeline);
+  const Sums expected = sumOfPlayed(*api->timeline);
+  CHECK(sumOf(reports).x == expected.x);
+  CHECK(sumOf(reports).y == expected.y);
+  // Kernel stamps of the file's 2 ms polls: the rate exactly, whatever the reader's wake-ups.
+  CHECK(backend->counters().measuredRateHz == Approx(500).epsilon(0.03));
+}
+
+TEST_CASE("hidapi backend: a full kernel queue is counted as a loss and flags the next report", "[mouse][hid]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 7.0;
+  script.kernelQueue = 64;  // the kernel's own: this test is about loss
+  script.stallAtS = 0.72;   // the reader is held 300 ms: ~110 reports come, 64 fit
+  script.stallForS = 0.3;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  const size_t played = api->timeline->played().size();
+  CHECK(reports.size() < played);
+  CHECK(backend->counters().lossEvents == 1);
+  const auto flagged =
+      std::count_if(reports.begin(), reports.end(), [](const MouseReport& r) { return r.flags & kAfterLoss; });
+  CHECK(flagged == 1);
+}
+
+TEST_CASE("evdev backend: SYN_DROPPED is counted, the broken packet dropped, the next flagged", "[mouse][evdev]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 7.0;
+  script.kernelQueue = 64;  // the kernel's own: this test is about loss
+  script.stallAtS = 0.72;
+  script.stallForS = 0.15;  // ~55 reports of ~3 events: the 64-event buffer overflows
+  auto api = std::make_shared<FakeEvdevApi>(script);
+  std::string error;
+  auto backend = EvdevMouseBackend::open(api, "", false, error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  CHECK(api->lastHandle->syncDropped() >= 1);
+  CHECK(backend->counters().lossEvents == static_cast<uint64_t>(api->lastHandle->syncDropped()));
+  const auto flagged =
+      std::count_if(reports.begin(), reports.end(), [](const MouseReport& r) { return r.flags & kAfterLoss; });
+  CHECK(flagged >= 1);
+  CHECK(flagged <= api->lastHandle->syncDropped());
+}
+
+TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on request resumes", "[mouse]", FakeHidApi,
+                   FakeEvdevApi) {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.unplugAtS = 0.3;
+  script.replugAtS = 0.6;
+  auto api = std::make_shared<TestType>(script);
+  std::string error;
+  std::unique_ptr<RealMouseBackend> backend;
+  if constexpr (std::is_same_v<TestType, FakeHidApi>)
+    backend = HidapiMouseBackend::open(api, "", error);
+  else
+    backend = EvdevMouseBackend::open(api, "", false, error);
+  REQUIRE(backend);
+  const auto before = collect(*backend, *api->timeline, 0.3);
+  while (backend->state() == MouseState::kRunning && api->timeline->nowSincePlugS() < 1.0)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  const double seenAfterS = api->timeline->nowSincePlugS() - 0.3;
+  CHECK(backend->state() == MouseState::kUnplugged);
+  CHECK(seenAfterS < 0.1);
+  CHECK(backend->statusLine().find("UNPLUGGED") != std::string::npos);
+  CHECK_FALSE(backend->lastError().empty());
+  CHECK(collect(*backend, *api->timeline, 0.65).empty());  // position holds: nothing comes
+
+  backend->requestReopen();       // replugged at 0.6
+  for (int i = 0; i < 50; ++i) {  // status read while the reader re-opens (TSan build: no race)
+    CHECK_FALSE(backend->statusLine().empty());
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto after = collect(*backend, *api->timeline, 1.0);
+  CHECK(backend->state() == MouseState::kRunning);
+  CHECK(backend->counters().unplugs == 1);
+  CHECK(backend->counters().reopens == 1);
+  REQUIRE_FALSE(after.empty());
+  CHECK(after.front().flags & kAfterLoss);
+  CHECK(before.size() > 10);
+}
+
+TEMPLATE_TEST_CASE("permission denied names the node and the fix, and opens nothing", "[mouse]", FakeHidApi,
+                   FakeEvdevApi) {
+  FakeMouseScript script = geniusScript();
+  script.denyAccess = true;
+  auto api = std::make_shared<TestType>(script);
+  std::string error;
+  OpenFailure why = OpenFailure::kNone;
+  std::unique_ptr<RealMouseBackend> backend;
+  if constexpr (std::is_same_v<TestType, FakeHidApi>)
+    backend = HidapiMouseBackend::open(api, "", error, &why);
+  else
+    backend = EvdevMouseBackend::open(api, "", false, error, &why);
+  CHECK_FALSE(backend);
+  CHECK(why == OpenFailure::kPermission);
+  CHECK(error.find(std::is_same_v<TestType, FakeHidApi> ? "/dev/hidraw7" : "/dev/input/event9") != std::string::npos);
+  CHECK(error.find("70-kineticfriction.rules") != std::string::npos);
+}
+
+TEST_CASE("saturated deltas (at the field's logical limit) are flagged and counted", "[mouse][hid]") {
+  FakeMouseScript script = geniusScript();
+  script.recording.events.clear();
+  auto report = [](double t, int16_t dx) {
+    return HidRecordedEvent{t,
+                            {1, 0, static_cast<uint8_t>(dx & 0xff), static_cast<uint8_t>(dx >> 8 & 0xff), 0, 0, 0, 0}};
+  };
+  script.recording.events = {report(0.02, 32767), report(0.04, -32767), report(0.06, 5)};
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  REQUIRE(reports.size() == 3);
+  CHECK(reports[0].flags & kSaturated);
+  CHECK(reports[1].flags & kSaturated);
+  CHECK_FALSE(reports[2].flags & kSaturated);
+  CHECK(backend->counters().saturated == 2);
+}
+
+TEST_CASE("a mouse device: reports reach the audio side's queue, status names the mouse", "[mouse]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 6.5;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  MouseOpenOptions options;
+  options.which = "0458:0138";
+  auto device = openMouseDevice(options, DeviceSpec{}, error, nullptr, api);
+  REQUIRE(device);
+  CHECK_FALSE(device->isLockstep());
+  std::vector<MouseReport> got;
+  MouseReport buffer[64];
+  while (api->timeline->nowSincePlugS() < 0.8) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    const int n = device->popReports(buffer, 64);
+    got.insert(got.end(), buffer, buffer + n);
+  }
+  const Sums expected = sumOfPlayed(*api->timeline);
+  CHECK(sumOf(got).x == expected.x);
+  CHECK(sumOf(got).y == expected.y);
+  CHECK(device->telemetry().reports == static_cast<uint64_t>(expected.reports));
+  CHECK(device->mouseBackend().statusLine().find("hidapi mouse /dev/hidraw7") != std::string::npos);
+}
+
+TEST_CASE("mouse selectors: first, index, path, VID:PID(:serial), and clear errors", "[mouse]") {
+  std::vector<MouseInfo> mice(2);
+  mice[0].path = "/dev/hidraw1", mice[0].vendorId = 0x046d, mice[0].productId = 0xc077;
+  mice[1].path = "/dev/hidraw4", mice[1].vendorId = 0x0458, mice[1].productId = 0x0138, mice[1].serial = "A1";
+  MouseInfo out;
+  std::string error;
+  REQUIRE(selectMouse(mice, "", out, error));
+  CHECK(out.path == "/dev/hidraw1");
+  REQUIRE(selectMouse(mice, "1", out, error));
+  CHECK(out.path == "/dev/hidraw4");
+  REQUIRE(selectMouse(mice, "458:138", out, error));
+  CHECK(out.path == "/dev/hidraw4");
+  REQUIRE(selectMouse(mice, "0458:0138:A1", out, error));
+  CHECK_FALSE(selectMouse(mice, "0458:0138:B2", out, error));
+  CHECK(error.find("/dev/hidraw4") != std::string::npos);  // lists what there is
+  CHECK_FALSE(selectMouse(mice, "2", out, error));
+  CHECK_FALSE(selectMouse(mice, "mouse", out, error));
+  REQUIRE(selectMouse(mice, "/dev/hidraw9", out, error));  // not listed, still tried
+  CHECK(out.path == "/dev/hidraw9");
+  CHECK_FALSE(selectMouse({}, "", out, error));
+  CHECK(error.find("no mouse found") != std::string::npos);
+  CHECK(reselector(mice[1]) == "0458:0138:A1");
+}
+
+TEST_CASE("the real hidapi and evdev enumerate this machine and cope with finding no mouse", "[mouse][real]") {
+  for (MouseBackendKind kind : {MouseBackendKind::kHidapi, MouseBackendKind::kEvdev}) {
+    std::vector<std::string> lines;
+    std::string error;
+    REQUIRE(listMice(kind, lines, error));
+    MouseOpenOptions options;
+    options.kind = kind;
+    if (lines.empty()) {
+      // CI has no mouse: opening "the first" fails with a message, never a simulator.
+      OpenFailure why = OpenFailure::kNone;
+      CHECK_FALSE(openMouseDevice(options, DeviceSpec{}, error, &why));
+      CHECK(error.find("no mouse found") != std::string::npos);
+    }
+    WARN((kind == MouseBackendKind::kHidapi ? "hidapi" : "evdev") << " finds " << lines.size() << " mice");
+  }
+  // A node that is not there: not found, named.
+  std::string error;
+  OpenFailure why = OpenFailure::kNone;
+  MouseOpenOptions options;
+  options.which = "/dev/hidraw-kf-none";
+  CHECK_FALSE(openMouseDevice(options, DeviceSpec{}, error, &why));
+  CHECK(why == OpenFailure::kNotFound);
+  CHECK(error.find("/dev/hidraw-kf-none") != std::string::npos);
+}
+
+TEST_CASE("a real mouse's session is recorded like any device's and replays to the same sums", "[mouse]") {
+  FakeMouseScript script = geniusScript();
+  script.startS = 6.0;
+  script.endS = 6.5;
+  auto api = std::make_shared<FakeHidApi>(script);
+  std::string error;
+  DeviceSpec spec;
+  spec.countMm = 0.0212;
+  auto device = openMouseDevice(MouseOpenOptions{}, spec, error, nullptr, api);
+  REQUIRE(device);
+  const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
+  REQUIRE(device->startRecording(path, error));
+  MouseReport buffer[64];
+  while (api->timeline->nowSincePlugS() < 0.8) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    device->popReports(buffer, 64);
+  }
+  device->close();
+
+  DeviceSpec replaySpec;
+  std::vector<TimedReport> recorded;
+  REQUIRE(loadReplayReports(path, replaySpec, recorded, error));
+  CHECK(replaySpec.countMm == 0.0212);  // the session carries the mouse's spec
+  std::vector<MouseReport> reports;
+  for (const TimedReport& t : recorded) reports.push_back(t.report);
+  const Sums expected = sumOfPlayed(*api->timeline);
+  CHECK(sumOf(reports).reports == expected.reports);
+  CHECK(sumOf(reports).x == expected.x);
+  CHECK(sumOf(reports).y == expected.y);
+}

@@ -1,0 +1,128 @@
+// The plugin's ways out: when scsynth exits (/quit: the exit hook in host/DeviceSlots.cpp)
+// or is ended by a signal (host/ExitSafety.cpp), every device still in a slot, and every
+// device taken out of its slot whose close has not run yet (a kfClose followed at once by /quit
+// or a signal), has its magnet driven off. Run in a child process, whose exit runs the hook;
+// the magnet's drive-offs are written to a pipe.
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "DeviceSlots.hpp"
+#include "ExitSafety.hpp"
+#include "recordings/ReplayBackend.hpp"
+
+namespace {
+
+class PipeSink : public kf::ForceBackend {
+ public:
+  PipeSink(int fd, char name) : fd_(fd), name_(name) {}
+  void commandForce(double, float) override {}
+  void driveOff() override { (void)!write(fd_, &name_, 1); }
+
+ private:
+  int fd_;
+  char name_;
+};
+
+kf::Device* newDevice(int fd, char name) {
+  auto device = new kf::Device(kf::DeviceSpec{}, std::make_shared<kf::ReplayBackend>(std::vector<kf::TimedReport>{}),
+                               std::make_shared<PipeSink>(fd, name), false);
+  device->start();
+  return device;
+}
+
+// Runs `child` in a forked process that writes drive-offs to a pipe; returns what it wrote and
+// the child's wait status.
+template <typename Child>
+std::pair<std::string, int> offsWrittenBy(Child child) {
+  int fds[2];
+  REQUIRE(pipe(fds) == 0);
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    close(fds[0]);
+    child(fds[1]);
+    std::_Exit(99);  // not reached: the child ends by exit or by its signal
+  }
+  close(fds[1]);
+  std::string offs;
+  char buffer[16];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) offs.append(buffer, static_cast<size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  REQUIRE(waitpid(pid, &status, 0) == pid);
+  return {offs, status};
+}
+
+}  // namespace
+
+TEST_CASE("server exit closes open devices and those whose close has not finished", "[safety]") {
+  const std::string recording = "kf-exit-hook-" + std::to_string(getpid()) + ".txt";
+  const auto [offs, status] = offsWrittenBy([&recording](int fd) {
+    kf::Device* recorded = newDevice(fd, 'a');
+    std::string error;
+    if (!recorded->startRecording(recording, error)) std::_Exit(98);
+    kf::sc::exchangeSlot(5, recorded);  // open at exit, recording: the hook closes the file too
+    kf::sc::exchangeSlot(6, newDevice(fd, 'b'));
+    kf::sc::exchangeSlot(6, nullptr);  // kfClose's RT stage ran, its NRT stage (delete) did not
+    kf::sc::exchangeSlot(7, newDevice(fd, 'c'));
+    kf::sc::deleteRetired(kf::sc::exchangeSlot(7, nullptr));  // a close that finished: 'c' now
+    std::exit(0);                                             // static destructors: the exit hook
+  });
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  // Each magnet went off exactly once: 'c' at its close, 'a' and 'b' by the exit hook.
+  CHECK(offs.size() == 3);
+  CHECK(offs.find('a') != std::string::npos);
+  CHECK(offs.find('b') != std::string::npos);
+  CHECK(offs.find('c') == 0);
+  // The recording was closed by the hook after the file registry's own statics could be gone
+  // (a use after free there, found by AddressSanitizer in scsynth): it ends with the off record.
+  std::ifstream file(recording);
+  std::string line, last;
+  while (std::getline(file, line))
+    if (!line.empty()) last = line;
+  CHECK(last.rfind("O ", 0) == 0);
+  std::remove(recording.c_str());
+}
+
+TEST_CASE("a signal drives off open devices and those whose close has not finished", "[safety]") {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's own SIGSEGV handler, which ours hands the signal on to, reports and aborts.
+  const std::initializer_list<int> signals{SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGABRT};
+#else
+  const std::initializer_list<int> signals{SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGABRT, SIGSEGV};
+#endif
+  for (const int signalNumber : signals) {
+    CAPTURE(signalNumber);
+    const auto [offs, status] = offsWrittenBy([signalNumber](int fd) {
+      // No core file from the crash signals (their default action dumps core).
+      const rlimit noCore{0, 0};
+      setrlimit(RLIMIT_CORE, &noCore);
+      // As in scsynth: nothing handles these before the plugin (Catch2 installs handlers of its
+      // own, which ours would hand the signal on to).
+      for (const int other : {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGABRT, SIGSEGV}) signal(other, SIG_DFL);
+      installExitSafety();
+      kf::sc::exchangeSlot(5, newDevice(fd, 'a'));  // open
+      kf::sc::exchangeSlot(6, newDevice(fd, 'b'));
+      kf::sc::exchangeSlot(6, nullptr);  // closing: out of its slot, not deleted yet
+      raise(signalNumber);
+    });
+    // The handler passed the signal on: the process ended by it, as without the handler...
+    CHECK(WIFSIGNALED(status));
+    CHECK(WTERMSIG(status) == signalNumber);
+    // ... after driving both magnets off, once each.
+    CHECK(offs.size() == 2);
+    CHECK(offs.find('a') != std::string::npos);
+    CHECK(offs.find('b') != std::string::npos);
+  }
+}
