@@ -30,7 +30,8 @@ FrictionCalibration {
 				case
 				{ header.isNil } {
 					if(fields != ["kf-calibration", "1"]) {
-						Error("FrictionCalibration.read: %: line %: expected the header \"kf-calibration 1\"".format(path, i + 1)).throw
+						Error("FrictionCalibration.read: %: line %: expected the header \"kf-calibration 1\"".format(
+							path, i + 1)).throw
 					};
 					header = true
 				}
@@ -78,7 +79,9 @@ FrictionCalibration {
 		^drive.linlin(points[i - 1][0], points[i][0], points[i - 1][1], points[i][1])
 	}
 
-	printOn { |stream| stream << this.class.name << "(" << points.size << " points" << (serial !? { ", " ++ serial } ? "") << ")" }
+	printOn { |stream|
+		stream << this.class.name << "(" << points.size << " points" << (serial !? { ", " ++ serial } ? "") << ")"
+	}
 
 	prSetPath { |argPath| path = argPath }
 
@@ -90,15 +93,20 @@ FrictionCalibration {
 			if(p.isArray.not or: { p.size != 2 } or: { p.any { |v| v.isNumber.not } }) {
 				Error("FrictionCalibration: point % is not a [drive, forceN] pair: %".format(i + 1, p)).throw
 			};
-			if(p[0] < 0 or: { p[0] > 1 }) { Error("FrictionCalibration: point %: drive % is not in 0..1".format(i + 1, p[0])).throw };
-			if(p[1] < 0 or: { p[1] == inf }) { Error("FrictionCalibration: point %: force % N is not a finite force >= 0".format(i + 1, p[1])).throw };
+			if(p[0] < 0 or: { p[0] > 1 }) {
+				Error("FrictionCalibration: point %: drive % is not in 0..1".format(i + 1, p[0])).throw
+			};
+			if(p[1] < 0 or: { p[1] == inf }) {
+				Error("FrictionCalibration: point %: force % N is not a finite force >= 0".format(i + 1, p[1])).throw
+			};
 			if(i > 0) {
 				if(p[0] <= argPoints[i - 1][0]) {
-					Error("FrictionCalibration: point %: drive % does not ascend (previous %)".format(i + 1, p[0], argPoints[i - 1][0])).throw
+					Error("FrictionCalibration: point %: drive % does not ascend (previous %)".format(
+						i + 1, p[0], argPoints[i - 1][0])).throw
 				};
 				if(p[1] < argPoints[i - 1][1]) {
-					Error("FrictionCalibration: not monotone: point % has % N at drive %, less than % N at drive %".format(
-						i + 1, p[1], p[0], argPoints[i - 1][1], argPoints[i - 1][0])).throw
+					Error("FrictionCalibration: not monotone: point % has % N at drive %, less than % N at drive %"
+						.format(i + 1, p[1], p[0], argPoints[i - 1][1], argPoints[i - 1][0])).throw
 				};
 			};
 		};

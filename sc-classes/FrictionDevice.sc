@@ -1,13 +1,15 @@
-// One device slot of a server: a simulated friction device, a replay of a recorded session,
-// or (later) hardware. Every command has a ...Msg twin that returns the OSC message, so the
-// same device can be used in a Score (pass server nil to only describe it).
+// One device slot of a server: a simulated friction device, a replay of a recorded session, or
+// hardware: a real mouse (hidapi or evdev, FrictionDeviceMouse.sc) as the puck's sensor, and the
+// friction board (libusb, FrictionDeviceBoard.sc) driving its magnet. Every command has a ...Msg
+// twin that returns the OSC message, so the same device can be used in a Score (pass server nil
+// to only describe it). The server's answers to the commands are FrictionAnswers' business.
 FrictionDevice {
 	classvar <oldSpecNames;
-	// Life cycle: the devices sclang holds open, by server and slot; the commands awaiting an
-	// answer (/done or /kfFail), by server; how long to wait for one.
-	classvar slots, pendingAnswers, responders, <>answerTimeout = 5;
+	// The devices sclang holds open, by server and slot.
+	classvar slots;
 	var <server, <index, <specs, <kind, <source, <overrides;
-	var <state = \described, <replace = false, forceBus, forceWriter, positionBus, positionReader;
+	// busSynths: the writer of forceBus and the reader of positionBus, by role (\writer, \reader).
+	var <state = \described, <replace = false, forceBus, positionBus, busSynths;
 
 	*initClass {
 		// The names specs had before every name carried its unit. A user may have typed them, so
@@ -19,8 +21,6 @@ FrictionDevice {
 			watchdog: \watchdogS, magnetLag: \magnetLagS
 		);
 		slots = IdentityDictionary.new;
-		pendingAnswers = IdentityDictionary.new;
-		responders = IdentityDictionary.new;
 		// The server closes every device when it quits; a reboot opens them again, and the
 		// force writers come back after Cmd-. (ServerTree runs after boot and after Cmd-.).
 		ServerQuit.add({ |srv| this.prServerQuit(srv) }, \all);
@@ -42,6 +42,16 @@ FrictionDevice {
 	// counts x count size x update rate: 333.375 mm/s for the paper's device (the paper says 334).
 	*maxSpeedOf { |specs| ^specs[\countMm] * specs[\maxCountsPerReport] * specs[\updateRateHz] }
 
+	// How long (s) a command waits for the server's answer (FrictionAnswers.timeout).
+	*answerTimeout { ^FrictionAnswers.timeout }
+	*answerTimeout_ { |seconds| FrictionAnswers.timeout = seconds }
+
+	// The server of device: a FrictionDevice's (Server.default when it has none) or, for a slot
+	// index, Server.default.
+	*serverOf { |device|
+		^if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default }
+	}
+
 	// hand: a FrictionHand (nil: the puck stays put). profile: an Event of spec or simulation
 	// settings by name (e.g. (maxForceN: 1.0, puckMassKg: 0.2)); nil: the paper's numbers.
 	// replace: true closes a device open in the slot; false (the default) refuses the slot.
@@ -54,7 +64,9 @@ FrictionDevice {
 
 	// path: a kf-session recording (FrictionDevice.record) or a hid-recorder .hid file.
 	*replay { |server, path, index = 0, profile, replace = false|
-		if(path.isString.not) { Error("FrictionDevice.replay: path must be a String, got %".format(path)).throw };
+		if(path.isString.not) {
+			Error("FrictionDevice.replay: path must be a String, got %".format(path)).throw
+		};
 		path = path.standardizePath;
 		if(server.notNil and: { File.exists(path).not }) {
 			Error("FrictionDevice.replay: no such file: %".format(path)).throw
@@ -78,7 +90,8 @@ FrictionDevice {
 	openMsg {
 		if(kind == \mouse) { ^this.mouseMsg };  // FrictionDeviceMouse.sc
 		^if(kind == \sim) {
-			['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] }) ++ this.prOverrideArgs
+			['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] })
+			++ this.prOverrideArgs
 		} {
 			['/cmd', \kfOpenReplay, index, source] ++ this.prOverrideArgs
 		} ++ (if(replace) { [\replace, 1] } { [] })
@@ -88,8 +101,7 @@ FrictionDevice {
 	// the block the server executes the command in (a bundle's time, in a Score its time).
 	zero { |x = 0, y = 0| this.prSendAnswered(\kfZero, this.zeroMsg(x, y)) }
 	zeroMsg { |x = 0, y = 0|
-		[x, y].do { |v| if(v.isNumber.not or: { v.isNaN } or: { v.abs == inf }) {
-			Error("FrictionDevice.zero: x and y must be finite numbers (mm), got %".format(v)).throw } };
+		[\x, x, \y, y].pairsDo { |name, mm| FrictionCheck.finite(mm, name, "FrictionDevice.zero") };
 		^['/cmd', \kfZero, index, x.asFloat, y.asFloat]
 	}
 	setPosition { |x = 0, y = 0| this.zero(x, y) }
@@ -104,7 +116,7 @@ FrictionDevice {
 		if(server.isNil) { Error("FrictionDevice.forceBus: the device has no server").throw };
 		forceBus ?? {
 			forceBus = Bus.audio(server, 1);
-			this.prStartWriter;
+			this.prStartBusSynths;
 		};
 		^forceBus
 	}
@@ -119,58 +131,28 @@ FrictionDevice {
 	status { this.prSendAnswered(\kfStatus, this.statusMsg) }
 	statusMsg { ^['/cmd', \kfStatus, index] }
 
-	// The friction board (device/PROTOCOL.md), added to this device: every force frame goes to
-	// it too, through the calibration. serial: nil for the first board found; emulate: true for
-	// the board emulator (no hardware needed). The board starts disarmed.
-	addBoard { |serial, emulate = false, inFlight = 2| this.prSend(this.addBoardMsg(serial, emulate, inFlight)) }
-	addBoardMsg { |serial, emulate = false, inFlight = 2|
-		if(serial.notNil and: { serial.isString.not and: { serial.isKindOf(Symbol).not } }) {
-			Error("FrictionDevice.addBoard: serial must be a String or nil, got %".format(serial)).throw
-		};
-		if(inFlight.isInteger.not or: { inFlight < 1 or: { inFlight > 4 } }) {
-			Error("FrictionDevice.addBoard: inFlight must be an Integer from 1 to 4, got %".format(inFlight)).throw
-		};
-		^['/cmd', \kfBoardOpen, index, (serial ? "").asString, emulate.binaryValue, inFlight]
-	}
-	// The magnet is driven only while the board is armed.
-	arm { this.prSend(this.armMsg) }
-	armMsg { ^['/cmd', \kfBoardArm, index, 1] }
-	disarm { this.prSend(this.disarmMsg) }
-	disarmMsg { ^['/cmd', \kfBoardArm, index, 0] }
-	// calibration: a FrictionCalibration (written to a file first) or a path; nil: linear.
-	calibrate { |calibration| this.prSend(this.calibrateMsg(calibration)) }
-	calibrateMsg { |calibration|
-		var path = calibration;
-		if(calibration.isKindOf(FrictionCalibration)) {
-			path = calibration.path ?? {
-				Error("FrictionDevice.calibrate: write the FrictionCalibration to a file first").throw
-			}
-		};
-		if(path.notNil and: { path.isString.not }) {
-			Error("FrictionDevice.calibrate: give a FrictionCalibration, a path or nil, got %".format(calibration)).throw
-		};
-		^['/cmd', \kfBoardCalibrate, index, path !? { path.standardizePath } ? ""]
-	}
-	// The board's and the frame timing's telemetry as an Event, passed to action (the reply
-	// goes to clients registered with /notify, as sclang is by default).
-	boardStatus { |action|
+	// The same figures as numbers: an Event (FrictionDevice.statusOf) passed to action, from the
+	// server's /kfStatus reply to the clients registered with /notify (sclang by default).
+	statusValues { |action|
 		if(server.isNil) { ^this };
-		OSCFunc({ |msg| action.value(this.class.boardStatusOf(msg[3..])) }, '/kfBoardStatus', server.addr,
+		OSCFunc({ |msg| action.value(this.class.statusOf(msg[3..])) }, '/kfStatus', server.addr,
 			argTemplate: [nil, index]).oneShot;
-		this.prSend(this.boardStatusMsg)
+		this.status
 	}
-	boardStatusMsg { ^['/cmd', \kfBoardStatus, index] }
-	*boardStatusOf { |values|
-		var names = #[hasBoard, connected, armed, boardState, currentLevel, temperatureC, errors, setPointsSent, late,
-			lost, timeouts, partials, stalls, badStatus, unplugs, reopens, onePerPump, offsetP50S];
+	// Thread priorities: -1 no such thread, 0 normal scheduling (realtime refused or not asked
+	// for), > 0 SCHED_FIFO. Durations in s, the force in N.
+	*statusFields {
+		^#[open, realtime, deviceThreadPriority, mouseThreadPriority, usbThreadPriority, memoryLocked, reports,
+			frames, watchdogTrips, missedDeadlines, skippedFrames, lateFrames, reportQueueOverflows,
+			frameQueueOverflows, loopP50S, loopP99S, loopMaxS, forceP50S, forceP99S, forceP999S, forceMaxS,
+			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN]
+	}
+	*statusOf { |values|
 		var event = ();
-		names.do { |name, i| event[name] = values[i] };
-		#[hasBoard, connected, armed].do { |name| event[name] = event[name] == 1 };
-		event[\boardState] = [\disarmed, \armed, \fault][event[\boardState]] ? \unknown;
+		this.statusFields.do { |name, i| event[name] = values[i] };
+		#[open, realtime, memoryLocked].do { |name| event[name] = event[name] == 1 };
 		^event
 	}
-	removeBoard { this.prSend(this.removeBoardMsg) }
-	removeBoardMsg { ^['/cmd', \kfBoardClose, index] }
 
 	// A 4-channel control Bus of the puck's [x, y, speedX, speedY] (mm, mm/s), made on first
 	// use and written by one reader synth at the head of the server: for GUIs and re-centring
@@ -179,23 +161,9 @@ FrictionDevice {
 		if(server.isNil) { Error("FrictionDevice.positionBus: the device has no server").throw };
 		positionBus ?? {
 			positionBus = Bus.control(server, 4);
-			this.prStartReader;
+			this.prStartBusSynths;
 		};
 		^positionBus
-	}
-
-	prStartReader {
-		var def = SynthDef(\kfPositionReader, { Out.kr(\bus.ir(0), FrictionMouseIn.kr(\device.ir(0))) });
-		var reader;
-		if(positionReader.notNil or: { positionBus.isNil }) { ^this };
-		reader = positionReader = Synth.basicNew(\kfPositionReader, server);
-		forkIfNeeded {
-			def.add;
-			server.sync;
-			if(positionReader === reader) {
-				server.sendMsg(*reader.newMsg(RootNode(server), [\device, index, \bus, positionBus.index], \addToHead));
-			};
-		};
 	}
 
 	// Closes the device if this object still holds its slot (a device opened with replace: true
@@ -203,7 +171,8 @@ FrictionDevice {
 	close {
 		if(server.isNil) { ^this };
 		if(this.class.at(server, index) !== this) {
-			"FrictionDevice: % does not hold slot % (closed or replaced); nothing to close".format(this, index).warn;
+			"FrictionDevice: % does not hold slot % (closed or replaced); nothing to close".format(
+				this, index).warn;
 			^this
 		};
 		this.prForget(\closed);
@@ -213,25 +182,27 @@ FrictionDevice {
 
 	printOn { |stream| stream << this.class.name << "(" << kind << ", " << index << ")" }
 
+	// kind: \sim, \replay or \mouse, the class method that opens it (and names its errors).
 	prInit { |argServer, argIndex, argKind, argSource, profile, argReplace = false|
-		if(argReplace != true and: { argReplace != false }) {
-			Error("FrictionDevice: replace must be true or false, got %".format(argReplace)).throw
-		};
-		replace = argReplace;
+		var where = "FrictionDevice." ++ argKind;
+		replace = FrictionCheck.boolean(argReplace, "replace", where);
 		if(argIndex.isInteger.not or: { argIndex < 0 or: { argIndex > 15 } }) {
-			Error("FrictionDevice: index must be an Integer from 0 to 15, got %".format(argIndex)).throw
+			Error("%: index must be an Integer from 0 to 15, got %".format(where, argIndex)).throw
 		};
 		if(profile.notNil and: { profile.isKindOf(Dictionary).not }) {
-			Error("FrictionDevice: profile must be an Event of settings, got %".format(profile)).throw
+			Error("%: profile must be an Event of settings, got %".format(where, profile)).throw
 		};
 		server = argServer;
 		index = argIndex;
+		busSynths = IdentityDictionary.new;
 		kind = argKind;
 		source = argSource;
 		overrides = ();
 		(profile ? ()).keysValuesDo { |key, value|
 			if(value == true or: { value == false }) { value = value.binaryValue };  // loop: true
-			if(value.isNumber.not) { Error("FrictionDevice: setting % must be a number, got %".format(key, value)).throw };
+			if(value.isNumber.not) {
+				Error("%: setting % must be a number, got %".format(where, key, value)).throw
+			};
 			overrides[oldSpecNames[key] ? key] = value;
 		};
 		specs = KineticFriction.paperDevice;
@@ -243,7 +214,7 @@ FrictionDevice {
 	// and a refusal is an Error; elsewhere the refusal is posted as an ERROR when it comes.
 	prOpen {
 		if(server.isNil) { ^this };
-		if(server.serverRunning.not) { Error("FrictionDevice: server % is not running".format(server)).throw };
+		FrictionCheck.serverRunning(server, "FrictionDevice." ++ kind);
 		state = \opening;
 		// The server decides whether the slot is free (or replaced): it holds the devices of
 		// every client. Its answer updates what sclang holds.
@@ -260,112 +231,64 @@ FrictionDevice {
 		slots[server] = slots[server] ?? { Array.newClear(16) };
 		slots[server][index] = this;
 		state = \open;
-		forceBus !? { this.prStartWriter };
-		positionBus !? { this.prStartReader };
+		this.prStartBusSynths;
 	}
 
-	// Sends msg and awaits /done cmd or /kfFail for this slot (answerTimeout s at most).
 	// Sends a command nothing waits for (the board's: the server posts their result).
 	prSend { |msg|
 		if(server.isNil) { ^this };
-		if(server.serverRunning.not) { Error("FrictionDevice: server % is not running".format(server)).throw };
+		FrictionCheck.serverRunning(server, "FrictionDevice");
 		server.listSendMsg(msg)
 	}
 
+	// Sends msg and awaits /done cmd or /kfFail for this slot (FrictionAnswers.send).
 	prSendAnswered { |cmd, msg, onDone, onFail, block = true|
-		var cond, answer, inRoutine = block and: { thisThread.isKindOf(Routine) };
-		if(server.isNil) { ^this };
-		// (At ServerBoot, re-opening, the server is up but not yet marked running.)
-		if(block and: { server.serverRunning.not }) {
-			Error("FrictionDevice: server % is not running".format(server)).throw
-		};
-		cond = Condition(false);
-		this.class.prExpect(server, cmd, index, {
-			answer = \done;
-			onDone.value;
-			cond.test = true; cond.signal;
-		}, { |reason|
-			answer = reason;
-			onFail.value(reason);
-			if(inRoutine.not) { ("ERROR: " ++ this.prFailText(cmd, reason)).postln };
-			cond.test = true; cond.signal;
-		});
-		server.listSendMsg(msg);
-		if(inRoutine) {
-			cond.wait;
-			if(answer != \done) { Error(this.prFailText(cmd, answer)).throw };
-		};
-	}
-
-	// The server's reasons name their command already ("kfOpenSim: ..."); ours do not.
-	prFailText { |cmd, reason|
-		^if(reason.beginsWith(cmd.asString ++ ":")) {
-			"FrictionDevice " ++ reason
-		} {
-			"FrictionDevice %: %".format(cmd, reason)
-		}
+		FrictionAnswers.send(server, cmd, index, msg, onDone, onFail, block)
 	}
 
 	prForget { |newState|
 		var held = slots[server];
 		if(held.notNil and: { held[index] === this }) { held[index] = nil };
 		state = newState;
-		forceWriter !? { if(server.serverRunning) { forceWriter.free } };
-		forceWriter = nil;
+		busSynths.do { |node| if(server.serverRunning) { node.free } };
+		busSynths = IdentityDictionary.new;
 		forceBus !? { forceBus.free };
 		forceBus = nil;
-		positionReader !? { if(server.serverRunning) { positionReader.free } };
-		positionReader = nil;
 		positionBus !? { positionBus.free };
 		positionBus = nil;
 	}
 
-	// One writer per device, claimed at once so that it is never started twice.
-	prStartWriter {
-		var def = SynthDef(\kfForceWriter, { FrictionOut.ar(\device.ir(0), In.ar(\bus.ir(0), 1)) });
-		var writer;
-		if(forceWriter.notNil or: { forceBus.isNil }) { ^this };
-		writer = forceWriter = Synth.basicNew(\kfForceWriter, server);
-		forkIfNeeded {
-			def.add;
-			server.sync;
-			if(forceWriter === writer) {
-				server.sendMsg(*writer.newMsg(RootNode(server), [\device, index, \bus, forceBus.index], \addToTail));
+	// The writer of forceBus (at the tail: it sends the sum played into the bus to the device)
+	// and the reader of positionBus (at the head: the puck for every synth after it), each started
+	// once its bus exists: one synth per role, claimed at once so that it is never started twice.
+	prStartBusSynths {
+		[
+			[\writer, forceBus, \addToTail, \kfForceWriter,
+				{ FrictionOut.ar(\device.ir(0), In.ar(\bus.ir(0), 1)) }],
+			[\reader, positionBus, \addToHead, \kfPositionReader,
+				{ Out.kr(\bus.ir(0), FrictionMouseIn.kr(\device.ir(0))) }]
+		].do { |spec|
+			var role, bus, addAction, defName, graph, node;
+			#role, bus, addAction, defName, graph = spec;
+			if(bus.notNil and: { busSynths[role].isNil }) {
+				node = Synth.basicNew(defName, server);
+				busSynths[role] = node;
+				forkIfNeeded {
+					SynthDef(defName, graph).add;
+					server.sync;
+					// Forgotten meanwhile (closed, quit, Cmd-.): not started.
+					if(busSynths[role] === node) {
+						server.sendMsg(*node.newMsg(RootNode(server), [\device, index, \bus, bus.index], addAction));
+					};
+				};
 			};
 		};
-	}
-
-	*prExpect { |server, cmd, index, done, fail|
-		var list = pendingAnswers[server] ?? { List.new };
-		var entry = (cmd: cmd, index: index, done: done, fail: fail);
-		pendingAnswers[server] = list;
-		list.add(entry);
-		responders[server] ?? {
-			responders[server] = [
-				OSCFunc({ |msg|
-					var found = list.detect { |e| e[\cmd] == msg[1] };
-					found !? { list.remove(found); found[\done].value };
-				}, '/done', server.addr).permanent_(true),
-				OSCFunc({ |msg|
-					var found = list.detect { |e| e[\index] == msg[2] };
-					var reason = msg[3..].collect { |c| c.asInteger.asAscii }.join;
-					found !? { list.remove(found); found[\fail].value(reason) };
-				}, '/kfFail', server.addr).permanent_(true)
-			]
-		};
-		SystemClock.sched(answerTimeout, {
-			if(list.includes(entry)) {
-				list.remove(entry);
-				fail.value("no answer from % in % s".format(server, answerTimeout));
-			};
-			nil
-		});
 	}
 
 	*prServerQuit { |srv|
 		// The server closed them; they are opened again at the next boot.
 		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prQuit } } };
-		pendingAnswers[srv] !? { |list| list.copy.do { |e| list.remove(e); e[\fail].value("the server quit") } };
+		FrictionAnswers.failAll(srv, "the server quit");
 	}
 
 	*prServerBoot { |srv|
@@ -376,7 +299,7 @@ FrictionDevice {
 		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prRestoreWriter } } };
 	}
 
-	prQuit { state = \quit; forceWriter = nil; positionReader = nil }
+	prQuit { state = \quit; busSynths = IdentityDictionary.new }
 
 	prReopen {
 		if(state != \quit) { ^this };
@@ -385,20 +308,17 @@ FrictionDevice {
 		state = \opening;
 		this.prSendAnswered(this.openCommand, this.openMsg, {
 			state = \open;
-			this.prStartWriter;
-			this.prStartReader;
+			this.prStartBusSynths;
 		}, {
 			this.prForget(\failed);
 		}, false);
 	}
 
-	// After Cmd-. (all nodes freed): the force writer again.
+	// After Cmd-. (all nodes freed): the force writer and the position reader again.
 	prRestoreWriter {
 		if(state == \open) {
-			forceWriter = nil;
-			positionReader = nil;
-			this.prStartWriter;
-			this.prStartReader;
+			busSynths = IdentityDictionary.new;
+			this.prStartBusSynths;
 		};
 	}
 

@@ -27,7 +27,7 @@
 	*listMice { |server, backend, action|
 		var path;
 		server = server ? Server.default;
-		if(server.serverRunning.not) { Error("FrictionDevice.listMice: server % is not running".format(server)).throw };
+		FrictionCheck.serverRunning(server, "FrictionDevice.listMice");
 		path = PathName.tmp +/+ "kf-mice-%-%.txt".format(Main.elapsedTime.hash.abs, UniqueID.next);
 		fork {
 			var mice = [];
@@ -60,7 +60,7 @@
 	// The maker's counts per inch as a count size: a starting value before a stroke.
 	*countMmFromCpi { |cpi| ^25.4 / cpi }
 
-	// A mouse profile file ("key = value" lines; device/MouseProfile.hpp reads the same).
+	// A mouse profile file ("key = value" lines; device/mouse/MouseProfile.hpp reads the same).
 	*writeMouseProfile { |path, profile|
 		var file = File(path.standardizePath, "w");
 		if(file.isOpen.not) { Error("FrictionDevice.writeMouseProfile: cannot write %".format(path)).throw };
@@ -83,7 +83,9 @@
 				if(equals.isNil) { Error("%:%: not 'key = value'".format(path, i + 1)).throw };
 				key = line.keep(equals).stripWhiteSpace.asSymbol;
 				value = line.drop(equals + 1).stripWhiteSpace;
-				profile[key] = if([\cpi, \countMmX, \countMmY, \updateRateHz].includes(key)) { value.asFloat } { value };
+				profile[key] = if([\cpi, \countMmX, \countMmY, \updateRateHz].includes(key)) {
+					value.asFloat
+				} { value };
 			}
 		};
 		^profile
@@ -91,7 +93,9 @@
 	// The device settings a profile gives: countMm (measured, else from cpi), updateRate.
 	*mouseProfileSettings { |profile|
 		var settings = ();
-		(profile[\countMmX] ?? { profile[\cpi] !? { |cpi| this.countMmFromCpi(cpi) } }) !? { |mm| settings[\countMm] = mm };
+		(profile[\countMmX] ?? { profile[\cpi] !? { |cpi| this.countMmFromCpi(cpi) } }) !? { |mm|
+			settings[\countMm] = mm
+		};
 		profile[\updateRateHz] !? { |hz| settings[\updateRate] = hz };
 		^settings
 	}
@@ -103,7 +107,8 @@
 			Error("FrictionDevice.mouse: backend must be \\hidapi or \\evdev, got %".format(backend)).throw
 		};
 		if(which.notNil and: { which.isString.not and: { which.isInteger.not } }) {
-			Error("FrictionDevice.mouse: which must be nil, an index, a path or \"VVVV:PPPP\", got %".format(which)).throw
+			Error("FrictionDevice.mouse: which must be nil, an index, a path or \"VVVV:PPPP\", got %".format(
+				which)).throw
 		};
 		if(profile.isString) {
 			profilePath = profile.standardizePath;

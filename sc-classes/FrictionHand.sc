@@ -12,16 +12,15 @@ FrictionHand {
 	// [[speedMmPerS, durationS], ...]: target speed segments along x from x = 0.
 	*speeds { |speedAndDuration|
 		var pairs = this.prCheckPairs(speedAndDuration, "speeds", "[speedMmPerS, durationS]", false);
-		pairs.do { |p| if(p[1] < 0) { Error("FrictionHand.speeds: durations must be >= 0, got %".format(p[1])).throw } };
+		pairs.do { |p|
+			if(p[1] < 0) { Error("FrictionHand.speeds: durations must be >= 0, got %".format(p[1])).throw }
+		};
 		^this.newCopyArgs(1, pairs)
 	}
 
 	// A constant push of forceN along x (tests of the puck's dynamics).
 	*force { |forceN|
-		if(forceN.isNumber.not or: { forceN.isNaN or: { forceN.abs == inf } }) {
-			Error("FrictionHand.force: forceN must be a finite number, got %".format(forceN)).throw
-		};
-		^this.newCopyArgs(2, [], forceN)
+		^this.newCopyArgs(2, [], FrictionCheck.finite(forceN, "forceN", "FrictionHand.force"))
 	}
 
 	// The arguments of the kfOpenSim command: kind, count, values...
@@ -43,11 +42,14 @@ FrictionHand {
 			Error("FrictionHand.%: expects a non-empty array of % pairs".format(method, shape)).throw
 		};
 		pairs.do { |p|
-			if(p.isSequenceableCollection.not or: { p.size != 2 } or: { p.any { |v| v.isNumber.not or: { v.isNaN or: { v.abs == inf } } } }) {
+			var finite = { |v| v.isNumber and: { v.isNaN.not and: { v.abs != inf } } };
+			if(p.isSequenceableCollection.not or: { p.size != 2 } or: { p.every(finite).not }) {
 				Error("FrictionHand.%: each entry must be % with finite numbers, got %".format(method, shape, p)).throw
 			};
 			if(ascending) {
-				if(p[0] < last) { Error("FrictionHand.%: times must ascend, got % after %".format(method, p[0], last)).throw };
+				if(p[0] < last) {
+					Error("FrictionHand.%: times must ascend, got % after %".format(method, p[0], last)).throw
+				};
 				last = p[0];
 			};
 		};

@@ -34,8 +34,10 @@ FrictionPilot {
 	// Loads the pilot signal into a new Buffer on server (any server: sent as /b_setn).
 	*loadSignal { |server, action|
 		server = server ? Server.default;
-		if(server.isKindOf(Server).not) { Error("FrictionPilot.loadSignal: server must be a Server, got %".format(server)).throw };
-		if(server.serverRunning.not) { Error("FrictionPilot.loadSignal: server % is not running".format(server)).throw };
+		if(server.isKindOf(Server).not) {
+			Error("FrictionPilot.loadSignal: server must be a Server, got %".format(server)).throw
+		};
+		FrictionCheck.serverRunning(server, "FrictionPilot.loadSignal");
 		^Buffer.sendCollection(server, this.signal, 1, 0, action)
 	}
 
@@ -57,27 +59,12 @@ FrictionPilot {
 
 	// Samples per mm of a mapping: a name of Table 1 (\mapping1, \mapping2, \mapping3) or any
 	// positive finite number of samples per mm.
-	*samplesPerMmOf { |mapping|
-		case
-		{ mapping.isKindOf(Symbol) or: { mapping.isString } } {
-			^mappings[mapping.asSymbol] ?? {
-				Error("FrictionPilot: unknown mapping %; use one of % or a number of samples per mm".format(
-					mapping.asSymbol.cs, mappings.keys.asArray.sort.collect(_.cs).join(", "))).throw
-			}
-		}
-		{ mapping.isNumber } {
-			if(mapping.isNaN or: { mapping.abs == inf } or: { mapping <= 0 }) {
-				Error("FrictionPilot: samplesPerMm must be a positive finite number, got %".format(mapping)).throw
-			};
-			^mapping.asFloat
-		}
-		{ Error("FrictionPilot: mapping must be a Symbol (e.g. \\mapping1) or samples per mm, got %".format(mapping)).throw }
-	}
+	*samplesPerMmOf { |mapping| ^FrictionCheck.samplesPerMm(mapping, "FrictionPilot.samplesPerMmOf") }
 
 	// Table 1 computed from samples per mm: cycle width and fragment width (mm), and the audio
 	// frequency range (Hz) at the device's slowest and fastest speed (mm/s).
 	*table { |mapping = \mapping1, minSpeed = 2.6, maxSpeed = 334|
-		var spm = this.samplesPerMmOf(mapping);
+		var spm = FrictionCheck.samplesPerMm(mapping, "FrictionPilot.table");
 		^(
 			samplesPerMm: spm,
 			cycleWidthMm: cycleFrames / spm,
@@ -89,7 +76,7 @@ FrictionPilot {
 
 	// The audio frequency (Hz) when the pilot signal is crossed at speed (mm/s).
 	*frequencyAt { |speedMmPerS, mapping = \mapping1|
-		^speedMmPerS.abs * this.samplesPerMmOf(mapping) / cycleFrames
+		^speedMmPerS.abs * FrictionCheck.samplesPerMm(mapping, "FrictionPilot.frequencyAt") / cycleFrames
 	}
 
 	// ---- the ugen graph ----
@@ -116,7 +103,8 @@ FrictionPilot {
 			Error("FrictionPilot.ar: samplesPerMm must be > 0, got %".format(samplesPerMm)).throw
 		};
 		if(maxAudioDelay.isNumber.not or: { maxAudioDelay <= 0 }) {
-			Error("FrictionPilot.ar: maxAudioDelay is fixed at build time and must be a number > 0 s, got %".format(maxAudioDelay)).throw
+			Error("FrictionPilot.ar: maxAudioDelay is fixed at build time and must be a number > 0 s, got %".format(
+				maxAudioDelay)).throw
 		};
 		if(audioDelay.isNumber and: { audioDelay < 0 or: { audioDelay > maxAudioDelay } }) {
 			Error("FrictionPilot.ar: audioDelay must be within [0, %] s, got %".format(maxAudioDelay, audioDelay)).throw
@@ -139,33 +127,33 @@ FrictionPilot {
 	// (see recordChannelNames).
 	// monitor: true adds a control bus output (monitorBus: 5 channels) for FrictionView.
 	*synthDef { |name = \frictionPilot, device = 0, record = false, loForceN, hiForceN, monitor = false|
-		var index = this.prDeviceIndex(device, "synthDef");
+		var index = FrictionCheck.deviceIndex(device, "FrictionPilot.synthDef");
 		var delay = this.prAudioDelay(device);
 		var lo = loForceN ?? { this.prMinForce(device) };
 		var hi = hiForceN ? paperHiForceN;
 		if(name.isKindOf(Symbol).not and: { name.isString.not }) {
 			Error("FrictionPilot.synthDef: name must be a Symbol, got %".format(name)).throw
 		};
-		if(record != true and: { record != false }) {
-			Error("FrictionPilot.synthDef: record must be true or false, got %".format(record)).throw
-		};
+		FrictionCheck.boolean(record, "record", "FrictionPilot.synthDef");
 		[\loForceN, lo, \hiForceN, hi].pairsDo { |key, value|
-			if(value.isNumber.not or: { value.isNaN } or: { value.abs == inf }) {
-				Error("FrictionPilot.synthDef: % must be a finite number (N), got %".format(key, value)).throw
-			}
+			FrictionCheck.finite(value, key, "FrictionPilot.synthDef")
 		};
-		if(hi <= lo) { Error("FrictionPilot.synthDef: hiForceN (%) must be above loForceN (%)".format(hi, lo)).throw };
+		if(hi <= lo) {
+			Error("FrictionPilot.synthDef: hiForceN (%) must be above loForceN (%)".format(hi, lo)).throw
+		};
 		^SynthDef(name.asSymbol, {
 			var p = this.ar(\device.kr(index), \bufnum.kr(0), \samplesPerMm.kr(4000), \origin.kr(0),
 				\friction.kr(1), \amp.kr(0.5), \audioDelay.kr(delay), lo, hi, max(0.05, delay), \keep.kr(0));
 			Out.ar(\out.kr(0), p[\delayedAudio] ! 2);
 			if(record) {
-				Out.ar(\recordBus.kr(2), [\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
+				Out.ar(\recordBus.kr(2),
+					[\position, \speed, \audio, \delayedAudio, \force, \commandedForce].collect { |key| p[key] })
 			};
 			// Position, speed, requested and commanded force once per control block, and 1 while
 			// running (the buffer is loaded before the synth starts).
 			if(monitor == true) {
-				Out.kr(\monitorBus.kr(0), A2K.kr([p[\position], p[\speed], p[\force], p[\commandedForce]]) ++ [DC.kr(1)])
+				Out.kr(\monitorBus.kr(0),
+					A2K.kr([p[\position], p[\speed], p[\force], p[\commandedForce]]) ++ [DC.kr(1)])
 			};
 		})
 	}
@@ -180,9 +168,10 @@ FrictionPilot {
 	// kf-session recording of the device. duration nil: the hand script's duration + 0.5 s.
 	*score { |device, mapping = \mapping1, friction = 1, duration, origin = 0, amp = 1,
 		recordBus, recordPath, bufnum = 0, signal, nodeID = 1000|
-		var spm = this.samplesPerMmOf(mapping), def, msgs;
+		var spm = FrictionCheck.samplesPerMm(mapping, "FrictionPilot.score"), def, msgs;
 		if(device.isKindOf(FrictionDevice).not) {
-			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.sim(nil, 0, hand)), got %".format(device)).throw
+			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.sim(nil, 0, hand)), "
+				"got %".format(device)).throw
 		};
 		duration = duration ?? {
 			if(device.kind == \sim and: { device.source.notNil }) { device.source.duration + 0.5 } {
@@ -193,10 +182,11 @@ FrictionPilot {
 			Error("FrictionPilot.score: duration must be a positive finite number (s), got %".format(duration)).throw
 		};
 		this.prCheckFriction(friction, "score");
-		this.prCheckFinite(origin, "origin", "score");
-		this.prCheckFinite(amp, "amp", "score");
+		FrictionCheck.finite(origin, "origin", "FrictionPilot.score");
+		FrictionCheck.finite(amp, "amp", "FrictionPilot.score");
 		if(recordBus.notNil and: { recordBus.isInteger.not or: { recordBus < 2 } }) {
-			Error("FrictionPilot.score: recordBus must be nil or an Integer >= 2 (0 and 1 carry the audio), got %".format(recordBus)).throw
+			Error("FrictionPilot.score: recordBus must be nil or an Integer >= 2 (0 and 1 carry the audio), "
+				"got %".format(recordBus)).throw
 		};
 		if(recordPath.notNil and: { recordPath.isString.not }) {
 			Error("FrictionPilot.score: recordPath must be nil or a String, got %".format(recordPath)).throw
@@ -216,7 +206,9 @@ FrictionPilot {
 	}
 
 	// Switching a running pilot: the OSC messages for a node (Score or realtime).
-	*setMappingMsg { |nodeID, mapping| ^['/n_set', nodeID, \samplesPerMm, this.samplesPerMmOf(mapping)] }
+	*setMappingMsg { |nodeID, mapping|
+		^['/n_set', nodeID, \samplesPerMm, FrictionCheck.samplesPerMm(mapping, "FrictionPilot.setMappingMsg")]
+	}
 	*setFrictionMsg { |nodeID, on| ^['/n_set', nodeID, \friction, this.prCheckFriction(on, "setFrictionMsg")] }
 
 	// ---- realtime ----
@@ -228,13 +220,13 @@ FrictionPilot {
 		^super.new.prInit(device, mapping, friction, origin, amp, out)
 	}
 
-	server { ^if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default } }
+	server { ^FrictionDevice.serverOf(device) }
 
 	play {
 		var server = this.server;
-		if(server.serverRunning.not) { Error("FrictionPilot.play: server % is not running".format(server)).throw };
+		FrictionCheck.serverRunning(server, "FrictionPilot.play");
 		if(synth.notNil) { ^this };
-		defName = ("frictionPilot" ++ this.class.prDeviceIndex(device, "play")).asSymbol;
+		defName = ("frictionPilot" ++ FrictionCheck.deviceIndex(device, "FrictionPilot.play")).asSymbol;
 		// The synth is claimed now, so that a second play does nothing and a free before it starts
 		// (below) keeps it from starting at all.
 		synth = Synth.basicNew(defName, server);
@@ -247,8 +239,9 @@ FrictionPilot {
 			this.class.synthDef(defName, device, monitor: true).add;
 			server.sync;
 			if(synth === starting) {
-				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum, \samplesPerMm, samplesPerMm,
-					\origin, origin, \friction, friction, \amp, amp, \out, out, \monitorBus, this.monitorBus.index]));
+				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum,
+					\samplesPerMm, samplesPerMm, \origin, origin, \friction, friction, \amp, amp, \out, out,
+					\monitorBus, this.monitorBus.index]));
 				// Freed by anyone (n_free, s.freeAll): forgotten, so that play starts it again.
 				starting.onFree { if(synth === starting) { synth = nil } };
 			};
@@ -256,7 +249,7 @@ FrictionPilot {
 	}
 
 	mapping_ { |newMapping|
-		samplesPerMm = this.class.samplesPerMmOf(newMapping);
+		samplesPerMm = FrictionCheck.samplesPerMm(newMapping, "FrictionPilot.mapping_");
 		mapping = newMapping;
 		synth !? { synth.set(\keep, 0, \samplesPerMm, samplesPerMm) }
 	}
@@ -266,7 +259,7 @@ FrictionPilot {
 	// block the change takes effect. From then on origin_ changes keep it in place too; mapping_
 	// goes back to the absolute layout.
 	zoom { |newMapping|
-		samplesPerMm = this.class.samplesPerMmOf(newMapping);
+		samplesPerMm = FrictionCheck.samplesPerMm(newMapping, "FrictionPilot.zoom");
 		mapping = newMapping;
 		synth !? { synth.set(\keep, 1, \samplesPerMm, samplesPerMm) }
 	}
@@ -276,8 +269,14 @@ FrictionPilot {
 		synth !? { synth.set(\friction, friction) }
 	}
 
-	origin_ { |mm| origin = this.class.prCheckFinite(mm, "origin", "origin_"); synth !? { synth.set(\origin, origin) } }
-	amp_ { |value| amp = this.class.prCheckFinite(value, "amp", "amp_"); synth !? { synth.set(\amp, amp) } }
+	origin_ { |mm|
+		origin = FrictionCheck.finite(mm, "origin", "FrictionPilot.origin_");
+		synth !? { synth.set(\origin, origin) }
+	}
+	amp_ { |value|
+		amp = FrictionCheck.finite(value, "amp", "FrictionPilot.amp_");
+		synth !? { synth.set(\amp, amp) }
+	}
 
 	// Opens a FrictionView of this pilot (its own window; or in parent).
 	view { |parent, bounds| ^FrictionView.pilot(this, parent, bounds) }
@@ -303,28 +302,25 @@ FrictionPilot {
 		buffer = nil;
 	}
 
-	printOn { |stream| stream << this.class.name << "(" << device << ", " << mapping.cs << ", friction: " << friction << ")" }
+	printOn { |stream|
+		stream << this.class.name << "(" << device << ", " << mapping.cs << ", friction: " << friction << ")"
+	}
 
 	prInit { |argDevice, argMapping, argFriction, argOrigin, argAmp, argOut|
-		this.class.prDeviceIndex(argDevice, "new");
+		FrictionCheck.deviceIndex(argDevice, "FrictionPilot.new");
 		device = argDevice;
-		samplesPerMm = this.class.samplesPerMmOf(argMapping);
+		samplesPerMm = FrictionCheck.samplesPerMm(argMapping, "FrictionPilot.new");
 		mapping = argMapping;
 		friction = this.class.prCheckFriction(argFriction, "new");
-		origin = this.class.prCheckFinite(argOrigin, "origin", "new");
-		amp = this.class.prCheckFinite(argAmp, "amp", "new");
-		if(argOut.isInteger.not or: { argOut < 0 }) { Error("FrictionPilot.new: out must be a bus index (Integer >= 0), got %".format(argOut)).throw };
+		origin = FrictionCheck.finite(argOrigin, "origin", "FrictionPilot.new");
+		amp = FrictionCheck.finite(argAmp, "amp", "FrictionPilot.new");
+		if(argOut.isInteger.not or: { argOut < 0 }) {
+			Error("FrictionPilot.new: out must be a bus index (Integer >= 0), got %".format(argOut)).throw
+		};
 		out = argOut;
 	}
 
-	// ---- checks ----
-
-	*prDeviceIndex { |device, method|
-		^case
-		{ device.isKindOf(FrictionDevice) } { device.index }
-		{ device.isInteger and: { device >= 0 } } { device }
-		{ Error("FrictionPilot.%: device must be a FrictionDevice or a slot index (Integer >= 0), got %".format(method, device)).throw }
-	}
+	// ---- checks (those other classes share too are FrictionCheck's) ----
 
 	*prAudioDelay { |device|
 		^if(device.isKindOf(FrictionDevice)) { device.audioDelay } { paperAudioDelayS }
@@ -338,16 +334,10 @@ FrictionPilot {
 		if(on == true) { ^1 };
 		if(on == false) { ^0 };
 		if(on.isNumber.not or: { on.isNaN } or: { on < 0 } or: { on > 1 }) {
-			Error("FrictionPilot.%: friction must be 0 (off), 1 (on), a Boolean or a number in between, got %".format(method, on)).throw
+			Error("FrictionPilot.%: friction must be 0 (off), 1 (on), a Boolean or a number in between, got %".format(
+				method, on)).throw
 		};
 		^on
-	}
-
-	*prCheckFinite { |value, name, method|
-		if(value.isNumber.not or: { value.isNaN } or: { value.abs == inf }) {
-			Error("FrictionPilot.%: % must be a finite number, got %".format(method, name, value)).throw
-		};
-		^value
 	}
 
 	*prCheckBufnum { |bufnum, method|

@@ -1,20 +1,15 @@
 // A live view of one device slot: the buffer's signal laid out on the surface (mm), the puck on
-// it, and strip charts of the puck's speed and of the requested and commanded force. A small
-// monitor synth sends ~30 frames/s (SendReply at control rate); nothing polls per sample.
-// Usable as its own window or embedded in a layout (like FreqScopeView).
+// it, and strip charts of the puck's speed and of the requested and commanded force. Usable as
+// its own window or embedded in a layout (like FreqScopeView). This class draws; its frames come
+// from a FrictionViewMonitor (the server side) and its signal from a FrictionSignalPyramid.
 FrictionView {
 	classvar <markerColor, <requestedColor, <commandedColor, <speedColor, <signalColor;
-	classvar nextReplyID = 0;
 
-	var <device, <server, <pilot, <forceBus, <positionBus, <frameRate, <historyS;
-	var buffer, samplesPerMm, origin;
+	var <device, <server, <pilot, <monitor, buffer, samplesPerMm, origin;
 	var <view, <userView, <window, followBox, ownsWindow = false;
 	var <follow = false, <zoomToMapping = false, <rangeMm, <>forceRangeN, <minForceN;
-	var <positionMm = 0, <speedMmPerS = 0, <forceN, <commandedForceN, <timeS = 0, <frameCount = 0;
-	var <signalFrames = 0, pyramidMin, pyramidMax, signalPeak = 1, signalBufnum, fetching = false;
-	var history, historyHead = 0, <historyCount = 0;
-	var <synth, defName, replyID, oscFunc, <isFree = false, refreshPending = false, lastSpm;
-	var drag, columnCache, columnKey, pilotRunning = 0, <paused = false, <drawn, rangeSet = false, forceChannels = 0, monitorDef;
+	var pyramid, signalBufnum, fetching = false, <isFree = false, refreshPending = false, lastSpm;
+	var drag, columnCache, columnKey, <paused = false, <drawn, rangeSet = false;
 
 	*initClass {
 		// Distinct colours (drawn without antialiasing) so a test can find them in a screenshot.
@@ -33,16 +28,25 @@ FrictionView {
 	// parent nil: the view opens its own window.
 	*new { |device = 0, buffer, samplesPerMm = 1, origin = 0, forceBus, positionBus, parent, bounds,
 		frameRate = 30, historyS = 6|
-		^super.new.prInit(device, buffer, samplesPerMm, origin, forceBus, positionBus, nil, parent, bounds,
-			frameRate, historyS)
+		var where = "FrictionView.new";
+		FrictionViewMonitor.checkSettings(device, forceBus, positionBus, frameRate, historyS, where);
+		if(buffer.notNil and: { buffer.isKindOf(Buffer).not }) {
+			Error("%: buffer must be a Buffer or nil, got %".format(where, buffer)).throw
+		};
+		^super.new.prInit(device, buffer, FrictionCheck.samplesPerMm(samplesPerMm, where),
+			FrictionCheck.finite(origin, "origin", where), nil, parent, bounds, {
+				FrictionViewMonitor(device, forceBus, positionBus, frameRate, historyS)
+			})
 	}
 
 	// The view of a FrictionPilot: its position, speed and forces as its synth computes them, its
 	// buffer and its current mapping (samplesPerMm, origin) followed live.
 	*pilot { |pilot, parent, bounds, frameRate = 30, historyS = 6|
-		if(pilot.isKindOf(FrictionPilot).not) { Error("FrictionView.pilot: expects a FrictionPilot, got %".format(pilot)).throw };
-		^super.new.prInit(pilot.device, nil, pilot.samplesPerMm, pilot.origin, nil, nil, pilot, parent, bounds,
-			frameRate, historyS)
+		FrictionViewMonitor.checkPilot(pilot, "FrictionView.pilot");
+		FrictionViewMonitor.checkSettings(pilot.device, nil, nil, frameRate, historyS, "FrictionView.pilot");
+		^super.new.prInit(pilot.device, nil, pilot.samplesPerMm, pilot.origin, pilot, parent, bounds, {
+			FrictionViewMonitor.pilot(pilot, frameRate, historyS)
+		})
 	}
 
 	// ---- the mapping shown ----
@@ -53,15 +57,15 @@ FrictionView {
 
 	buffer_ { |newBuffer| buffer = newBuffer; this.refreshSignal }
 	samplesPerMm_ { |value|
-		samplesPerMm = FrictionPilot.samplesPerMmOf(value);
+		samplesPerMm = FrictionCheck.samplesPerMm(value, "FrictionView.samplesPerMm_");
 		this.refresh
 	}
-	origin_ { |mm| origin = FrictionPilot.prCheckFinite(mm, "origin", "FrictionView.origin_"); this.refresh }
+	origin_ { |mm| origin = FrictionCheck.finite(mm, "origin", "FrictionView.origin_"); this.refresh }
 
 	// The signal's first and last sample on the surface (mm).
 	fragmentMm {
 		var spm = this.samplesPerMm, start = this.origin;
-		^[start, start + (max(signalFrames - 1, 0) / spm)]
+		^[start, start + (max(this.signalFrames - 1, 0) / spm)]
 	}
 
 	// The visible part of the surface, [loMm, hiMm].
@@ -85,8 +89,8 @@ FrictionView {
 
 	// Shows the whole fragment (and the puck) with a margin.
 	fit {
-		var lo, hi, margin;
-		if(signalFrames > 0) {
+		var lo, hi, margin, positionMm = this.positionMm;
+		if(this.signalFrames > 0) {
 			#lo, hi = this.fragmentMm;
 			lo = min(lo, positionMm); hi = max(hi, positionMm);
 		} {
@@ -108,6 +112,27 @@ FrictionView {
 	// signal keeps its size on screen (as the pilot's re-mapping about the puck does on the surface).
 	zoomToMapping_ { |bool| zoomToMapping = bool == true; lastSpm = this.samplesPerMm }
 
+	// ---- the frames (the monitor's) and the signal ----
+
+	forceBus { ^monitor.forceBus }
+	positionBus { ^monitor.positionBus }
+	frameRate { ^monitor.frameRate }
+	historyS { ^monitor.historyS }
+	synth { ^monitor.synth }
+	positionMm { ^monitor.positionMm }
+	speedMmPerS { ^monitor.speedMmPerS }
+	forceN { ^monitor.forceN }
+	commandedForceN { ^monitor.commandedForceN }
+	timeS { ^monitor.timeS }
+	frameCount { ^monitor.frameCount }
+	historyCount { ^monitor.historyCount }
+	// The frames of the strip charts, oldest first: [timeS, positionMm, speedMmPerS, forceN,
+	// commandedForceN].
+	history { ^monitor.history }
+
+	// The samples of the signal shown (0 until the buffer is fetched).
+	signalFrames { ^if(pyramid.notNil) { pyramid.frames } { 0 } }
+
 	// ---- pixels (userView coordinates) ----
 
 	surfaceRect { ^this.prLayout[\surface] }
@@ -116,16 +141,16 @@ FrictionView {
 
 	mmToX { |mm| var r = this.surfaceRect; ^r.left + ((mm - rangeMm[0]) / (rangeMm[1] - rangeMm[0]) * r.width) }
 	xToMm { |x| var r = this.surfaceRect; ^rangeMm[0] + ((x - r.left) / r.width * (rangeMm[1] - rangeMm[0])) }
-	forceToY { |forceValueN| var r = this.forceRect; ^r.bottom - ((forceValueN - forceRangeN[0]) / (forceRangeN[1] - forceRangeN[0]) * r.height) }
-	yToForce { |y| var r = this.forceRect; ^forceRangeN[0] + ((r.bottom - y) / r.height * (forceRangeN[1] - forceRangeN[0])) }
-	// The strip charts' time axis: seconds before the latest frame -> x.
-	ageToX { |ageS| var r = this.forceRect; ^r.right - (ageS / historyS * r.width) }
-
-	// The frames of the strip charts, oldest first: [timeS, positionMm, speedMmPerS, forceN, commandedForceN].
-	history {
-		var size = history.size;
-		^Array.fill(historyCount, { |i| history[(historyHead - historyCount + i) % size].copy })
+	forceToY { |forceValueN|
+		var r = this.forceRect;
+		^r.bottom - ((forceValueN - forceRangeN[0]) / (forceRangeN[1] - forceRangeN[0]) * r.height)
 	}
+	yToForce { |y|
+		var r = this.forceRect;
+		^forceRangeN[0] + ((r.bottom - y) / r.height * (forceRangeN[1] - forceRangeN[0]))
+	}
+	// The strip charts' time axis: seconds before the latest frame -> x.
+	ageToX { |ageS| var r = this.forceRect; ^r.right - (ageS / this.historyS * r.width) }
 
 	// ---- life cycle ----
 
@@ -148,10 +173,7 @@ FrictionView {
 	free {
 		if(isFree) { ^this };
 		isFree = true;
-		oscFunc !? { oscFunc.free };
-		oscFunc = nil;
-		if(synth.notNil and: { server.serverRunning }) { synth.free };
-		synth = nil;
+		monitor.free;
 		ServerTree.remove(this, server);
 		CmdPeriod.remove(this);
 		if(ownsWindow and: { window.notNil } and: { window.isClosed.not }) { defer { window.close } };
@@ -165,70 +187,39 @@ FrictionView {
 
 	front { window !? { window.front } }
 
-	// After Cmd-. (which frees every node) or a boot: start the monitor again. A pilot's synth is
-	// gone too: clear what it left on its bus, so the view waits for it to play again.
-	doOnServerTree {
-		if(isFree.not) {
-			fetching = false;  // a fetch cut off by a quit or Cmd-. is taken again
-			if(pilot.notNil) { pilot.monitorBus.setn(0 ! 5) };
-			this.prStartSynth
-		}
-	}
+	// A fetch cut off by a quit or Cmd-. is taken again (the monitor starts its synth again itself).
+	doOnServerTree { fetching = false }
 
 	// Cmd-. also drops what was deferred or forked: a pending refresh or buffer fetch.
-	cmdPeriod { synth = nil; fetching = false; refreshPending = false }
+	cmdPeriod { fetching = false; refreshPending = false }
 
 	printOn { |stream| stream << this.class.name << "(" << (pilot ? device) << ")" }
 
 	// ---- private ----
 
-	prInit { |argDevice, argBuffer, argSpm, argOrigin, argForceBus, argPositionBus, argPilot, parent, bounds,
-		argFrameRate, argHistoryS|
-		FrictionPilot.prDeviceIndex(argDevice, "FrictionView");
-		[\forceBus, argForceBus, \positionBus, argPositionBus].pairsDo { |name, bus|
-			if(bus.notNil and: { bus.isKindOf(Bus).not or: { bus.index.isNil } }) {
-				Error("FrictionView: % must be a Bus (control or audio) or nil, got %".format(name, bus)).throw
-			}
-		};
-		if(argBuffer.notNil and: { argBuffer.isKindOf(Buffer).not }) {
-			Error("FrictionView: buffer must be a Buffer or nil, got %".format(argBuffer)).throw
-		};
-		if(argFrameRate.isNumber.not or: { argFrameRate <= 0 } or: { argFrameRate > 100 }) {
-			Error("FrictionView: frameRate must be in (0, 100] Hz, got %".format(argFrameRate)).throw
-		};
-		if(argHistoryS.isNumber.not or: { argHistoryS <= 0 } or: { argHistoryS > 600 }) {
-			Error("FrictionView: historyS must be in (0, 600] s, got %".format(argHistoryS)).throw
-		};
+	// Arguments checked by *new and *pilot; makeMonitor: a function that makes the monitor.
+	prInit { |argDevice, argBuffer, argSpm, argOrigin, argPilot, parent, bounds, makeMonitor|
 		device = argDevice;
 		pilot = argPilot;
-		server = if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default };
+		server = FrictionDevice.serverOf(device);
 		buffer = argBuffer;
-		samplesPerMm = FrictionPilot.samplesPerMmOf(argSpm);
-		origin = FrictionPilot.prCheckFinite(argOrigin, "origin", "FrictionView");
-		forceBus = argForceBus;
-		// Fixed now: the bus may be freed before the view.
-		forceChannels = if(pilot.notNil) { 2 } { forceBus !? { forceBus.numChannels.min(2) } ? 0 };
-		positionBus = argPositionBus;
-		frameRate = argFrameRate;
-		historyS = argHistoryS;
+		samplesPerMm = argSpm;
+		origin = argOrigin;
 		minForceN = if(device.isKindOf(FrictionDevice)) { device.specs[\minForceN] } { FrictionPilot.paperLoForceN };
-		forceRangeN = if(pilot.notNil) { [0, FrictionPilot.paperHiForceN * 1.2] } {
-			[0, if(device.isKindOf(FrictionDevice)) { device.specs[\maxForceN] } { KineticFriction.paperDevice[\maxForceN] }]
-		};
-		history = Array.fill((historyS * frameRate * 1.5).ceil.asInteger + 16, { FloatArray.newClear(5) });
+		forceRangeN = case
+			{ pilot.notNil } { [0, FrictionPilot.paperHiForceN * 1.2] }
+			{ device.isKindOf(FrictionDevice) } { [0, device.specs[\maxForceN]] }
+			{ [0, KineticFriction.paperDevice[\maxForceN]] };
 		rangeMm = [-10, 10];
 		lastSpm = this.samplesPerMm;
-		replyID = nextReplyID;
-		nextReplyID = nextReplyID + 1;
-		defName = ("frictionView" ++ replyID).asSymbol;
-		// Built once, from the buses as they are now (they may be freed before the view).
-		monitorDef = this.prMonitorDef;
 		this.prMakeGui(parent, bounds);
-		oscFunc = OSCFunc({ |msg| this.prFrame(msg) }, '/frictionView', server.addr, argTemplate: [nil, replyID]);
-		oscFunc.permanent = true;  // survives Cmd-.; the synth is restarted by doOnServerTree
+		monitor = makeMonitor.value;
+		monitor.action = { |m, resumed| this.prFrame(resumed) };
 		ServerTree.add(this, server);
 		CmdPeriod.add(this);
-		if(server.serverRunning) { this.prStartSynth } { "FrictionView: server % is not running; the view starts with it".format(server).warn };
+		if(server.serverRunning.not) {
+			"FrictionView: server % is not running; the view starts with it".format(server).warn
+		};
 		if(pilot.isNil) { this.prFetchSignalIfNeeded(false) };
 	}
 
@@ -244,10 +235,11 @@ FrictionView {
 		followBox = CheckBox(text: "follow the puck").value_(follow).action_({ |b| follow = b.value; this.refresh });
 		fitButton = Button().states_([["fit"]]).action_({ follow = false; followBox.value = false; this.fit });
 		hint = StaticText().string_("wheel: zoom, drag: pan, double-click: fit").stringColor_(Color.gray(0.35));
-		view.layout = VLayout(HLayout(followBox, fitButton, [hint, stretch: 1]), [userView, stretch: 1]).margins_(4).spacing_(2);
+		view.layout = VLayout(HLayout(followBox, fitButton, [hint, stretch: 1]), [userView, stretch: 1])
+			.margins_(4).spacing_(2);
 		userView.drawFunc = { this.prDraw };
 		userView.mouseWheelAction = { |v, x, y, mod, dx, dy|
-			if(dy != 0) { this.zoom(0.8 ** dy.sign, if(follow) { positionMm } { this.xToMm(x) }) };
+			if(dy != 0) { this.zoom(0.8 ** dy.sign, if(follow) { this.positionMm } { this.xToMm(x) }) };
 			true
 		};
 		userView.mouseDownAction = { |v, x, y, mod, button, clickCount|
@@ -272,64 +264,12 @@ FrictionView {
 		};
 	}
 
-	prMonitorDef {
-		var force = forceBus, pos = positionBus, rate = frameRate, busIn;
-		busIn = { |bus, maxChannels|
-			var n = bus.numChannels.min(maxChannels);
-			if(bus.rate == \audio) { A2K.kr(InFeedback.ar(bus.index, n)) } { In.kr(bus.index, n) }.asArray
-		};
-		^SynthDef(defName, {
-			var trig = Impulse.kr(rate);
-			var frameBlocks = (ControlRate.ir / rate).round.max(1), blocks = Integrator.kr(DC.kr(1), 1);
-			var x, speed, forces, running = DC.kr(1), mean;
-			// The mean over the last frame (over the blocks so far, at the start).
-			mean = { |sig| RunningSum.kr(sig, frameBlocks) / blocks.clip(1, frameBlocks) };
-			case
-			{ pilot.notNil } {
-				var p = In.kr(pilot.monitorBus.index, 5);
-				x = p[0]; speed = p[1]; forces = [mean.(p[2]), mean.(p[3])]; running = p[4];
-			}
-			{ pos.notNil } {
-				var p = busIn.(pos, 2);
-				x = p[0]; speed = if(p.size > 1) { p[1] } { Slope.kr(x) };
-			}
-			{
-				var m = FrictionMouseIn.kr(device.isKindOf(FrictionDevice).if({ device.index }, { device }));
-				x = m[0]; speed = m[2];
-			};
-			if(pilot.isNil) {
-				forces = if(force.notNil) { busIn.(force, 2).collect(mean) } { [] };
-				forces = forces ++ (0 ! (2 - forces.size));
-			};
-			SendReply.kr(trig, '/frictionView', [PulseCount.kr(trig), x, speed] ++ forces ++ [running], replyID);
-		})
-	}
-
-	prStartSynth {
-		var def;
-		if(isFree or: { server.serverRunning.not }) { ^this };
-		def = monitorDef;
-		synth = Synth.basicNew(defName, server);
-		// The def travels with its node, so a rebooted server (no defs) works as well.
-		server.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(server), [], \addToTail));
-	}
-
-	prFrame { |msg|
-		var count = msg[3], values = msg[4..8], row, spm, ratio;
+	// A frame kept by the monitor (resumed: the first since it was not running).
+	prFrame { |resumed|
+		var spm, ratio, positionMm = this.positionMm;
 		if(isFree) { ^this };
-		// A pilot that is not playing (yet, or any more) writes nothing: keep its last picture.
-		if(pilot.notNil and: { values[4] < 0.5 }) { pilotRunning = 0; ^this };
-		frameCount = frameCount + 1;
-		timeS = count / frameRate;
-		positionMm = values[0]; speedMmPerS = values[1];
-		forceN = if(forceChannels > 0) { values[2] };
-		commandedForceN = if(forceChannels > 1) { values[3] };
-		row = history[historyHead % history.size];
-		row[0] = timeS; row[1] = positionMm; row[2] = speedMmPerS; row[3] = values[2]; row[4] = values[3];
-		historyHead = (historyHead + 1) % history.size;
-		historyCount = min(historyCount + 1, history.size);
 		// The pilot's synth runs only once its buffer is loaded: then fetch it.
-		if(pilot.notNil and: { pilotRunning < 0.5 }) { signalBufnum = nil; pilotRunning = 1 };
+		if(pilot.notNil and: { resumed }) { signalBufnum = nil };
 		this.prFetchSignalIfNeeded(false);
 		spm = this.samplesPerMm;
 		if(zoomToMapping and: { spm != lastSpm } and: { lastSpm.notNil }) {
@@ -346,62 +286,19 @@ FrictionView {
 		if(buf.isNil or: { fetching } or: { isFree } or: { server.serverRunning.not }) { ^this };
 		if(force.not and: { signalBufnum == buf.bufnum }) { ^this };
 		fetching = true;
-		fork {
-			var store = { |array|
-				var channels = buf.numChannels ? 1;
-				// A Routine on AppClock: a long signal is reduced without freezing the GUI.
-				if(array.notNil) {
-					Routine {
-						this.prSetSignal(if(channels > 1) { array[0, channels ..] } { array }, buf.bufnum);
-						fetching = false;
-					}.play(AppClock)
-				} { fetching = false }
-			};
-			try {
-				server.sync;
-				if(server.isLocal) { buf.loadToFloatArray(action: store) } { buf.getToFloatArray(action: store) }
-			} { |error|
-				fetching = false;
-				"FrictionView: could not fetch buffer %: %".format(buf.bufnum, error.errorString).warn;
-			}
-		}
+		FrictionSignalPyramid.fetch(buf, { |newPyramid, failure|
+			fetching = false;
+			failure !? { "FrictionView: %".format(failure).warn };
+			if(newPyramid.notNil and: { isFree.not }) { this.prSetSignal(newPyramid, buf.bufnum) };
+		})
 	}
 
-	// A min/max pyramid: level k holds min and max over blocks of 2^k samples, so any pixel
-	// column is reduced from a few blocks, whatever the zoom. Runs in a Routine (yields).
-	prSetSignal { |array, bufnum|
-		var mins = array.as(FloatArray), maxs = mins, levelsMin = [mins], levelsMax = [maxs];
-		if(mins.isEmpty) { "FrictionView: buffer % is empty".format(bufnum).warn; ^this };
-		while { mins.size > 1 } {
-			var n = (mins.size + 1) div: 2, lo = FloatArray.newClear(n), hi = FloatArray.newClear(n);
-			n.do { |i|
-				var j = min(2 * i + 1, mins.size - 1);
-				lo[i] = min(mins[2 * i], mins[j]);
-				hi[i] = max(maxs[2 * i], maxs[j]);
-				if(i % 65536 == 65535) { 0.wait };
-			};
-			mins = lo; maxs = hi;
-			levelsMin = levelsMin.add(mins); levelsMax = levelsMax.add(maxs);
-		};
-		if(isFree) { ^this };
-		pyramidMin = levelsMin; pyramidMax = levelsMax;
-		signalFrames = array.size;
-		signalPeak = max(max(mins[0].abs, maxs[0].abs), 1e-9);
+	prSetSignal { |newPyramid, bufnum|
+		pyramid = newPyramid;
 		signalBufnum = bufnum;
 		columnKey = nil;
 		// The first signal sets the view, unless the user already chose a range.
 		if(rangeSet.not) { this.fit; rangeSet = true } { this.refresh };
-	}
-
-	// min and max of the samples in [frameA, frameB] (fractional frame positions).
-	prEnvelope { |frameA, frameB|
-		var i0 = frameA.floor.asInteger.max(0), i1 = frameB.ceil.asInteger.min(signalFrames - 1);
-		var level = 0, lo = inf, hi = -inf, mins, maxs;
-		if(i1 < i0) { ^nil };
-		while { (1 << (level + 1)) * 2 <= (i1 - i0 + 1) and: { level + 1 < pyramidMin.size } } { level = level + 1 };
-		mins = pyramidMin[level]; maxs = pyramidMax[level];
-		(i0 >> level).for(i1 >> level, { |k| lo = min(lo, mins[k]); hi = max(hi, maxs[k]) });
-		^[lo, hi]
 	}
 
 	prLayout {
@@ -421,8 +318,9 @@ FrictionView {
 	prDraw {
 		var lay = this.prLayout, font = Font.sansSerif(11), small = Font.sansSerif(9), rows = this.history;
 		// What this picture shows (the window may show it a little after it was drawn).
-		drawn = (positionMm: positionMm, rangeMm: rangeMm.copy, timeS: if(rows.notEmpty) { rows.last[0] },
-			surfaceRect: lay[\surface], speedRect: lay[\speed], forceRect: lay[\force], forceRangeN: forceRangeN.copy);
+		drawn = (positionMm: this.positionMm, rangeMm: rangeMm.copy, timeS: if(rows.notEmpty) { rows.last[0] },
+			surfaceRect: lay[\surface], speedRect: lay[\speed], forceRect: lay[\force],
+			forceRangeN: forceRangeN.copy);
 		Pen.smoothing = false;
 		this.prDrawHeader(lay[\header], font);
 		this.prDrawSurface(lay[\surface], small);
@@ -431,21 +329,26 @@ FrictionView {
 	}
 
 	prDrawHeader { |r, font|
-		var text = "puck % mm   speed % mm/s".format(this.prFormat(positionMm, 2), this.prFormat(speedMmPerS, 1));
+		var spm = this.samplesPerMm, forceN = this.forceN, commandedForceN = this.commandedForceN;
+		var text = "puck % mm   speed % mm/s".format(this.prFormat(this.positionMm, 2),
+			this.prFormat(this.speedMmPerS, 1));
 		if(forceN.notNil) { text = text ++ "   force % N requested".format(this.prFormat(forceN, 3)) };
 		if(commandedForceN.notNil) { text = text ++ ", % N commanded".format(this.prFormat(commandedForceN, 3)) };
-		if(pilot.notNil and: { pilotRunning < 0.5 }) { text = text ++ "   (the pilot is not playing)" };
-		text = text ++ "   % samples/mm, origin % mm".format(this.prFormat(this.samplesPerMm, if(this.samplesPerMm.frac == 0) { 0 } { 3 }),
+		if(pilot.notNil and: { monitor.running.not }) { text = text ++ "   (the pilot is not playing)" };
+		text = text ++ "   % samples/mm, origin % mm".format(this.prFormat(spm, if(spm.frac == 0) { 0 } { 3 }),
 			this.prFormat(this.origin, 2));
 		Pen.stringInRect(text, r, font, Color.black, \left);
 	}
 
 	prDrawSurface { |r, font|
-		var spm = this.samplesPerMm, org = this.origin, mid = (r.top + 8 + (r.height / 2)).round, yScale = (r.height - 20) * 0.48 / signalPeak;
+		var spm = this.samplesPerMm, org = this.origin, positionMm = this.positionMm;
+		var signalFrames = this.signalFrames, signalPeak = if(pyramid.notNil) { pyramid.peak } { 1 };
+		var mid = (r.top + 8 + (r.height / 2)).round, yScale = (r.height - 20) * 0.48 / signalPeak;
 		var startMm, endMm, x0, x1, key, px;
 		// The mapping of this picture, local: mmToX/xToMm would lay the panels out on every call.
 		var mmPerPx = (rangeMm[1] - rangeMm[0]) / r.width;
-		var toX = { |mm| r.left + ((mm - rangeMm[0]) / mmPerPx) }, toMm = { |x| rangeMm[0] + ((x - r.left) * mmPerPx) };
+		var toX = { |mm| r.left + ((mm - rangeMm[0]) / mmPerPx) };
+		var toMm = { |x| rangeMm[0] + ((x - r.left) * mmPerPx) };
 		Pen.fillColor = Color.gray(0.97); Pen.fillRect(r);
 		this.prAxisX(r, rangeMm, font, "position on the surface (mm)");
 		Pen.strokeColor = Color.gray(0.85); Pen.width = 1;
@@ -459,7 +362,7 @@ FrictionView {
 				x1 = toX.(endMm).ceil.min(r.right - 1).asInteger;
 				columnCache = List.new;
 				x0.for(x1, { |x|
-					var env = this.prEnvelope((toMm.(x) - org) * spm, (toMm.(x + 1) - org) * spm);
+					var env = pyramid.envelope((toMm.(x) - org) * spm, (toMm.(x + 1) - org) * spm);
 					env !? { columnCache.add([x, mid - (env[1] * yScale), mid - (env[0] * yScale)]) };
 				});
 				columnKey = key;
@@ -473,13 +376,17 @@ FrictionView {
 				if(x >= r.left and: { x <= r.right }) {
 					var text = if(i == 0) { "start % mm" } { "end % mm" }.format(this.prFormat(mm, 2));
 					var at = (if(i == 0) { x + 3 } { x - 3 - (text.size * 5.6) }) @ (r.top + 2);
-					Pen.use { Pen.strokeColor = Color.gray(0.45); Pen.lineDash = FloatArray[4, 3]; Pen.line(x @ r.top, x @ r.bottom); Pen.stroke };
+					Pen.use {
+						Pen.strokeColor = Color.gray(0.45); Pen.lineDash = FloatArray[4, 3];
+						Pen.line(x @ r.top, x @ r.bottom); Pen.stroke
+					};
 					Pen.fillColor = Color.gray(0.97); Pen.fillRect(Rect(at.x - 1, at.y, text.size * 5.6 + 2, 13));
 					Pen.stringAtPoint(text, at, font, Color.gray(0.2));
 				}
 			};
 		} {
-			Pen.stringAtPoint(if(this.buffer.isNil) { "no buffer" } { "fetching the buffer..." }, (r.left + 8) @ (r.top + 8), font, Color.gray(0.4));
+			Pen.stringAtPoint(if(this.buffer.isNil) { "no buffer" } { "fetching the buffer..." },
+				(r.left + 8) @ (r.top + 8), font, Color.gray(0.4));
 		};
 		Pen.strokeColor = Color.gray(0.6); Pen.width = 1; Pen.strokeRect(r);
 		// The puck: a bar across the surface and a triangle above it.
@@ -487,7 +394,8 @@ FrictionView {
 		Pen.fillColor = markerColor;
 		if(px >= r.left and: { px <= r.right }) {
 			Pen.fillRect(Rect(px - 1, r.top + 1, 3, r.height - 1));
-			Pen.moveTo((px - 6) @ (r.top - 12)); Pen.lineTo((px + 6) @ (r.top - 12)); Pen.lineTo(px @ (r.top - 1)); Pen.lineTo((px - 6) @ (r.top - 12));
+			Pen.moveTo((px - 6) @ (r.top - 12)); Pen.lineTo((px + 6) @ (r.top - 12));
+			Pen.lineTo(px @ (r.top - 1)); Pen.lineTo((px - 6) @ (r.top - 12));
 			Pen.fill;
 			Pen.stringAtPoint("puck % mm".format(this.prFormat(positionMm, 2)),
 				(if(px > (r.right - 110)) { px - 112 } { px + 9 }) @ (r.top - 16), font, Color.black);
@@ -506,7 +414,8 @@ FrictionView {
 	}
 
 	prDrawStrip { |r, font, which, rows|
-		var ageToX = { |ageS| r.right - (ageS / historyS * r.width) }, latest, range, toY, fragment, values, labels;
+		var historyS = this.historyS, ageToX = { |ageS| r.right - (ageS / historyS * r.width) };
+		var latest, range, toY, fragment, labels;
 		Pen.fillColor = Color.white; Pen.fillRect(r);
 		latest = if(rows.notEmpty) { rows.last[0] } { 0 };
 		if(which == \speed) {
@@ -515,18 +424,20 @@ FrictionView {
 		} {
 			range = forceRangeN;
 			labels = [["force (N)", Color.black], ["requested", requestedColor]]
-			++ (if(commandedForceN.notNil or: { pilot.notNil }) { [["commanded", commandedColor]] } { [] })
+			++ (if(this.commandedForceN.notNil or: { pilot.notNil }) { [["commanded", commandedColor]] } { [] })
 			++ [["min force % N".format(this.prFormat(minForceN, 2)), Color.gray(0.5)]];
 		};
 		toY = { |v| r.bottom - ((v - range[0]) / (range[1] - range[0]) * r.height).clip(0, r.height) };
 		// Grey where the puck was on the fragment.
-		if(signalFrames > 0) {
+		if(this.signalFrames > 0) {
 			fragment = this.fragmentMm;
 			Pen.fillColor = Color.gray(0.9);
 			rows.doAdjacentPairs { |a, b|
 				if(a[1] >= fragment[0] and: { a[1] <= fragment[1] }) {
 					var xa = ageToX.(latest - a[0]), xb = ageToX.(latest - b[0]);
-					if(xb > r.left) { Pen.fillRect(Rect(xa.max(r.left), r.top + 1, xb - xa.max(r.left) + 1, r.height - 1)) }
+					if(xb > r.left) {
+						Pen.fillRect(Rect(xa.max(r.left), r.top + 1, xb - xa.max(r.left) + 1, r.height - 1))
+					}
 				}
 			};
 		};
@@ -537,8 +448,8 @@ FrictionView {
 				Pen.strokeColor = Color.gray(0.5); Pen.lineDash = FloatArray[2, 3]; Pen.width = 1;
 				Pen.line(r.left @ toY.(minForceN), r.right @ toY.(minForceN)); Pen.stroke;
 			};
-			if(forceN.notNil) { this.prTrace(rows, latest, r, toY, 3, requestedColor, 3) };
-			if(commandedForceN.notNil) { this.prTrace(rows, latest, r, toY, 4, commandedColor, 1) };
+			if(this.forceN.notNil) { this.prTrace(rows, latest, r, toY, 3, requestedColor, 3) };
+			if(this.commandedForceN.notNil) { this.prTrace(rows, latest, r, toY, 4, commandedColor, 1) };
 		} {
 			Pen.strokeColor = Color.gray(0.8);
 			Pen.line(r.left @ toY.(0), r.right @ toY.(0)); Pen.stroke;
@@ -550,7 +461,10 @@ FrictionView {
 			var text = pair[0], color = pair[1];
 			if(i > 0) {
 				if(color == Color.gray(0.5)) {
-					Pen.use { Pen.strokeColor = color; Pen.lineDash = FloatArray[2, 3]; Pen.line(x @ (r.top - 9), (x + 14) @ (r.top - 9)); Pen.stroke };
+					Pen.use {
+						Pen.strokeColor = color; Pen.lineDash = FloatArray[2, 3];
+						Pen.line(x @ (r.top - 9), (x + 14) @ (r.top - 9)); Pen.stroke
+					};
 				} { Pen.fillColor = color; Pen.fillRect(Rect(x, r.top - 12, 14, 6)) };
 				x = x + 18;
 			};
@@ -560,7 +474,7 @@ FrictionView {
 	}
 
 	prTrace { |rows, latest, r, toY, column, color, width|
-		var first = true, ageToX = { |ageS| r.right - (ageS / historyS * r.width) };
+		var first = true, historyS = this.historyS, ageToX = { |ageS| r.right - (ageS / historyS * r.width) };
 		Pen.strokeColor = color; Pen.width = width;
 		rows.do { |row|
 			var x = ageToX.(latest - row[0]), point;
@@ -588,7 +502,9 @@ FrictionView {
 		v = (range[0] / step).ceil * step;
 		Pen.strokeColor = Color.gray(0.6); Pen.width = 1;
 		while { v <= (range[1] + (step * 1e-6)) } {
-			x = if(isTime) { r.right - (v.neg / historyS * r.width) } { r.left + ((v - range[0]) / (range[1] - range[0]) * r.width) };
+			x = if(isTime) { r.right - (v.neg / this.historyS * r.width) } {
+				r.left + ((v - range[0]) / (range[1] - range[0]) * r.width)
+			};
 			Pen.line(x @ r.bottom, x @ (r.bottom + 4)); Pen.stroke;
 			if(title.notNil and: { x + 26 < titleLeft }) {
 				Pen.stringAtPoint(this.prFormat(v, decimals), (x - 12) @ (r.bottom + 5), font, Color.gray(0.2))
@@ -606,7 +522,8 @@ FrictionView {
 		while { v <= (range[1] + (step * 1e-6)) } {
 			y = r.bottom - ((v - range[0]) / (range[1] - range[0]) * r.height);
 			Pen.line((r.left - 4) @ y, r.left @ y); Pen.stroke;
-			Pen.stringInRect(this.prFormat(v, decimals), Rect(0, y - 7, r.left - 6, 14), font, Color.gray(0.2), \right);
+			Pen.stringInRect(this.prFormat(v, decimals), Rect(0, y - 7, r.left - 6, 14), font, Color.gray(0.2),
+				\right);
 			v = v + step;
 		};
 	}

@@ -31,6 +31,7 @@ KineticFriction {
 	}
 
 	*systemPluginDirs {
-		^[Platform.resourceDir +/+ "plugins", "/usr/lib/SuperCollider/plugins", "/usr/local/lib/SuperCollider/plugins"].select { |d| File.exists(d) }
+		^[Platform.resourceDir +/+ "plugins", "/usr/lib/SuperCollider/plugins", "/usr/local/lib/SuperCollider/plugins"]
+			.select { |d| File.exists(d) }
 	}
 }

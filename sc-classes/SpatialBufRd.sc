@@ -23,7 +23,8 @@ SpatialBufRd : MultiOutUGen {
 	checkInputs {
 		var interpolation = inputs[4], samplesPerMm = inputs[2];
 		if(rate == 'audio' and: { inputs[1].rate != 'audio' }) {
-			^"position must be audio rate for SpatialBufRd.ar (got %); use K2A.ar or SpatialBufRd.kr".format(inputs[1].rate)
+			^"position must be audio rate for SpatialBufRd.ar (got %); use K2A.ar or SpatialBufRd.kr".format(
+				inputs[1].rate)
 		};
 		if(interpolation.isNumber and: { [1, 2, 4].includes(interpolation).not }) {
 			^"interpolation must be 1 (none), 2 (linear) or 4 (cubic), got %".format(interpolation)

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The habits CI enforces, beside the tests (scripts/test.sh runs this first):
-#   format     every C++ file as clang-format (the root .clang-format) would write it
+#   format     every C++ file as clang-format (the root .clang-format) would write it, and every
+#              sclang line (sc-classes/) within 120 columns (also alone: sclang-lines)
 #   pyflakes   no unused import or undefined name in the Python
 #   sanitize   dsp/, device/ and host/ built without SuperCollider, their C++ tests under AddressSanitizer
 #              + UndefinedBehaviorSanitizer (build-asan/); any finding fails
@@ -10,7 +11,8 @@
 #              (build-asan-plugin/), their runtimes preloaded into every scsynth the tests start
 #              (KF_SERVER_PRELOAD); any finding fails. KF_SANITIZED_TESTS: a ctest regex to run
 #              fewer of them.
-# Usage: scripts/check.sh [format|pyflakes|sanitize|fuzz|sanitize-plugin]...   (none: all, in this order)
+# Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin]...
+#        (none: all but sclang-lines, which format runs, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/env.sh
@@ -21,6 +23,19 @@ command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 check_format() {
   echo "== format (clang-format $(clang-format --version | grep -o '[0-9][0-9.]*' | head -1))"
   git ls-files '*.cpp' '*.hpp' '*.h' | xargs clang-format --dry-run --Werror
+}
+
+# sclang has no formatter: the one rule checked is the line length. A tab counts to the next
+# multiple of 4 columns, as SuperCollider's IDE shows it. Each long line is named (file:line).
+check_sclang_lines() {
+  echo "== sclang lines within 120 columns (sc-classes/)"
+  local file long=0
+  while IFS= read -r file; do
+    LC_ALL=C expand -t 4 "$file" | LC_ALL=C awk -v file="$file" '
+      length > 120 { printf "%s:%d: %d columns (at most 120)\n", file, NR, length; bad = 1 }
+      END { exit bad }' || long=1
+  done < <(find sc-classes \( -name '*.sc' -o -name '*.sc.in' \) | sort)
+  return "$long"
 }
 
 check_pyflakes() {
@@ -82,11 +97,12 @@ checks=("$@")
 ((${#checks[@]})) || checks=(format pyflakes sanitize fuzz sanitize-plugin)
 for check in "${checks[@]}"; do
   case "$check" in
-    format) check_format ;;
+    format) check_format; check_sclang_lines ;;
+    sclang-lines) check_sclang_lines ;;
     pyflakes) check_pyflakes ;;
     sanitize) check_sanitize ;;
     fuzz) check_fuzz ;;
     sanitize-plugin) check_sanitize_plugin ;;
-    *) echo "unknown check: $check (format, pyflakes, sanitize, fuzz, sanitize-plugin)" >&2; exit 2 ;;
+    *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin)" >&2; exit 2 ;;
   esac
 done
