@@ -8,7 +8,7 @@ must hold python/ (scripts/env.sh sets it).
     scripts/bench.sh                              # scripts/setup.sh (install, build), then this
     /usr/bin/python3 bench/run.py                 # everything (about 7 minutes on 2 cores, build excluded)
     /usr/bin/python3 bench/run.py --only timing   # one part (repeatable): build, log, timing, spatial,
-                                                  # loudness, drift, reconstruction, e2e, scale
+                                                  # loudness, drift, reconstruction, e2e, rtload, scale
 
 Parts:
   log       bench/log_choice.cpp: the logarithm of equation (2), std::log10 against faster ones
@@ -24,6 +24,9 @@ Parts:
   e2e       realtime: scsynth on `jackd -d dummy` (48 kHz, period 64), a FrictionPilot on
             FrictionDevice.sim for 10 s (three times), then kfStatus: loop period, report-to-UGen
             and force-to-magnet latencies
+  rtload    realtime: force and report latencies, loop jitter, missed deadlines and watchdog
+            trips with realtime scheduling, with it under load (2 CPU hogs, a disk writer) and at
+            normal priority under load, at 48 kHz / 64 and 256 and 192 kHz / 256 (20 s each)
   scale     realtime: voices of the pilot chain on one simulated device, added stepwise until
             scsynth misses periods, at 48 and 192 kHz
 """
@@ -45,6 +48,7 @@ def arguments():
     ap.add_argument("--drift-min", type=float, default=20)
     ap.add_argument("--e2e-s", type=float, default=10.0, help="seconds of each realtime end-to-end run")
     ap.add_argument("--e2e-runs", type=int, default=3)
+    ap.add_argument("--rtload-s", type=float, default=20.0, help="seconds of each run of the rtload part")
     ap.add_argument("--scale-runs", type=int, default=3, help="scale searches per sample rate")
     ap.add_argument("--no-report", action="store_true", help="print only; leave bench/REPORT.md and the plots alone")
     ap.add_argument("--report-only", action="store_true",

@@ -31,9 +31,10 @@ std::unique_ptr<Device> openMouseDevice(const MouseOpenOptions& options, const D
   }
   std::shared_ptr<MouseBackend> mouse;
   if (options.kind == MouseBackendKind::kHidapi)
-    mouse = HidapiMouseBackend::open(hidApi ? hidApi : realHidApi(), options.which, error, why);
+    mouse = HidapiMouseBackend::open(hidApi ? hidApi : realHidApi(), options.which, error, why, deviceOptions.thread);
   else
-    mouse = EvdevMouseBackend::open(evdevApi ? evdevApi : realEvdevApi(), options.which, options.grab, error, why);
+    mouse = EvdevMouseBackend::open(evdevApi ? evdevApi : realEvdevApi(), options.which, options.grab, error, why,
+                                    deviceOptions.thread);
   if (!mouse) return nullptr;
   // A real mouse reports up to 8 kHz: room for 1 s of reports between pumps and the UGen.
   deviceOptions.reportQueueCapacity = std::max<size_t>(deviceOptions.reportQueueCapacity, 8192);

@@ -1,8 +1,11 @@
 // ExitSafety: the magnet goes off however scsynth leaves. /quit runs the static destructors
 // (DeviceSlots' exit hook closes every device); a signal does not, so at plugin load this
-// installs handlers for the signals that end the process — SIGTERM, SIGINT, SIGHUP, SIGQUIT,
-// and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a thread
-// aborts). Each handler drives the force backend of every open device, and of every device
+// installs handlers for every signal whose default action ends the process — SIGTERM, SIGINT,
+// SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGPIPE, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGPWR,
+// SIGSTKFLT, and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a
+// thread aborts), SIGSYS, SIGTRAP. SIGXFSZ (a write past the file size limit) is ignored
+// instead: the write fails with EFBIG, the recording that made it stops with its message, and
+// the server and the magnet go on. Each handler drives the force backend of every open device, and of every device
 // whose close has not finished, off with async-signal-safe work only (atomic slot loads,
 // stores, write(2) of an off record to a recording), then hands the signal on: to the handler
 // installed before ours if there was one, else the original disposition is restored and the
@@ -19,7 +22,9 @@
 
 namespace {
 
-constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+constexpr int kSignals[] = {SIGTERM, SIGINT,    SIGHUP,  SIGQUIT, SIGUSR1, SIGUSR2,  SIGPIPE,
+                            SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGPWR,  SIGSEGV,  SIGBUS,
+                            SIGFPE,  SIGILL,    SIGABRT, SIGSYS,  SIGTRAP, SIGSTKFLT};
 
 struct sigaction gPrevious[NSIG];
 std::atomic<bool> gInstalled[NSIG];
@@ -44,6 +49,12 @@ void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
 }  // namespace
 
 void installExitSafety() {
+  // A file size limit (RLIMIT_FSIZE) must not kill the server with the magnet on: ignored, the
+  // write that passes it fails with EFBIG, which the recorder reports. Unless the host handles it.
+  struct sigaction fileSize {};
+  if (::sigaction(SIGXFSZ, nullptr, &fileSize) == 0 && !(fileSize.sa_flags & SA_SIGINFO) &&
+      fileSize.sa_handler == SIG_DFL)
+    ::signal(SIGXFSZ, SIG_IGN);
   for (const int signalNumber : kSignals) {
     if (gInstalled[signalNumber].load()) continue;
     struct sigaction previous {};

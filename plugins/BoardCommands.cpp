@@ -75,6 +75,7 @@ bool openStage(World*, void* raw) {  // NRT
   options.transfersInFlight = static_cast<int>(data->args.numbers[1]);
   options.minForceN = data->device->spec().minForceN;
   options.maxForceN = data->device->spec().maxForceN;
+  options.thread = data->device->options().thread;
   std::unique_ptr<kf::usb::Port> port;
   if (emulate)
     port = kf::board::EmulatedUsb::create(data->args.which[0] != '\0' ? data->args.which : "KF-EMU-0001")->makePort();

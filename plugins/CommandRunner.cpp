@@ -10,6 +10,8 @@
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 #include "PostLimiter.hpp"
+#include "core/ThreadScheduling.hpp"
+#include "core/spec/SettingBounds.hpp"
 
 namespace kf::sc {
 
@@ -135,6 +137,10 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   data->name = name;
   data->device = data->previous = nullptr;
   data->replace = data->failed = data->ownsDevice = false;
+  data->threadPriority = kf::kAutoPriority;
+  // The audio thread's priority, for the device threads' own (ThreadScheduling): commands run in
+  // the audio thread of a realtime server.
+  if (world->mRealTime) kf::noteAudioThreadPriority(kf::currentThreadPriority());
   data->onEnd = nullptr;
   data->reason[0] = '\0';
   OscArgReader reader = readerOf(msg);
@@ -161,13 +167,22 @@ bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim,
                     const char* callerKey) {
   for (int i = 0; i < data->args.numOverrides; ++i) {
     const char* key = data->args.keys[i];
-    const double value = data->args.overrideValues[i];
+    const double value = kf::snapToBounds(key, data->args.overrideValues[i]);
     if (std::strcmp(key, "replace") == 0) {  // not a device setting: how to treat a taken slot
       data->replace = value != 0.0;
       continue;
     }
     if (callerKey != nullptr && std::strcmp(key, callerKey) == 0) continue;
     std::string error;
+    if (std::strcmp(key, "threadPriority") == 0) {  // not a device setting: its threads'
+      error = kf::checkSetting(key, value);
+      if (error.empty()) {
+        data->threadPriority = static_cast<int>(value);
+        continue;
+      }
+      failWith(data, "%s: %s; not opened", data->name, error.c_str());
+      return false;
+    }
     if (spec.applyOverride(key, value, &error)) continue;
     // Not a device setting: perhaps a simulation or replay one. A setting one of them knows but
     // whose value is out of range is an error with that one's message.
@@ -184,6 +199,13 @@ bool applyOverrides(CommandData* data, kf::DeviceSpec& spec, kf::SimParams* sim,
     return false;
   }
   return true;
+}
+
+kf::DeviceOptions deviceOptionsOf(World* world, const CommandData* data) {
+  kf::DeviceOptions options;
+  options.thread = {data->args.index, data->threadPriority};
+  options.audioPeriodS = world->mBufLength / world->mSampleRate;
+  return options;
 }
 
 bool publishStage(World* world, void* raw) {  // RT

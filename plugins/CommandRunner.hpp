@@ -20,6 +20,7 @@ struct CommandData {
   kf::Device* device;    // opened by stage 2, or the target of record/status
   kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
   bool replace;          // open commands: a device in the slot is closed, not refused
+  int threadPriority;    // open commands: the device's threads (ThreadScheduling), kAutoPriority
   bool ownsDevice;       // open commands: `device` is theirs until published
   bool failed;           // a stage failed; `reason` says why
   char reason[kMaxReasonChars];
@@ -44,8 +45,8 @@ void run(World* world, void* replyAddr, CommandData* data, AsyncStageFn stage2, 
 void freeCommand(World* world, void* raw);
 
 // NRT: the command's settings applied to a spec, simulation and replay settings (null: not
-// taken), and `replace`; a setting named callerKey is left to the caller. False (failWith) on a
-// bad key or value.
+// taken), `replace` and `threadPriority`; a setting named callerKey is left to the caller. False
+// (failWith) on a bad key or value.
 bool applyOverrides(CommandData* data, DeviceSpec& spec, SimParams* sim, ReplayOptions* replay = nullptr,
                     const char* callerKey = nullptr);
 
@@ -53,6 +54,9 @@ bool applyOverrides(CommandData* data, DeviceSpec& spec, SimParams* sim, ReplayO
 // unless replace), delete the one it replaced (NRT).
 bool publishStage(World* world, void* raw);
 bool deletePreviousStage(World* world, void* raw);
+// The options of a device an open command makes: its threads named after the slot, at the
+// command's threadPriority; the server's block as the audio period its jitter buffer starts from.
+DeviceOptions deviceOptionsOf(World* world, const CommandData* data);
 // Stages of the commands that act on the slot's device: a hop to NRT, then the look-up (RT),
 // or its removal from the slot (RT).
 bool nrtHop(World* world, void* raw);

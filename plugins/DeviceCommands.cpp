@@ -6,7 +6,9 @@
 //                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N)
 //   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
-//   kfStatus     index             (posts telemetry)
+//   kfStatus     index             (posts telemetry and replies /kfStatus with its figures as
+//                                   numbers, to /notify clients: index, then kStatusFields
+//                                   values in StatusField order)
 //   kfClose      index
 //   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
 //                                   default, for every reader, from the next block on)
@@ -27,11 +29,49 @@
 #include "CommandRunner.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
+#include "board/UsbBoardBackend.hpp"
 #include "core/DeviceMessages.hpp"
 
 namespace {
 
 using namespace kf::sc;
+
+// The values of a /kfStatus reply, in order (sclang: FrictionDevice.statusFields). Thread
+// priorities: -1 no such thread (or not started), 0 normal scheduling, > 0 SCHED_FIFO.
+// Durations in seconds.
+enum StatusField {
+  kOpen,
+  kRealtime,
+  kDeviceThreadPriority,
+  kMouseThreadPriority,
+  kUsbThreadPriority,
+  kMemoryLocked,
+  kReports,
+  kFrames,
+  kWatchdogTrips,
+  kMissedDeadlines,
+  kSkippedFrames,
+  kLateFrames,
+  kReportQueueOverflows,
+  kFrameQueueOverflows,
+  kLoopP50S,
+  kLoopP99S,
+  kLoopMaxS,
+  kForceP50S,
+  kForceP99S,
+  kForceP999S,
+  kForceMaxS,
+  kReportP50S,
+  kReportP99S,
+  kReportMaxS,
+  kReleaseLatencyS,
+  kReportIntervalS,
+  kReportJitterS,
+  kLastForceN,
+  kStatusFields
+};
+
+static_assert(kStatusFields <= static_cast<int>(sizeof(CommandData::replyValues) / sizeof(float)));
 
 kf::HandScript handScriptOf(const CommandData* data) {
   const CommandArgs& args = data->args;
@@ -65,7 +105,7 @@ bool openSimStage(World* world, void* raw) {  // NRT
   }
   std::string error;
   data->ownsDevice = true;
-  data->device = kf::openSimDevice(spec, sim, hand, !world->mRealTime, &error).release();
+  data->device = kf::openSimDevice(spec, sim, hand, !world->mRealTime, &error, deviceOptionsOf(world, data)).release();
   if (data->device == nullptr) failWith(data, "kfOpenSim: %s", error.c_str());
   return data->device != nullptr;
 }
@@ -84,7 +124,9 @@ bool openReplayStage(World* world, void* raw) {  // NRT
   if (!applyOverrides(data, spec, nullptr, &replay)) return false;
   std::string error, warning;
   data->ownsDevice = true;
-  data->device = kf::openReplayDevice(data->args.path, spec, !world->mRealTime, error, {}, &warning, replay).release();
+  data->device = kf::openReplayDevice(data->args.path, spec, !world->mRealTime, error, deviceOptionsOf(world, data),
+                                      &warning, replay)
+                     .release();
   if (data->device == nullptr) failWith(data, "kfOpenReplay: %s", error.c_str());
   if (!warning.empty()) Print("kfOpenReplay: warning: %s\n", warning.c_str());
   return data->device != nullptr;
@@ -120,12 +162,56 @@ void recordCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, recordStage);
 }
 
+// The figures of the reply (statusStage).
+void fillStatusValues(const kf::Device& device, const kf::ThreadScheduling& usbThread, float* v) {
+  const kf::TelemetrySnapshot t = device.telemetry();
+  auto f = [](double value) { return static_cast<float>(value); };
+  v[kOpen] = 1.0f;
+  v[kRealtime] = device.isLockstep() ? 0.0f : 1.0f;
+  v[kDeviceThreadPriority] = f(t.deviceThread.priority);
+  v[kMouseThreadPriority] = f(t.mouseThread.priority);
+  v[kUsbThreadPriority] = f(usbThread.priority);
+  v[kMemoryLocked] = t.deviceThread.memoryLocked ? 1.0f : 0.0f;
+  v[kReports] = f(t.reports);
+  v[kFrames] = f(t.frames);
+  v[kWatchdogTrips] = f(t.watchdogTrips);
+  v[kMissedDeadlines] = f(t.missedDeadlines);
+  v[kSkippedFrames] = f(t.skippedFrames);
+  v[kLateFrames] = f(t.lateFrames);
+  v[kReportQueueOverflows] = f(t.reportQueueOverflows);
+  v[kFrameQueueOverflows] = f(t.frameQueueOverflows);
+  v[kLoopP50S] = f(t.pumpPeriod.p50S);
+  v[kLoopP99S] = f(t.pumpPeriod.p99S);
+  v[kLoopMaxS] = f(t.pumpPeriod.maxS);
+  v[kForceP50S] = f(t.forceLatency.p50S);
+  v[kForceP99S] = f(t.forceLatency.p99S);
+  v[kForceP999S] = f(t.forceLatency.p999S);
+  v[kForceMaxS] = f(t.forceLatency.maxS);
+  v[kReportP50S] = f(t.reportLatency.p50S);
+  v[kReportP99S] = f(t.reportLatency.p99S);
+  v[kReportMaxS] = f(t.reportLatency.maxS);
+  v[kReleaseLatencyS] = f(t.releaseLatencyS);
+  v[kReportIntervalS] = f(t.reportIntervalMeanS);
+  v[kReportJitterS] = f(t.reportIntervalJitterS);
+  v[kLastForceN] = t.lastCommandedForceN;
+}
+
+// The board's event thread, if the device has a board.
+kf::ThreadScheduling usbThreadOf(kf::Device& device) {
+  const std::shared_ptr<kf::ForceBackend> holder = device.board();
+  const auto* board = dynamic_cast<const kf::UsbBoardBackend*>(holder.get());
+  return board != nullptr ? board->threadScheduling() : kf::ThreadScheduling{};
+}
+
 bool statusStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
+  std::fill_n(data->replyValues, static_cast<int>(kStatusFields), 0.0f);
   if (data->device == nullptr) {
     Print("kfStatus %d: closed\n", data->args.index);
-    return true;
+    return true;  // replies kOpen 0
   }
+  const kf::ThreadScheduling usbThread = usbThreadOf(*data->device);
+  fillStatusValues(*data->device, usbThread, data->replyValues);
   const kf::TelemetrySnapshot t = data->device->telemetry();
   Print(
       "kfStatus %d: %s, reports %llu (interval %.3f ms, jitter %.3f ms), frames %llu, "
@@ -135,10 +221,17 @@ bool statusStage(World*, void* raw) {  // NRT
       static_cast<unsigned long long>(t.frames), t.lastCommandedForceN,
       static_cast<unsigned long long>(t.watchdogTrips), static_cast<unsigned long long>(t.reportQueueOverflows),
       static_cast<unsigned long long>(t.frameQueueOverflows));
+  if (!data->device->isLockstep()) {
+    std::string threads = "device " + kf::describe(t.deviceThread);
+    if (t.mouseThread.priority >= 0) threads += "; mouse " + kf::describe(t.mouseThread);
+    if (usbThread.priority >= 0) threads += "; usb " + kf::describe(usbThread);
+    Print("kfStatus %d: threads: %s; missed deadlines %llu, skipped frames %llu\n", data->args.index, threads.c_str(),
+          static_cast<unsigned long long>(t.missedDeadlines), static_cast<unsigned long long>(t.skippedFrames));
+  }
   auto line = [&](const char* what, const kf::LatencySummary& l) {
     if (l.count > 0)
-      Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu)\n", data->args.index, what, l.p50S * 1e3,
-            l.p99S * 1e3, l.maxS * 1e3, static_cast<unsigned long long>(l.count));
+      Print("kfStatus %d: %s p50 %.3f ms, p99 %.3f ms, max %.3f ms (n %llu), p99.9 %.3f ms\n", data->args.index, what,
+            l.p50S * 1e3, l.p99S * 1e3, l.maxS * 1e3, static_cast<unsigned long long>(l.count), l.p999S * 1e3);
   };
   line("loop period", t.pumpPeriod);
   line("report to UGen", t.reportLatency);
@@ -160,9 +253,19 @@ bool statusStage(World*, void* raw) {  // NRT
   return true;
 }
 
+// RT, at the end: the figures to every client that asked for notifications (sclang's default).
+void replyStatus(World* world, CommandData* data) {
+  // The plugin headers do not define Group; the server's starts with its Node (SC_Group.h).
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfStatus", kStatusFields,
+                data->replyValues);
+}
+
 void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   CommandData* data = newCommand(world, "kfStatus", CommandShape::kIndex, args);
-  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, statusStage);
+  if (data == nullptr) return;
+  std::fill_n(data->replyValues, static_cast<int>(kStatusFields), 0.0f);
+  data->onEnd = replyStatus;
+  run(world, replyAddr, data, nrtHop, lookUpDeviceStage, statusStage);
 }
 
 // --- kfClose -------------------------------------------------------------------------------

@@ -49,6 +49,9 @@ class FrictionOut : public SCUnit {
     if (device == nullptr) return;
     FrameSink sink{device, device->nowS(), clock.startS + kf::sc::blockDurationS(mWorld)};
     force->writerGone(clock, sink);
+    // The last writer gone (its synth freed, Cmd-., s.freeAll, the server quitting): the magnet
+    // goes off at the device's next pump, not after the watchdog's 10 ms.
+    if (force->registeredWriters() == 0) device->requestOff();
   }
 
  private:

@@ -102,7 +102,8 @@ bool openStage(World* world, void* raw) {  // NRT
   if (!applyOverrides(data, spec, nullptr, nullptr, "grab")) return false;
   std::string error;
   data->ownsDevice = true;
-  data->device = kf::openMouseDevice(options, spec, error).release();
+  data->device =
+      kf::openMouseDevice(options, spec, error, nullptr, nullptr, nullptr, deviceOptionsOf(world, data)).release();
   if (data->device == nullptr) {
     failWith(data, "kfOpenMouse: %s", error.c_str());
     return false;

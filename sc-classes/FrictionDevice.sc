@@ -327,6 +327,10 @@ FrictionDevice {
 	prepareForProxySynthDef { ^{ FrictionMouseIn.kr(index) } }
 
 	prOverrideArgs {
-		^overrides.asSortedArray.flatten(1).collect { |v| if(v.isKindOf(Symbol)) { v.asString } { v } }
+		// Sorted by name, but a lift's end after its start: the server takes them in order, and a
+		// liftEndS before any liftStartS is refused.
+		var pairs = overrides.asSortedArray;
+		pairs = pairs.reject { |p| p[0] == \liftEndS } ++ pairs.select { |p| p[0] == \liftEndS };
+		^pairs.flatten(1).collect { |v| if(v.isKindOf(Symbol)) { v.asString } { v } }
 	}
 }

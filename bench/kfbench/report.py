@@ -163,6 +163,25 @@ def e2e_section(e2e):
                   avg_cpu=", ".join(f"{r['avg_cpu']:.1f} %" for r in runs if r.get("avg_cpu") is not None))
 
 
+def rtload_section(rt):
+    rows = []
+    for r in rt["runs"]:
+        f, m = r["force"], r["mouse"]
+        rows.append((f"{r['rate'] // 1000} kHz / {r['period']}", r["condition"],
+                     f"{f['forceP50S'] * 1e3:.3f}", f"{f['forceP99S'] * 1e3:.3f}", f"{f['forceP999S'] * 1e3:.3f}",
+                     f"{f['forceMaxS'] * 1e3:.3f}", f"{(f['loopP99S'] - f['loopP50S']) * 1e3:.3f}",
+                     f"{f['loopMaxS'] * 1e3:.3f}", f"{f['missedDeadlines']:.0f}",
+                     f"{f['skippedFrames'] + f['frameQueueOverflows']:.0f}", f"{f['watchdogTrips']:.0f}",
+                     f"{m['reportP99S'] * 1e3:.3f}", f"{m['reportMaxS'] * 1e3:.3f}",
+                     f"{f['deviceThreadPriority']:.0f} / {m['mouseThreadPriority']:.0f}",
+                     f"{r['client_xruns']}"))
+    return render("rtload", cmd=CMD, seconds=rt["seconds"], load=rt["load"], priority=rt["jack_priority"],
+                  table=table(["rate / period", "scheduling", "force p50 (ms)", "p99", "p99.9", "max",
+                               "loop jitter p99 (ms)", "loop max (ms)", "missed deadlines", "missed frames",
+                               "watchdog trips", "report to UGen p99 (ms)", "max", "device / reader thread",
+                               "JACK xruns"], rows))
+
+
 def scale_section(sc):
     rates = []
     for rate, e in sc.items():
@@ -198,6 +217,7 @@ def write(results, path, build_dir="build"):
                       ("drift_test", lambda: drift_test_section(get("drift_test"))),
                       ("reconstruction", lambda: reconstruction_section(get("reconstruction"), build_dir)),
                       ("e2e", lambda: e2e_section(get("e2e"))),
+                      ("rtload", lambda: rtload_section(get("rtload"))),
                       ("scale", lambda: scale_section(get("scale"))),
                       ("log", lambda: log_section(get("log"), build_dir))):
         if get(key):

@@ -6,7 +6,7 @@ import time
 
 from kfharness import nrt
 
-from . import build, drift, goals, loudness, native, plots, realtime, report, scores, spatial, timing
+from . import build, drift, goals, loudness, native, plots, realtime, report, rtload, scores, spatial, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import key_numbers, summary_lines
 
@@ -92,7 +92,7 @@ def run_parts(bench, args, parts):
         log("reconstruction bench (3 runs)")
         results["reconstruction"] = native.run_reconstruction(bench)
         _print({"reconstruction": results["reconstruction"]})
-    if ("e2e" in parts or "scale" in parts) and not (bench.extension / "plugins").exists():
+    if ("e2e" in parts or "rtload" in parts or "scale" in parts) and not (bench.extension / "plugins").exists():
         raise SystemExit(f"no extension folder at {bench.extension}: run scripts/setup.sh (or --only build)")
     if "e2e" in parts:
         runs = []
@@ -100,6 +100,8 @@ def run_parts(bench, args, parts):
             log(f"realtime end to end, run {i + 1} of {args.e2e_runs} ({args.e2e_s:.0f} s)")
             runs.append(realtime.run_e2e(bench, seconds=args.e2e_s))
         results["e2e"] = {"runs": runs, "seconds": args.e2e_s}
+    if "rtload" in parts:
+        results["rtload"] = rtload.run_all(bench, seconds=args.rtload_s)
     if "scale" in parts:
         results["scale"] = {str(rate): realtime.run_scale_searches(bench, rate, args.scale_runs)
                             for rate in (48000, 192000)}

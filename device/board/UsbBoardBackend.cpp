@@ -316,6 +316,7 @@ void UsbBoardBackend::dropHandle() {
 }
 
 void UsbBoardBackend::run() {
+  threadScheduling_.store(scheduleThisThread("usb", options_.thread));
   submitIdle();
   while (!stopping_.load()) {
     if (connected_.load()) {

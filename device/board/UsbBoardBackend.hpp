@@ -20,6 +20,7 @@
 #include "board/BoardProtocol.hpp"
 #include "board/UsbPort.hpp"
 #include "core/ForceBackend.hpp"
+#include "core/ThreadScheduling.hpp"
 
 namespace kf {
 
@@ -32,6 +33,7 @@ struct BoardOptions {
   // commandForce (no drive given): the linear map of an uncalibrated board.
   double minForceN = 0.14;
   double maxForceN = 1.4;
+  ThreadRequest thread;  // the event thread (kf-usb-<slot>): the device's request
 };
 
 struct BoardTelemetry {
@@ -75,6 +77,7 @@ class UsbBoardBackend : public ForceBackend {
   void driveOff() override;
 
   BoardTelemetry telemetry() const;
+  ThreadScheduling threadScheduling() const { return threadScheduling_.load(); }
   uint16_t latestDrive() const { return latestDrive_.load(std::memory_order_relaxed); }
 
  private:
@@ -119,6 +122,7 @@ class UsbBoardBackend : public ForceBackend {
   std::atomic<bool> stopping_{false};
   std::atomic<bool> opened_{false};
   std::thread thread_;
+  ThreadSchedulingCell threadScheduling_;
   std::mutex wakeMutex_;
   std::condition_variable wake_;
 

@@ -23,7 +23,8 @@ Device::Device(const DeviceSpec& spec, std::shared_ptr<MouseBackend> mouse, std:
       frameQueue_(options.frameQueueCapacity),
       safety_(spec),
       pending_(std::max<size_t>(options.frameQueueCapacity, 1)),
-      releaseLatencyS_(options.forceLatencyS),
+      releaseLatencyS_(
+          std::min(spec.forceFramePeriodS + options.audioPeriodS + options.pumpPeriodS, options.maxForceLatencyS)),
       startTime_(std::chrono::steady_clock::now()) {
   telemetry_.setCommandedForce(static_cast<float>(spec.minForceN));
   telemetry_.setReleaseLatency(releaseLatencyS_);
@@ -34,26 +35,38 @@ Device::~Device() { close(); }
 void Device::start() {
   if (lockstep_ || options_.externalPump || thread_.joinable() || isClosed()) return;
   stopRequested_.store(false);
+  memoryLocked_ = options_.thread.priority != kNormalPriority && lockProcessMemory();
   startTime_ = std::chrono::steady_clock::now();
   thread_ = std::thread([this] { threadMain(); });
 }
 
 void Device::threadMain() {
+  ThreadScheduling scheduling = scheduleThisThread("device", options_.thread);
+  scheduling.memoryLocked = memoryLocked_;
+  threadScheduling_.store(scheduling);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point openTime = startTime_;
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.pumpPeriodS));
   Clock::time_point next = openTime;
   while (!stopRequested_.load(std::memory_order_acquire)) {
     next += period;
-    std::this_thread::sleep_until(next);
+    sleepUntil(next);
     const Clock::time_point now = Clock::now();
-    // After a long stall, do not try to catch up with a burst of pumps.
-    if (now - next > 10 * period) next = now;
+    const double scheduledS = std::chrono::duration<double>(next - openTime).count();
+    // Woken a whole period or more late: the deadlines passed meanwhile are missed, not caught
+    // up with a burst of pumps; the next one is the grid's next after now. This pump judges
+    // the frames against the deadline it missed and releases the newest that came due, not a
+    // burst of stale force (releaseFramesLocked).
+    if (now - next >= period) {
+      const auto missed = (now - next) / period;
+      telemetry_.countMissedDeadlines(static_cast<uint64_t>(missed));
+      next += missed * period;
+    }
     const double nowS = std::chrono::duration<double>(now - openTime).count();
     if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
     std::lock_guard<std::mutex> lock(stateMutex_);
     try {
-      pumpLocked(nowS);
+      pumpLocked(nowS, scheduledS);
     } catch (const std::exception& e) {
       failThread(e.what());
       return;
@@ -83,17 +96,17 @@ void Device::failThread(const char* what) noexcept {
   }
 }
 
-void Device::pump(double nowS) {
+void Device::pump(double nowS, double scheduledS) {
   if (options_.externalPump && !lockstep_ && !isClosed()) {
     std::lock_guard<std::mutex> lock(stateMutex_);
-    pumpLocked(nowS);
+    pumpLocked(nowS, scheduledS < 0.0 ? nowS : std::min(scheduledS, nowS));
     return;
   }
   if (!lockstep_ || isClosed()) return;
   // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
   std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
-  pumpLocked(nowS - lockstepOriginS_);
+  pumpLocked(nowS - lockstepOriginS_, nowS - lockstepOriginS_);
 }
 
 void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double nowS) {
@@ -116,16 +129,20 @@ void Device::applyLockstepFrameLocked(const ForceFrame& frame, double nowS) {
   applyFrameLocked(frame, commandS, nowS);
 }
 
-void Device::takeFramesLocked(double nowS) {
+void Device::takeFramesLocked(double nowS, double scheduledS) {
   const double periodS = spec_.forceFramePeriodS;
   ForceFrame frame;
   while (frameQueue_.pop(frame)) {
     double startS = std::isfinite(frame.endedHostS) ? frame.endedHostS - periodS : frame.timeS;
     if (!std::isfinite(startS)) startS = nowS;
     // A frame later than the latency allows raises it, so the frames after it keep their
-    // spacing instead of going out in a burst (a long audio period).
-    const double latenessS = nowS - startS;
+    // spacing instead of going out in a burst (a long audio period). Lateness counts to when
+    // the pump was due: a late pump's own delay is no reason to hold every later frame back.
+    const double latenessS = scheduledS - startS;
     windowLatenessS_ = std::max(windowLatenessS_, latenessS);
+    // The first frame replaces the estimate made before any was measured (DeviceOptions).
+    if (!latencyMeasured_) releaseLatencyS_ = std::clamp(latenessS, spec_.forceFramePeriodS, options_.maxForceLatencyS);
+    latencyMeasured_ = true;
     releaseLatencyS_ = std::max(releaseLatencyS_, std::min(latenessS, options_.maxForceLatencyS));
     if (pendingCount_ == pending_.size()) {
       // Full: the oldest goes out now rather than being lost.
@@ -145,34 +162,49 @@ void Device::settleLatencyLocked(double nowS) {
     windowLatenessS_ = 0.0;
     windowEndS_ = nowS + kLatencyWindowS;
   }
-  // Down to what the frames of the last 0.5 to 1 s needed, never below the base, by 5 % of the
+  // No frame in the last 0.5 to 1 s: nothing measured, the latency holds (at open, what a frame
+  // can need before any is measured).
+  if (windowLatenessS_ == 0.0 && previousWindowLatenessS_ == 0.0) return;
+  // Down to what the frames of the last 0.5 to 1 s needed, never below a frame period, by 5 % of the
   // time since the last pump: one stall must not hold the force latency up for the rest of the session.
-  const double neededS = std::min(std::max({options_.forceLatencyS, windowLatenessS_, previousWindowLatenessS_}),
+  const double neededS = std::min(std::max({spec_.forceFramePeriodS, windowLatenessS_, previousWindowLatenessS_}),
                                   options_.maxForceLatencyS);
-  const double stepS = kLatencyDecayRate * std::max(nowS - lastPumpS_, 0.0);
+  const double stepS = lastPumpS_ < 0.0 ? 0.0 : kLatencyDecayRate * std::max(nowS - lastPumpS_, 0.0);
   if (releaseLatencyS_ > neededS) releaseLatencyS_ = std::max(neededS, releaseLatencyS_ - stepS);
 }
 
-int Device::releaseFramesLocked(double nowS) {
+int Device::releaseFramesLocked(double nowS, bool latePump) {
   const double periodS = spec_.forceFramePeriodS;
+  // The pump nearest the due time releases a frame: due times on the pump grid would otherwise
+  // split between two pumps at the slightest wake-up jitter.
+  auto isDue = [&](const PendingFrame& pending) {
+    return pending.startS + releaseLatencyS_ <= nowS + 0.5 * options_.pumpPeriodS;
+  };
   int released = 0;
-  while (pendingCount_ > 0) {
+  while (pendingCount_ > 0 && isDue(pending_[pendingHead_])) {
     const PendingFrame& pending = pending_[pendingHead_];
     const double dueS = pending.startS + releaseLatencyS_;
-    // The pump nearest the due time releases it: due times on the pump grid would otherwise
-    // split between two pumps at the slightest wake-up jitter.
-    if (dueS > nowS + 0.5 * options_.pumpPeriodS) break;
+    const size_t after = (pendingHead_ + 1) % pending_.size();
+    const bool newerDue = pendingCount_ > 1 && isDue(pending_[after]);
+    pendingHead_ = after;
+    --pendingCount_;
+    // A pump that missed deadlines (the device thread held up) sends the newest frame due and
+    // skips the older ones: the magnet gets the force of now at once, not a burst of stale
+    // set-points that the newest would overwrite within microseconds. An on-time pump finds two
+    // due only while the release latency comes down; both go (FrictionOut's frames, recorded).
+    if (latePump && newerDue) {
+      telemetry_.countSkippedFrame();
+      continue;
+    }
     telemetry_.frameOffset.record(std::abs(nowS - dueS));
     if (nowS - dueS > periodS) telemetry_.countLateFrame();
     applyFrameLocked(pending.frame, nowS, nowS);
-    pendingHead_ = (pendingHead_ + 1) % pending_.size();
-    --pendingCount_;
     ++released;
   }
   return released;
 }
 
-void Device::pumpLocked(double nowS) {
+void Device::pumpLocked(double nowS, double scheduledS) {
   // Announce the pump before looking at halted_ (both sequentially consistent): either
   // emergencyOff() sees this pump and waits for it, or this pump sees the halt.
   pumping_.store(true);
@@ -183,13 +215,14 @@ void Device::pumpLocked(double nowS) {
   if (halted_.load()) return;
   if (!(nowS > lastPumpS_)) return;
 
+  if (offRequested_.exchange(false, std::memory_order_acq_rel)) applyOffRequestLocked(nowS);
   if (lockstep_) {
     ForceFrame frame;  // only frames whose push found the state busy
     while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
   } else {
-    takeFramesLocked(nowS);
+    takeFramesLocked(nowS, scheduledS);
     settleLatencyLocked(nowS);
-    const int released = releaseFramesLocked(nowS);
+    const int released = releaseFramesLocked(nowS, nowS - scheduledS >= options_.pumpPeriodS);
     if (released > 0 || pendingCount_ > 0) telemetry_.countReleases(released);
     telemetry_.setReleaseLatency(releaseLatencyS_);
   }
@@ -222,6 +255,27 @@ void Device::pumpLocked(double nowS) {
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
+}
+
+void Device::requestOff() {
+  offRequested_.store(true, std::memory_order_release);
+  if (!lockstep_ || isClosed()) return;
+  std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+  if (lock.owns_lock() && lastPumpS_ >= 0.0 && offRequested_.exchange(false, std::memory_order_acq_rel))
+    applyOffRequestLocked(lastPumpS_);
+}
+
+void Device::applyOffRequestLocked(double nowS) {
+  ForceFrame dropped;
+  while (frameQueue_.pop(dropped)) {
+  }
+  pendingCount_ = 0;
+  force_->driveOff();
+  if (board_) board_->driveOff();
+  safety_.resetToOff();
+  telemetry_.countOrderlyOff();
+  telemetry_.setCommandedForce(safety_.commandedForceN());
+  recorder_.writeOff(nowS);
 }
 
 void Device::close() {
@@ -297,6 +351,8 @@ double Device::heatEstimate() {
 
 TelemetrySnapshot Device::telemetry() const {
   TelemetrySnapshot snapshot = telemetry_.snapshot();
+  snapshot.deviceThread = threadScheduling_.load();
+  snapshot.mouseThread = mouse_->readerScheduling();
   snapshot.reportQueueOverflows = reportQueue_.overflows();
   snapshot.frameQueueOverflows = frameQueue_.overflows();
   return snapshot;

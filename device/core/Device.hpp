@@ -28,15 +28,22 @@ struct DeviceOptions {
   size_t reportQueueCapacity = 1024;  // 8 s of 125 Hz reports
   size_t frameQueueCapacity = 1024;   // 1 s of 1 kHz frames
   double pumpPeriodS = 0.001;         // realtime: how often the thread pumps
-  // Realtime: each force frame goes to the magnet at its own device time, its start plus this
-  // latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut framed
-  // them. A frame that arrives later than that (a long audio period, a late audio thread)
-  // raises the latency to its lateness (so it goes out now), up to maxForceLatencyS: the frames
-  // after it keep their spacing instead of coming in bursts. Once no frame of the last 0.5 to 1 s
-  // needed it, it comes back down by 5 % of the time passing (frames 0.95 ms apart meanwhile), so a stall
-  // does not keep it raised, while long audio periods, whose every burst needs it, keep it.
-  double forceLatencyS = 0.002;
+  // Realtime: each force frame goes to the magnet at its own device time, its start plus a
+  // release latency (a jitter buffer), so the magnet gets one set-point per ms as FrictionOut
+  // framed them. The latency is what the frames are measured to need, from the first frame on;
+  // before it, the estimate of what one can need: its own period, the audio period that carries
+  // it (audioPeriodS, the host's; 0 unknown) and the pump that picks it up. A frame later than the latency (a long
+  // audio period, a late audio thread) raises it to its lateness (so it goes out now), up to
+  // maxForceLatencyS: the frames after it keep their spacing instead of coming in bursts. Once
+  // no frame of the last 0.5 to 1 s needed it, it comes back down by 5 % of the time passing
+  // (frames 0.95 ms apart meanwhile), to what they needed, never below one frame period (a
+  // frame goes out complete). So a stall does not keep it raised, long audio periods, whose
+  // every burst needs it, keep it, and with realtime threads it stays small.
+  double audioPeriodS = 0.0;
   double maxForceLatencyS = 0.1;
+  // The device thread (realtime): its name's slot and its priority (ThreadScheduling). The
+  // mouse reader and USB threads of the device take the same request.
+  ThreadRequest thread;
   // Tests: a realtime device (jitter buffer, watchdog) without its thread, pumped by the
   // caller through pump(nowS) on a clock of its own (nowS() is the last pumped time).
   bool externalPump = false;
@@ -61,7 +68,10 @@ class Device {
   // through ForceSafety to the force backend, the watchdog, reports up to nowS into the audio queue, recording. Does
   // nothing for nowS <= the last pumped time (several UGens may call it), while the state is being changed (recording
   // started/stopped), after close, and in realtime mode (where the device thread is the only pumper).
-  void pump(double nowS);
+  // scheduledS (externalPump): when this pump was due, if it runs late, as the device thread
+  // passes the deadline it missed; frames are judged late against it, so the pumper's own
+  // lateness does not raise the release latency (the stale frames are skipped instead).
+  void pump(double nowS, double scheduledS = -1.0);
 
   // Audio side (one consumer / one producer thread): never allocate, lock or wait.
   // popReports also measures, in realtime, how long each report waited in the queue.
@@ -70,6 +80,12 @@ class Device {
   // frame goes through the safety path at once (try_lock; queued when that fails), and
   // commandedForceN() tells at once what it became.
   bool pushForceFrame(const ForceFrame& frame);
+  // Magnet off now, as an orderly stop asks (the last FrictionOut of the slot freed: a synth
+  // freed, Cmd-., s.freeAll, /quit): any thread, never waits. Realtime: the next pump (within a
+  // pump period) drops the frames not yet sent, drives the magnet off and records the off,
+  // before the watchdog would. Lockstep: at once (try_lock; else at the next pump). Frames that
+  // come after it drive the magnet again.
+  void requestOff();
   // The force last sent to the magnet after the safety path (watchdog trips and close too).
   float commandedForceN() const { return telemetry_.commandedForceN(); }
   // The device clock: seconds since start() in realtime (steady clock, any thread, no lock);
@@ -77,6 +93,7 @@ class Device {
   double nowS() const;
 
   const DeviceSpec& spec() const { return spec_; }
+  const DeviceOptions& options() const { return options_; }
   bool isLockstep() const { return lockstep_; }
   // Lockstep: the audio time at which the device opened, its time 0 (as a realtime device's
   // clock starts at open). pump() takes audio time and subtracts it. Set before first use.
@@ -121,7 +138,9 @@ class Device {
     double startS;  // the frame's start on the device clock
   };
 
-  void pumpLocked(double nowS);
+  void pumpLocked(double nowS, double scheduledS);
+  // requestOff() in the pump: the frames not sent dropped, the magnet off, the off recorded.
+  void applyOffRequestLocked(double nowS);
   void threadMain();
   // The device thread caught an exception from a backend: magnet off, recording closed.
   void failThread(const char* what) noexcept;
@@ -129,9 +148,9 @@ class Device {
   void applyFrameLocked(const ForceFrame& frame, double commandS, double nowS);
   void applyLockstepFrameLocked(const ForceFrame& frame, double nowS);
   // Realtime jitter buffer: queue -> pending (with release times), then the due ones out.
-  void takeFramesLocked(double nowS);
+  void takeFramesLocked(double nowS, double scheduledS);
   void settleLatencyLocked(double nowS);
-  int releaseFramesLocked(double nowS);
+  int releaseFramesLocked(double nowS, bool latePump);
 
   const DeviceSpec spec_;
   const bool lockstep_;
@@ -155,6 +174,7 @@ class Device {
   size_t pendingHead_ = 0;
   size_t pendingCount_ = 0;
   double releaseLatencyS_;
+  bool latencyMeasured_ = false;  // a frame has set releaseLatencyS_
   // The largest lateness of the frames taken in this window and the one before (seconds).
   double windowLatenessS_ = 0.0, previousWindowLatenessS_ = 0.0;
   double windowEndS_ = 0.0;
@@ -164,7 +184,10 @@ class Device {
   std::chrono::steady_clock::time_point startTime_;  // device time 0; reset by start()
   std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads
   std::thread thread_;
+  ThreadSchedulingCell threadScheduling_;
+  bool memoryLocked_ = false;  // by start(), before the thread
   std::atomic<bool> stopRequested_{false};
+  std::atomic<bool> offRequested_{false};  // requestOff()
   std::atomic<bool> closed_{false};
   // emergencyOff(): no pump runs any more (halted_), and none is under way (pumping_).
   std::atomic<bool> halted_{false};

@@ -46,12 +46,12 @@ class LatencyHistogram {
   std::atomic<double> maxS_{0.0};
 };
 
-// p50, p99 and max of a histogram, for snapshots.
+// p50, p99, p99.9 and max of a histogram, for snapshots.
 struct LatencySummary {
   uint64_t count = 0;
-  double p50S = 0.0, p99S = 0.0, maxS = 0.0;
+  double p50S = 0.0, p99S = 0.0, maxS = 0.0, p999S = 0.0;
   static LatencySummary of(const LatencyHistogram& h) {
-    return {h.count(), h.quantileS(0.50), h.quantileS(0.99), h.maxS()};
+    return {h.count(), h.quantileS(0.50), h.quantileS(0.99), h.maxS(), h.quantileS(0.999)};
   }
 };
 

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "core/ThreadScheduling.hpp"
 #include "core/spec/Report.hpp"
 
 namespace kf {
@@ -18,6 +19,8 @@ class MouseBackend {
   // A line for kfStatus about the source itself (a real mouse: state, losses); empty for none.
   // Non-realtime threads only.
   virtual std::string statusLine() const { return {}; }
+  // How the backend's own reader thread is scheduled; "not started" for backends without one.
+  virtual ThreadScheduling readerScheduling() const { return {}; }
 };
 
 }  // namespace kf

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "core/LatencyHistogram.hpp"
+#include "core/ThreadScheduling.hpp"
 
 namespace kf {
 
@@ -31,6 +32,14 @@ struct TelemetrySnapshot {
   LatencySummary frameOffset;
   double releaseLatencyS = 0.0;
   uint64_t lateFrames = 0;
+  // Realtime: 1 ms deadlines the device thread woke a whole period or more after (each
+  // period counted), and frames it skipped rather than send stale in a burst after such a wake.
+  uint64_t missedDeadlines = 0;
+  uint64_t skippedFrames = 0;
+  uint64_t orderlyOffs = 0;  // requestOff() carried out: the last writer went away
+  // How the device thread and the mouse's reader thread are scheduled (ThreadScheduling).
+  ThreadScheduling deviceThread;
+  ThreadScheduling mouseThread;
 };
 
 class Telemetry {
@@ -51,6 +60,9 @@ class Telemetry {
   // Device thread: one pump released `count` frames while frames were flowing.
   void countReleases(int count) { framesPerPump_[count < 3 ? count : 3].fetch_add(1, std::memory_order_relaxed); }
   void countLateFrame() { lateFrames_.fetch_add(1, std::memory_order_relaxed); }
+  void countMissedDeadlines(uint64_t count) { missedDeadlines_.fetch_add(count, std::memory_order_relaxed); }
+  void countSkippedFrame() { skippedFrames_.fetch_add(1, std::memory_order_relaxed); }
+  void countOrderlyOff() { orderlyOffs_.fetch_add(1, std::memory_order_relaxed); }
   void setReleaseLatency(double latencyS) { releaseLatencyS_.store(latencyS, std::memory_order_relaxed); }
   float commandedForceN() const { return lastCommandedForceN_.load(std::memory_order_relaxed); }
 
@@ -73,6 +85,9 @@ class Telemetry {
   std::atomic<uint64_t> pumps_{0};
   std::atomic<uint64_t> framesPerPump_[4] = {};
   std::atomic<uint64_t> lateFrames_{0};
+  std::atomic<uint64_t> missedDeadlines_{0};
+  std::atomic<uint64_t> skippedFrames_{0};
+  std::atomic<uint64_t> orderlyOffs_{0};
   std::atomic<double> releaseLatencyS_{0.0};
 };
 
@@ -111,6 +126,9 @@ inline TelemetrySnapshot Telemetry::snapshot() const {
   s.frameOffset = LatencySummary::of(frameOffset);
   s.releaseLatencyS = releaseLatencyS_.load(std::memory_order_relaxed);
   s.lateFrames = lateFrames_.load(std::memory_order_relaxed);
+  s.missedDeadlines = missedDeadlines_.load(std::memory_order_relaxed);
+  s.skippedFrames = skippedFrames_.load(std::memory_order_relaxed);
+  s.orderlyOffs = orderlyOffs_.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -21,12 +21,13 @@ bool atFieldLimit(int32_t value) {
 }  // namespace
 
 std::unique_ptr<EvdevMouseBackend> EvdevMouseBackend::open(std::shared_ptr<EvdevApi> api, const std::string& which,
-                                                           bool grab, std::string& error, OpenFailure* why) {
+                                                           bool grab, std::string& error, OpenFailure* why,
+                                                           const ThreadRequest& thread) {
   if (why) *why = OpenFailure::kOther;
   std::vector<MouseInfo> mice;
   if (!api->enumerateMice(mice, error)) return nullptr;
   std::unique_ptr<EvdevMouseBackend> backend(new EvdevMouseBackend(std::move(api), grab));
-  if (!backend->openSelected(mice, which, error, why)) return nullptr;
+  if (!backend->openSelected(mice, which, error, why, thread)) return nullptr;
   return backend;
 }
 

@@ -16,9 +16,10 @@ namespace kf {
 class EvdevMouseBackend : public RealMouseBackend {
  public:
   // Enumerates, selects (MouseSelect's `which`), opens, sets the clock, grabs if asked, starts
-  // the reader. Null with a message (and why) on failure.
+  // the reader (scheduled as `thread` asks). Null with a message (and why) on failure.
   static std::unique_ptr<EvdevMouseBackend> open(std::shared_ptr<EvdevApi> api, const std::string& which, bool grab,
-                                                 std::string& error, OpenFailure* why = nullptr);
+                                                 std::string& error, OpenFailure* why = nullptr,
+                                                 const ThreadRequest& thread = {});
   ~EvdevMouseBackend() override { stop(); }
   std::string kindName() const override { return "evdev"; }
   // False when the kernel would not stamp with CLOCK_MONOTONIC: then arrival times are used.

@@ -5,12 +5,13 @@
 namespace kf {
 
 std::unique_ptr<HidapiMouseBackend> HidapiMouseBackend::open(std::shared_ptr<HidApi> api, const std::string& which,
-                                                             std::string& error, OpenFailure* why) {
+                                                             std::string& error, OpenFailure* why,
+                                                             const ThreadRequest& thread) {
   if (why) *why = OpenFailure::kOther;
   std::vector<MouseInfo> mice;
   if (!api->enumerateMice(mice, error)) return nullptr;
   std::unique_ptr<HidapiMouseBackend> backend(new HidapiMouseBackend(std::move(api)));
-  if (!backend->openSelected(mice, which, error, why)) return nullptr;
+  if (!backend->openSelected(mice, which, error, why, thread)) return nullptr;
   return backend;
 }
 

@@ -17,9 +17,10 @@ class HidapiMouseBackend : public RealMouseBackend {
   static constexpr int kKernelQueueReports = 64;  // hidraw's HIDRAW_BUFFER_SIZE
 
   // Enumerates, selects (MouseSelect's `which`), opens, reads the descriptor, starts the
-  // reader. Null with a message (and why) on failure.
+  // reader (scheduled as `thread` asks). Null with a message (and why) on failure.
   static std::unique_ptr<HidapiMouseBackend> open(std::shared_ptr<HidApi> api, const std::string& which,
-                                                  std::string& error, OpenFailure* why = nullptr);
+                                                  std::string& error, OpenFailure* why = nullptr,
+                                                  const ThreadRequest& thread = {});
   ~HidapiMouseBackend() override { stop(); }
   std::string kindName() const override { return "hidapi"; }
 

@@ -11,11 +11,12 @@ RealMouseBackend::RealMouseBackend() : originS_(monotonicNowS()), queue_(kQueueC
 RealMouseBackend::~RealMouseBackend() { stop(); }
 
 bool RealMouseBackend::openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error,
-                                    OpenFailure* why) {
+                                    OpenFailure* why, const ThreadRequest& thread) {
   OpenFailure failure = OpenFailure::kOther;
   MouseInfo info;
   const bool opened = selectMouse(mice, which, info, error) && openInfo(info, error, failure);
   if (why) *why = opened ? OpenFailure::kNone : failure;
+  threadRequest_ = thread;
   if (opened) startReader();
   return opened;
 }
@@ -33,6 +34,7 @@ void RealMouseBackend::stop() {
 }
 
 void RealMouseBackend::threadMain() {
+  readerScheduling_.store(scheduleThisThread("mouse", threadRequest_));
   bool open = true;
   while (!stopRequested_.load(std::memory_order_acquire)) {
     if (!open) {

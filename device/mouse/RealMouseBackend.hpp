@@ -65,6 +65,7 @@ class RealMouseBackend : public MouseBackend {
   // One line for kfStatus.
   std::string describe() const;
   std::string statusLine() const override { return describe(); }
+  ThreadScheduling readerScheduling() const override { return readerScheduling_.load(); }
   virtual std::string kindName() const = 0;
   // The mouse open now (it may change at a re-open). Any non-realtime thread.
   MouseInfo info() const;
@@ -82,8 +83,10 @@ class RealMouseBackend : public MouseBackend {
   virtual bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) = 0;
 
   // Every kind's open(), once its API has listed `mice`: selects `which` (MouseSelect), opens
-  // it and starts the reader. False with a message; *why (if given) says why.
-  bool openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error, OpenFailure* why);
+  // it and starts the reader, scheduled as `thread` asks (named kf-mouse-<slot>). False with a
+  // message; *why (if given) says why.
+  bool openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error, OpenFailure* why,
+                    const ThreadRequest& thread);
 
   void emit(MouseReport report);  // reader thread; counts, measures, queues
   void countLoss() { lossEvents_.fetch_add(1, std::memory_order_relaxed); }
@@ -99,6 +102,8 @@ class RealMouseBackend : public MouseBackend {
   SpscQueue<MouseReport> queue_;
   ReportRateEstimator rate_;
   std::thread thread_;
+  ThreadRequest threadRequest_;
+  ThreadSchedulingCell readerScheduling_;
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> reopenRequested_{false};
   std::atomic<int> state_{static_cast<int>(MouseState::kStopped)};

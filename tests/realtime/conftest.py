@@ -1,11 +1,17 @@
 """What every realtime test file shares: `jack`, a JACK server of its own on the dummy driver
-(unique name), started for the test and stopped after it by its process."""
+(unique name), started for the test and stopped after it by its process. Where this user may
+use realtime scheduling it runs as a performer's would (`jackd -R`): its and scsynth's audio
+threads SCHED_FIFO, and the device's threads above them (ThreadScheduling), so that the tests'
+timing holds on a busy machine (scripts/realtime-under-load.sh)."""
 import pytest
 
 from kfharness.jack import JackServer
+from kfharness.load import realtime_allowed
+
+REALTIME_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the device threads at 66
 
 
 @pytest.fixture
 def jack():
-    with JackServer() as server:
+    with JackServer(realtime_priority=REALTIME_PRIORITY if realtime_allowed() else None) as server:
         yield server

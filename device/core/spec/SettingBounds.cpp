@@ -26,6 +26,8 @@ constexpr SettingBounds kBounds[] = {
     {"maxDriveLevel", 1e-3, 1.0, false, "of full-scale drive"},
     {"heatTimeConstantS", 0.01, 1e5, false, "s"},
     {"heatRatedDuty", 1e-3, 1.0, false, "of full-scale drive squared"},
+    // DeviceOptions: the device's threads, -1 auto, 0 normal scheduling, 1..98 SCHED_FIFO
+    {"threadPriority", -1.0, 98.0, true, ""},
     // ReplayOptions
     {"startS", 0.0, 1e6, false, "s"},
     {"rate", 0.01, 100.0, false, ""},  // a replay at 1/100 .. 100 times the recorded speed
@@ -62,6 +64,15 @@ const SettingBounds* findSettingBounds(std::string_view name) {
 bool isWithinBounds(const SettingBounds& bounds, double value) {
   return std::isfinite(value) && value >= bounds.min && value <= bounds.max &&
          (!bounds.integer || value == std::floor(value));
+}
+
+double snapToBounds(std::string_view name, double value) {
+  const SettingBounds* bounds = findSettingBounds(name);
+  if (bounds == nullptr || !std::isfinite(value)) return value;
+  const float asSent = static_cast<float>(value);
+  if (asSent == static_cast<float>(bounds->min)) return bounds->min;
+  if (asSent == static_cast<float>(bounds->max)) return bounds->max;
+  return value;
 }
 
 std::string checkSetting(std::string_view name, double value) {

@@ -24,6 +24,11 @@ const SettingBounds* findSettingBounds(std::string_view name);
 // True when `value` is finite, within the bounds (and whole if it must be).
 bool isWithinBounds(const SettingBounds& bounds, double value);
 
+// A value sent as a 32-bit float (as sclang sends numbers) that is a bound at that precision
+// becomes the bound: "countMm 0.0001" from sclang arrives as 1.0000000e-4f, below the double
+// 1e-4, and a bound the help writes must be accepted as written. Other values are unchanged.
+double snapToBounds(std::string_view name, double value);
+
 // Empty when the value is allowed; otherwise a message naming field, value and range, e.g.
 // "countMm = 1e+300 is out of range 0.0001..10 mm". Unknown names give "unknown setting".
 std::string checkSetting(std::string_view name, double value);

@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/spec/DeviceSpec.hpp"
+#include "core/spec/SettingBounds.hpp"
 #include "sim/SimParams.hpp"
 
 using namespace kf;
@@ -53,4 +57,29 @@ TEST_CASE("sim parameter overrides by key", "[spec]") {
   REQUIRE(params.liftIntervalsS.size() == 1);
   CHECK(params.liftIntervalsS[0].second == 1.5);
   CHECK_FALSE(params.applyOverride("unknown", 1.0));
+}
+
+TEST_CASE("a bound sent as a 32-bit float is the bound: as written in the help, it is accepted", "[spec]") {
+  // sclang sends 0.0001 as the float nearest it, 1.00000005e-4 here but below 1e-4 for others:
+  // each documented bound of the report, as sent, is taken as the bound itself.
+  for (const auto& [name, bound] : std::vector<std::pair<const char*, double>>{{"countMm", 1e-4},
+                                                                               {"forceFramePeriodS", 1e-4},
+                                                                               {"stepS", 1e-6},
+                                                                               {"maxForceSlewNPerS", 0.01},
+                                                                               {"heatTimeConstantS", 0.01},
+                                                                               {"watchdogS", 0.002},
+                                                                               {"maxDriveLevel", 1e-3}}) {
+    INFO(name);
+    const double sent = static_cast<float>(bound);
+    CHECK(snapToBounds(name, sent) == bound);
+    CHECK(checkSetting(name, snapToBounds(name, sent)).empty());
+    // The next float outside stays outside, and is refused.
+    const double outside = std::nextafter(static_cast<float>(bound), 0.0f);
+    CHECK(snapToBounds(name, outside) == outside);
+    CHECK_FALSE(checkSetting(name, snapToBounds(name, outside)).empty());
+  }
+  CHECK(snapToBounds("maxForceN", static_cast<float>(50.0)) == 50.0);  // the upper bounds too
+  CHECK(snapToBounds("countMm", 0.021) == 0.021);                      // others unchanged
+  CHECK(std::isnan(snapToBounds("countMm", std::nan(""))));
+  CHECK(snapToBounds("noSuchSetting", 1e-4) == 1e-4);
 }

@@ -23,6 +23,9 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   std::atomic<bool> stop{false};
   std::atomic<int> pushed{0};
   std::thread audio([&] {  // stands in for FrictionOut: one frame per ms
+    // Realtime where allowed, below the device thread, as scsynth's audio thread is: at normal
+    // priority two CPU hogs hold it up past the 10 ms watchdog.
+    scheduleThisThread("audio", {0, kFallbackPriority - 1});
     int frame = 0;
     auto next = std::chrono::steady_clock::now();
     while (!stop.load()) {
@@ -44,7 +47,7 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   audio.join();
   // Let the thread take the last frames (bounded wait, for loaded machines).
   const auto waitStart = std::chrono::steady_clock::now();
-  while (device.telemetry().frames < static_cast<uint64_t>(pushed.load()) &&
+  while (device.telemetry().frames + device.telemetry().skippedFrames < static_cast<uint64_t>(pushed.load()) &&
          std::chrono::steady_clock::now() - waitStart < 2s)
     std::this_thread::sleep_for(1ms);
   const TelemetrySnapshot telemetry = device.telemetry();
@@ -59,8 +62,10 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   for (size_t i = 1; i < reports.size(); ++i)
     CHECK(reports[i].deviceTimeS - reports[i - 1].deviceTimeS == Approx(0.008));
   CHECK(pushed.load() > 150);
-  CHECK(telemetry.frames == static_cast<uint64_t>(pushed.load()));
-  CHECK(sink->commands() == static_cast<uint64_t>(pushed.load()));
+  // Every frame reached the magnet but those a pump that missed its deadlines skipped as stale.
+  CHECK(telemetry.frames + telemetry.skippedFrames == static_cast<uint64_t>(pushed.load()));
+  CHECK(telemetry.skippedFrames <= telemetry.missedDeadlines + 1);
+  CHECK(sink->commands() == telemetry.frames);
   CHECK(sink->lastForceN() == 0.3f);
   CHECK(telemetry.watchdogTrips == 0);
   CHECK(telemetry.reportQueueOverflows == 0);

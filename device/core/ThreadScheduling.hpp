@@ -1,0 +1,81 @@
+// ThreadScheduling: how a thread of ours with a deadline (the device thread, a mouse reader, the
+// USB event thread) asks to run as a realtime citizen, as JACK's and scsynth's audio threads do:
+// a name that ps -L and top -H show (kf-device-0), SCHED_FIFO at a priority chosen relative to
+// the audio thread, memory locked. Where the system refuses, the thread runs on at normal
+// priority and one message per process says how to grant it. Never a reason to fail an open.
+// Linux (pthread, sched, mlockall); the calls are POSIX but for the thread name.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <string>
+
+namespace kf {
+
+// A thread's requested priority: kAutoPriority chooses one above the audio thread (see
+// resolvePriority), kNormalPriority asks for nothing (SCHED_OTHER), 1..kMaxPriority SCHED_FIFO.
+constexpr int kAutoPriority = -1;
+constexpr int kNormalPriority = 0;
+constexpr int kMaxPriority = 98;  // 99 is left to the kernel's own watchdog threads
+
+struct ThreadRequest {
+  int slot = 0;                  // the device slot: part of the thread's name
+  int priority = kAutoPriority;  // as above
+};
+
+// What a thread got: priority -1 before it started, 0 normal scheduling, > 0 SCHED_FIFO; and
+// whether the memory of its device was locked when it started.
+struct ThreadScheduling {
+  int priority = -1;
+  bool memoryLocked = false;
+};
+
+// Written once by the thread it describes, read by status from any thread.
+class ThreadSchedulingCell {
+ public:
+  void store(const ThreadScheduling& s) {
+    memoryLocked_.store(s.memoryLocked, std::memory_order_relaxed);
+    priority_.store(s.priority, std::memory_order_release);
+  }
+  ThreadScheduling load() const {
+    return {priority_.load(std::memory_order_acquire), memoryLocked_.load(std::memory_order_relaxed)};
+  }
+
+ private:
+  std::atomic<int> priority_{-1};
+  std::atomic<bool> memoryLocked_{false};
+};
+
+// The audio thread's SCHED_FIFO priority (0: not realtime), noted by the host from the audio
+// thread itself (noteAudioThreadPriority(currentThreadPriority())); -1 while unknown.
+void noteAudioThreadPriority(int priority);
+int audioThreadPriority();
+// The calling thread's SCHED_FIFO/SCHED_RR priority, 0 for any other policy. No lock, no
+// allocation: two system calls on the calling thread (the audio thread may call it).
+int currentThreadPriority();
+
+// kAutoPriority: one above the audio thread when that is realtime (our threads' work is a few
+// microseconds a wake-up and their deadline, a 1 ms frame, is no longer than an audio period;
+// JACK runs its own server thread above its clients for the same reason), else
+// kFallbackPriority; others as given, within 0..kMaxPriority.
+constexpr int kFallbackPriority = 10;
+int resolvePriority(int requested);
+
+// Locks the memory the process has now (mlockall(MCL_CURRENT)) where the memlock limit or
+// CAP_IPC_LOCK allows it, so that the device's queues and state never page out. Called by the
+// opener before a device's clock starts (it may take milliseconds); false where refused.
+bool lockProcessMemory();
+
+// Called by the thread itself as it starts: names it "kf-<role>-<slot>" and asks SCHED_FIFO at
+// resolvePriority(request.priority); kNormalPriority sets SCHED_OTHER. A refusal posts one message per
+// process (postDeviceMessage) naming the fix.
+ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& request);
+
+// Sleeps until `deadline` on the monotonic clock, as an absolute deadline (clock_nanosleep
+// TIMER_ABSTIME): a wake-up's lateness does not add to the next one's.
+void sleepUntil(std::chrono::steady_clock::time_point deadline);
+
+// "SCHED_FIFO 66, memory locked" / "normal priority (realtime refused)" / "not started".
+std::string describe(const ThreadScheduling& s);
+
+}  // namespace kf

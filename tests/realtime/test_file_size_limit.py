@@ -1,0 +1,54 @@
+"""A file size limit lowered on the running server while it records (prlimit --fsize: a limit set
+before boot would stop JACK's own shared memory) does not kill it with the magnet on: the write
+past the limit fails with EFBIG (SIGXFSZ is ignored, host/ExitSafety.cpp), the recording stops
+with one message and a kfStatus entry, the file is kept whole (whole lines, within the limit),
+and the server and the force frames go on at the commanded force."""
+import pytest
+
+from kfharness import paths, procs, readers, sclang, status
+
+LIMIT_BYTES = 64 * 1024
+FORCE_N = 1.0
+
+
+def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
+    record = paths.work_dir() / "fsize-session.txt"
+    record.unlink(missing_ok=True)
+    run = sclang.require_ok(sclang.run_with_server("var dev, syn, before;\n" + status.SC_POST + f"""
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 10]]));
+        s.sync;
+        syn = {{ FrictionOut.ar(0, DC.ar({FORCE_N})) * 0 }}.play;
+        0.3.wait;
+        ("prlimit --pid " ++ s.pid ++ " --fsize={LIMIT_BYTES}").systemCmd;
+        dev.record({sclang.sc_string(record)});
+        s.sync;
+        3.wait;  // about 40 kB a second of frames and reports: the limit comes after ~1.5 s
+        ~kfPostStatus.(dev, "KF-STATUS-A");
+        1.wait;
+        ~kfPostStatus.(dev, "KF-STATUS-B");
+        dev.status;
+        s.sync;
+        "KF-ALIVE %".format(s.serverRunning).postln;
+        syn.free;
+        dev.close;
+        s.sync;
+    """, jack, name="fsize"))
+    assert run.lines("KF-ALIVE ") == [["true"]], run.output[-3000:]
+    assert run.scsynth_pid is None or procs.wait_pid_gone(run.scsynth_pid, 5)
+    # One message, and the status entry.
+    messages = [line for line in run.output.splitlines() if "File too large" in line]
+    assert any(line.startswith("kfRecord: writing") for line in messages), run.output[-3000:]
+    assert sum(1 for line in messages if line.startswith("kfRecord:")) == 1, messages
+    assert any(line.startswith("kfStatus 0: recording failed:") and "File too large" in line for line in messages)
+    # The force frames went on, at the commanded force, after the recording stopped.
+    a = status.parse(run.output, "KF-STATUS-A")[0]
+    b = status.parse(run.output, "KF-STATUS-B")[0]
+    assert b["frames"] - a["frames"] >= 800, "the force frames stopped"
+    assert b["lastForceN"] == pytest.approx(FORCE_N) and b["watchdogTrips"] == 0
+    # The file: within the limit, whole lines only, readable to its end.
+    size = record.stat().st_size
+    assert 0 < size <= LIMIT_BYTES
+    text = record.read_bytes()
+    assert text.endswith(b"\n"), "the file ends mid-line"
+    header, records = readers.read_session(record)
+    assert sum(1 for tag, _ in records if tag == "F") >= 500
