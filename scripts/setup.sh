@@ -10,6 +10,7 @@ PACKAGES=(
   supercollider-dev supercollider-server supercollider-supernova supercollider-language
   libhidapi-dev libusb-1.0-0-dev catch2 libsndfile1-dev jackd2
   python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
+  rt-tests
 )
 source scripts/packages.sh
 kf_install_missing "${PACKAGES[@]}"

@@ -175,7 +175,10 @@ def rtload_section(rt):
                      f"{m['reportP99S'] * 1e3:.3f}", f"{m['reportMaxS'] * 1e3:.3f}",
                      f"{f['deviceThreadPriority']:.0f} / {m['mouseThreadPriority']:.0f}",
                      f"{r['client_xruns']}"))
+    floors = "; ".join(f"{'under load' if f['loaded'] else 'idle'}: max {f['max_us'] / 1e3:.3f} ms, mean "
+                       f"{f['avg_us']:.0f} us" for f in rt.get("floors", [])) or "not measured (no cyclictest)"
     return render("rtload", cmd=CMD, seconds=rt["seconds"], load=rt["load"], priority=rt["jack_priority"],
+                  floors=floors,
                   table=table(["rate / period", "scheduling", "force p50 (ms)", "p99", "p99.9", "max",
                                "loop jitter p99 (ms)", "loop max (ms)", "missed deadlines", "missed frames",
                                "watchdog trips", "report to UGen p99 (ms)", "max", "device / reader thread",

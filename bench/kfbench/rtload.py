@@ -7,6 +7,9 @@ Each run: jackd -d dummy (-R -P 70 with realtime scheduling), scsynth booted by 
 FrictionPilot on a simulated device (slot 0) and a FrictionMouseIn on a replayed 1 kHz mouse
 (slot 1), `seconds` long; then each device's /kfStatus reply (numbers, FrictionDevice.statusOf).
 """
+import re
+import shutil
+import subprocess
 import time
 
 from kfharness import jack, load, paths, sclang, status
@@ -51,9 +54,40 @@ def run_one(bench, sample_rate, period, realtime, loaded, seconds):
             "driver_xruns": driver_xruns(jack_log), "wall_s": time.monotonic() - t}
 
 
+def machine_floor(seconds, loaded):
+    """What the machine itself allows a realtime thread: cyclictest (Debian rt-tests), one
+    SCHED_FIFO 90 thread per core waking every 1 ms for `seconds`, memory locked; the max and
+    mean wake-up latency (us) over the cores. None without cyclictest."""
+    if not shutil.which("cyclictest"):
+        return None
+    background = load.BackgroundLoad() if loaded else None
+    if background:
+        background.start()
+    try:
+        out = subprocess.run(["cyclictest", "-m", "-p", "90", "-t", "-a", "-i", "1000", "-D", f"{int(seconds)}",
+                              "-q", "-h", "100000"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
+    finally:
+        if background:
+            background.stop()
+    def values(name):
+        m = re.search(rf"^# {name} Latencies: ([\d ]+)$", out, re.M)
+        return [int(v) for v in m.group(1).split()] if m else []
+    if not values("Max"):
+        log(f"cyclictest gave no latencies:\n{out[-1000:]}")
+        return None
+    return {"loaded": loaded, "max_us": max(values("Max")), "avg_us": sum(values("Avg")) / len(values("Avg"))}
+
+
 def run_all(bench, seconds=20.0):
     if not load.realtime_allowed():
         log("rtload: this user may not use realtime scheduling; the realtime columns are measured without it")
+    floors = []
+    for loaded in (False, True):
+        floor = machine_floor(seconds, loaded)
+        if floor:
+            floors.append(floor)
+            log(f"rtload: the machine's own floor{' under load' if loaded else ''} (cyclictest, SCHED_FIFO 90): "
+                f"wake-up latency max {floor['max_us']} us, mean {floor['avg_us']:.0f} us")
     runs = []
     for rate, period in CONFIGS:
         for name, realtime, loaded in CONDITIONS:
@@ -68,4 +102,4 @@ def run_all(bench, seconds=20.0):
                 f"{f['deviceThreadPriority']:.0f}")
             runs.append(r)
     return {"runs": runs, "seconds": seconds, "load": load.BackgroundLoad().describe(),
-            "jack_priority": REALTIME_PRIORITY}
+            "jack_priority": REALTIME_PRIORITY, "floors": floors}

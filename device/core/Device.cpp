@@ -35,14 +35,18 @@ Device::~Device() { close(); }
 void Device::start() {
   if (lockstep_ || options_.externalPump || thread_.joinable() || isClosed()) return;
   stopRequested_.store(false);
-  memoryLocked_ = options_.thread.priority != kNormalPriority && lockProcessMemory();
+  // Realtime: the device's own memory stays in RAM (ThreadScheduling's lockMemory).
+  memoryLocked_ = options_.thread.priority != kNormalPriority && lockMemory(this, sizeof(Device)) &&
+                  lockMemory(reportQueue_.storage(), reportQueue_.storageBytes()) &&
+                  lockMemory(frameQueue_.storage(), frameQueue_.storageBytes()) &&
+                  lockMemory(pending_.data(), pending_.size() * sizeof(PendingFrame));
   startTime_ = std::chrono::steady_clock::now();
   thread_ = std::thread([this] { threadMain(); });
 }
 
 void Device::threadMain() {
   ThreadScheduling scheduling = scheduleThisThread("device", options_.thread);
-  scheduling.memoryLocked = memoryLocked_;
+  scheduling.memoryLocked = scheduling.memoryLocked && memoryLocked_;  // its stack and its memory
   threadScheduling_.store(scheduling);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point openTime = startTime_;

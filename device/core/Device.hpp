@@ -185,7 +185,7 @@ class Device {
   std::atomic<double> lastPumpAtomicS_{0.0};         // lastPumpS_ for other threads
   std::thread thread_;
   ThreadSchedulingCell threadScheduling_;
-  bool memoryLocked_ = false;  // by start(), before the thread
+  bool memoryLocked_ = false;  // the device's own memory, by start()
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> offRequested_{false};  // requestOff()
   std::atomic<bool> closed_{false};

@@ -49,6 +49,9 @@ class SpscQueue {
     return tail >= head ? tail - head : tail + slotCount_ - head;
   }
   uint64_t overflows() const { return overflows_.load(std::memory_order_relaxed); }
+  // The slots' memory (to lock it: ThreadScheduling's lockMemory).
+  const void* storage() const { return slots_.get(); }
+  size_t storageBytes() const { return slotCount_ * sizeof(T); }
 
  private:
   const size_t slotCount_;  // one slot stays free to tell full from empty

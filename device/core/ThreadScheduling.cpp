@@ -4,9 +4,11 @@
 #include <sched.h>
 #include <sys/mman.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
@@ -54,12 +56,26 @@ int resolvePriority(int requested) {
   return audio > 0 ? std::min(audio + 1, kMaxPriority) : kFallbackPriority;
 }
 
-bool lockProcessMemory() {
-  // The kernel refuses mlockall(MCL_CURRENT) whole, locking nothing, when the process is over its
-  // memlock limit and may not exceed it (CAP_IPC_LOCK). Not MCL_FUTURE: with it, an allocation of
-  // the server beyond the limit would fail later, far from here.
-  return ::mlockall(MCL_CURRENT) == 0;
+bool lockMemory(const void* data, size_t bytes) {
+  if (data == nullptr || bytes == 0) return true;
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const uintptr_t start = reinterpret_cast<uintptr_t>(data) & ~(page - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(data) + bytes;
+  return ::mlock(reinterpret_cast<const void*>(start), end - start) == 0;
 }
+
+namespace {
+
+// The stack below the caller, where the thread's work will run: written (so that it is mapped)
+// and locked. Not inlined: its frame must lie below the caller's.
+__attribute__((noinline)) bool lockStackBelow() {
+  constexpr size_t kBytes = 64 * 1024;  // the device pump's calls need a few kB
+  volatile char stack[kBytes];
+  for (size_t i = 0; i < kBytes; i += 256) stack[i] = 0;
+  return lockMemory(const_cast<char*>(stack), kBytes);
+}
+
+}  // namespace
 
 ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& request) {
   char name[16];  // the kernel keeps 15 characters
@@ -76,6 +92,7 @@ ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& reque
     param.sched_priority = priority;
     if (const int error = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &param); error != 0)
       postRefusalOnce(name, priority, error);
+    got.memoryLocked = lockStackBelow();
   }
   got.priority = currentThreadPriority();  // what it has, inherited or not
   return got;

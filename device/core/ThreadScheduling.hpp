@@ -3,7 +3,7 @@
 // a name that ps -L and top -H show (kf-device-0), SCHED_FIFO at a priority chosen relative to
 // the audio thread, memory locked. Where the system refuses, the thread runs on at normal
 // priority and one message per process says how to grant it. Never a reason to fail an open.
-// Linux (pthread, sched, mlockall); the calls are POSIX but for the thread name.
+// Linux (pthread, sched, mlock, clock_nanosleep); the calls are POSIX but for the thread name.
 #pragma once
 
 #include <atomic>
@@ -24,7 +24,7 @@ struct ThreadRequest {
 };
 
 // What a thread got: priority -1 before it started, 0 normal scheduling, > 0 SCHED_FIFO; and
-// whether the memory of its device was locked when it started.
+// whether its stack (and, for the device thread, the device's memory) is locked in RAM.
 struct ThreadScheduling {
   int priority = -1;
   bool memoryLocked = false;
@@ -61,13 +61,15 @@ int currentThreadPriority();
 constexpr int kFallbackPriority = 10;
 int resolvePriority(int requested);
 
-// Locks the memory the process has now (mlockall(MCL_CURRENT)) where the memlock limit or
-// CAP_IPC_LOCK allows it, so that the device's queues and state never page out. Called by the
-// opener before a device's clock starts (it may take milliseconds); false where refused.
-bool lockProcessMemory();
+// Locks `bytes` of memory at `data` in RAM (mlock) where the memlock limit or CAP_IPC_LOCK allows
+// it, so that a device's state and queues never page out; false where refused. Only the
+// device's own memory: mlockall would fault in and pin the whole server (scsynth maps about a
+// gigabyte) and hold every other thread's page faults up meanwhile, the audio thread's too.
+bool lockMemory(const void* data, size_t bytes);
 
-// Called by the thread itself as it starts: names it "kf-<role>-<slot>" and asks SCHED_FIFO at
-// resolvePriority(request.priority); kNormalPriority sets SCHED_OTHER. A refusal posts one message per
+// Called by the thread itself as it starts: names it "kf-<role>-<slot>", asks SCHED_FIFO at
+// resolvePriority(request.priority) (kNormalPriority sets SCHED_OTHER), and with realtime
+// faults in and locks the stack its work will use (memoryLocked). A refusal posts one message per
 // process (postDeviceMessage) naming the fix.
 ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& request);
 
