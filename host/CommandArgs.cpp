@@ -166,6 +166,11 @@ const char* describe(OscArgReader& args) {
       return "a string, not a number";
     case 'b':
       return "a blob";
+    case 'i':
+    case 'f':
+    case 'h':
+    case 'd':
+      return "a number, not a string";
     default:
       return "of an unsupported type";
   }
@@ -213,8 +218,9 @@ bool readOverrides(OscArgReader& args, CommandArgs& out, char* error, size_t err
       return fail(error, errorSize, "argument %d: a setting name was expected, it is %s", args.position() + 1,
                   describe(args));
     if (out.numOverrides == kMaxOverrides) return fail(error, errorSize, "more than %d settings", kMaxOverrides);
-    if (length == 0 || length >= static_cast<size_t>(kMaxKeyChars))
-      return fail(error, errorSize, "setting name of %zu characters (1..%d allowed)", length, kMaxKeyChars - 1);
+    if (length == 0) return fail(error, errorSize, "argument %d: a setting name is empty", args.position());
+    if (length >= static_cast<size_t>(kMaxKeyChars))
+      return fail(error, errorSize, "setting name of %zu characters is longer than %d", length, kMaxKeyChars - 1);
     double value = 0.0;
     if (!args.readNumber(value))
       return fail(error, errorSize, "setting '%.*s' has no numeric value (%s)", static_cast<int>(length), key,

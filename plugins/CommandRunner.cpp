@@ -48,12 +48,12 @@ OscArgReader readerOf(sc_msg_iter* msg) {
 
 // Refused commands post one line each, and the same refusal at most once a second (a flood
 // of one bad command must not flood the post window; different problems all show).
-void postRefusal(World* world, const char* name, const char* error) {
+void postRefusal(World* world, const char* name, const char* reason) {
   constexpr int kCauses = 16;
   static PostLimiter limiters[kCauses];
   static uint32_t causes[kCauses] = {};
   uint32_t hash = 2166136261u;  // FNV-1a of command and message: the cause
-  for (const char* c : {name, error})
+  for (const char* c : {name, reason})
     for (; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
   int slot = static_cast<int>(hash % kCauses);
   if (causes[slot] != hash) {  // another cause had this slot: start afresh
@@ -63,9 +63,9 @@ void postRefusal(World* world, const char* name, const char* error) {
   int suppressed = 0;
   if (!limiters[slot].allow(blockStartTimeS(world), suppressed)) return;
   if (suppressed > 0)
-    postFromRt(world, "%s: %s; refused (and %d times more since the last message)\n", name, error, suppressed);
+    postFromRt(world, "%s (and %d times more since the last message)\n", reason, suppressed);
   else
-    postFromRt(world, "%s: %s; refused\n", name, error);
+    postFromRt(world, "%s\n", reason);
 }
 
 // The stages every command runs, around its own: a failing NRT stage does not end the command
@@ -114,12 +114,15 @@ void failWith(CommandData* data, const char* format, ...) {
 }
 
 // RT: the failure to the notified clients, as the node reply /kfFail from the root group.
-void replyFailure(World* world, const CommandData* data) {
+void replyFailure(World* world, int index, const char* reason) {
   float codes[kMaxReasonChars];
   int n = 0;
-  for (; n < kMaxReasonChars && data->reason[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(data->reason[n]);
-  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfFail", n, codes);
+  for (; n < kMaxReasonChars && reason[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(reason[n]);
+  // The plugin headers do not define Group; the server's starts with its Node (SC_Group.h).
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), index, "/kfFail", n, codes);
 }
+
+void replyFailure(World* world, const CommandData* data) { replyFailure(world, data->args.index, data->reason); }
 
 void freeCommand(World* world, void* raw) {
   auto* data = static_cast<CommandData*>(raw);
@@ -131,7 +134,11 @@ void freeCommand(World* world, void* raw) {
 CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_msg_iter* msg) {
   auto* data = static_cast<CommandData*>(RTAlloc(world, sizeof(CommandData)));
   if (data == nullptr) {
-    postFromRt(world, "%s: RT memory allocation failed\n", name);
+    char reason[kMaxReasonChars];
+    std::snprintf(reason, sizeof reason, "%s: RT memory allocation failed (raise ServerOptions.memSize); refused",
+                  name);
+    postFromRt(world, "%s\n", reason);
+    replyFailure(world, -1, reason);
     return nullptr;
   }
   data->name = name;
@@ -146,7 +153,14 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   OscArgReader reader = readerOf(msg);
   char error[200];
   if (!parseCommandArgs(shape, reader, kNumDeviceSlots, data->args, allocValues, world, error, sizeof error)) {
-    postRefusal(world, name, error);
+    // Answered every time, posted at most once a second per cause (postRefusal). The device is
+    // the reply ID, -1 when the device argument itself is what is wrong.
+    if (data->args.index >= 0)
+      failWith(data, "%s: device %d: %s; refused", name, data->args.index, error);
+    else
+      failWith(data, "%s: %s; refused", name, error);
+    postRefusal(world, name, data->reason);
+    replyFailure(world, data);
     freeCommand(world, data);
     return nullptr;
   }

@@ -1,8 +1,9 @@
 // The machinery every plugin command shares (DeviceCommands, MouseCommands, BoardCommands):
 // arguments read and checked in the RT stage by CommandArgs (never past the packet), refusals
 // posted at most once a second per cause, the stages run as SC's asynchronous commands with
-// `/done cmdName` on success and `/kfFail` (node 0, replyID = the slot, then the reason as
-// character codes) on failure, and the stages the open and slot commands have in common.
+// `/done cmdName` on success and `/kfFail` (replyFailure) on failure, whatever failed: the
+// arguments, RT memory or a stage. Every command gets exactly one of the two. Also the stages
+// the open and slot commands have in common.
 #pragma once
 
 #include <SC_PlugIn.hpp>
@@ -32,11 +33,14 @@ struct CommandData {
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.
 void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
-// RT: the failure to the notified clients.
+// RT: the failure to the notified clients: /kfFail, node 0, reply ID the device (-1 when the
+// device argument itself was wrong, or the command has none), then the reason as character
+// codes, which starts with the command's name ("kfRecord: ...").
+void replyFailure(World* world, int index, const char* reason);
 void replyFailure(World* world, const CommandData* data);
 
-// RT: a command with its arguments read and checked for `shape`; null (refusal posted) if
-// they do not fit or RT memory is short.
+// RT: a command with its arguments read and checked for `shape`; null if they do not fit or RT
+// memory is short (then the refusal is answered and posted).
 CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_msg_iter* msg);
 // An SC asynchronous command from the command's own stages (2 and 4 NRT, 3 RT; see the
 // wrappers for what happens on failure); frees `data` at the end.

@@ -34,10 +34,17 @@ using namespace kf::sc;
 bool listStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   const std::string only = data->args.backend;
+  if (!only.empty() && only != "hidapi" && only != "evdev") {
+    failWith(data, "kfListMice: unknown backend '%s' (hidapi, evdev, or \"\" for both)", only.c_str());
+    return false;
+  }
   std::ofstream answer;
   if (data->args.path[0] != '\0') {
     answer.open(data->args.path);
-    if (!answer) Print("kfListMice: cannot write %s\n", data->args.path);
+    if (!answer) {
+      failWith(data, "kfListMice: cannot write the answer file %s", data->args.path);
+      return false;
+    }
   }
   for (kf::MouseBackendKind kind : {kf::MouseBackendKind::kHidapi, kf::MouseBackendKind::kEvdev}) {
     const char* kindName = kind == kf::MouseBackendKind::kHidapi ? "hidapi" : "evdev";
@@ -46,7 +53,11 @@ bool listStage(World*, void* raw) {  // NRT
     std::string error;
     const bool ok = kind == kf::MouseBackendKind::kHidapi ? kf::realHidApi()->enumerateMice(mice, error)
                                                           : kf::realEvdevApi()->enumerateMice(mice, error);
-    if (!ok) {
+    if (!ok && !only.empty()) {  // the one backend asked for: a failure
+      failWith(data, "kfListMice: %s enumeration failed: %s", kindName, error.c_str());
+      return false;
+    }
+    if (!ok) {  // one of both: the other's mice still come
       Print("kfListMice: %s enumeration failed: %s\n", kindName, error.c_str());
       continue;
     }

@@ -1,6 +1,7 @@
 // The answers to FrictionDevice's asynchronous commands (the plugin's CommandRunner): /done with
 // the command's name when it succeeded, /kfFail (node 0, reply ID the slot, then the reason as
-// character codes) when the server refused it, nothing when the server is gone, so a timeout.
+// character codes, starting with the command's name) when the server refused it, whatever was
+// wrong; nothing only when the server is gone, so a timeout.
 // One pair of responders per server; the commands awaiting an answer, by server, in the order
 // they were sent.
 FrictionAnswers {
@@ -51,8 +52,8 @@ FrictionAnswers {
 					found !? { list.remove(found); found[\done].value };
 				}, '/done', server.addr).permanent_(true),
 				OSCFunc({ |msg|
-					var found = list.detect { |e| e[\index] == msg[2] };
 					var reason = msg[3..].collect { |c| c.asInteger.asAscii }.join;
+					var found = this.awaiting(list, reason.split($:).first.asSymbol, msg[2]);
 					found !? { list.remove(found); found[\fail].value(reason) };
 				}, '/kfFail', server.addr).permanent_(true)
 			]
@@ -64,6 +65,12 @@ FrictionAnswers {
 			};
 			nil
 		});
+	}
+
+	// The first command cmd awaiting an answer for device index: a refusal's reply ID is -1 when
+	// the device argument itself was wrong (or the command has none, kfListMice).
+	*awaiting { |list, cmd, index|
+		^list.detect { |e| e[\cmd] == cmd and: { index < 0 or: { e[\index] == index } } }
 	}
 
 	// Fails every command still awaiting an answer from server (it quit: none will come).

@@ -234,13 +234,6 @@ FrictionDevice {
 		this.prStartBusSynths;
 	}
 
-	// Sends a command nothing waits for (the board's: the server posts their result).
-	prSend { |msg|
-		if(server.isNil) { ^this };
-		FrictionCheck.serverRunning(server, "FrictionDevice");
-		server.listSendMsg(msg)
-	}
-
 	// Sends msg and awaits /done cmd or /kfFail for this slot (FrictionAnswers.send).
 	prSendAnswered { |cmd, msg, onDone, onFail, block = true|
 		FrictionAnswers.send(server, cmd, index, msg, onDone, onFail, block)

@@ -1,12 +1,15 @@
 // FrictionDevice with the friction board (device/board/PROTOCOL.md), the USB electromagnet
 // driver: added to a device so that its force frames also drive the magnet, armed, calibrated,
-// asked for its telemetry. Its commands await no answer: the server posts their result.
+// asked for its telemetry. Its commands are answered as every device command is
+// (FrictionAnswers): inside a Routine they wait, and a refusal is an Error with the server's reason.
 + FrictionDevice {
 
 	// The friction board, added to this device: every force frame goes to it too, through the
 	// calibration. serial: nil for the first board found; emulate: true for the board emulator
 	// (no hardware needed). The board starts disarmed.
-	addBoard { |serial, emulate = false, inFlight = 2| this.prSend(this.addBoardMsg(serial, emulate, inFlight)) }
+	addBoard { |serial, emulate = false, inFlight = 2|
+		this.prSendAnswered(\kfBoardOpen, this.addBoardMsg(serial, emulate, inFlight))
+	}
 	addBoardMsg { |serial, emulate = false, inFlight = 2|
 		if(serial.notNil and: { serial.isString.not and: { serial.isKindOf(Symbol).not } }) {
 			Error("FrictionDevice.addBoard: serial must be a String or nil, got %".format(serial)).throw
@@ -18,13 +21,13 @@
 	}
 
 	// The magnet is driven only while the board is armed.
-	arm { this.prSend(this.armMsg) }
+	arm { this.prSendAnswered(\kfBoardArm, this.armMsg) }
 	armMsg { ^['/cmd', \kfBoardArm, index, 1] }
-	disarm { this.prSend(this.disarmMsg) }
+	disarm { this.prSendAnswered(\kfBoardArm, this.disarmMsg) }
 	disarmMsg { ^['/cmd', \kfBoardArm, index, 0] }
 
 	// calibration: a FrictionCalibration (written to a file first) or a path; nil: linear.
-	calibrate { |calibration| this.prSend(this.calibrateMsg(calibration)) }
+	calibrate { |calibration| this.prSendAnswered(\kfBoardCalibrate, this.calibrateMsg(calibration)) }
 	calibrateMsg { |calibration|
 		var path = calibration;
 		if(calibration.isKindOf(FrictionCalibration)) {
@@ -45,7 +48,7 @@
 		if(server.isNil) { ^this };
 		OSCFunc({ |msg| action.value(this.class.boardStatusOf(msg[3..])) }, '/kfBoardStatus', server.addr,
 			argTemplate: [nil, index]).oneShot;
-		this.prSend(this.boardStatusMsg)
+		this.prSendAnswered(\kfBoardStatus, this.boardStatusMsg)
 	}
 	boardStatusMsg { ^['/cmd', \kfBoardStatus, index] }
 	*boardStatusOf { |values|
@@ -58,6 +61,6 @@
 		^event
 	}
 
-	removeBoard { this.prSend(this.removeBoardMsg) }
+	removeBoard { this.prSendAnswered(\kfBoardClose, this.removeBoardMsg) }
 	removeBoardMsg { ^['/cmd', \kfBoardClose, index] }
 }

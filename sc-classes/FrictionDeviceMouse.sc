@@ -31,8 +31,8 @@
 		path = PathName.tmp +/+ "kf-mice-%-%.txt".format(Main.elapsedTime.hash.abs, UniqueID.next);
 		fork {
 			var mice = [];
-			server.listSendMsg(this.listMiceMsg(backend, path));
-			server.sync;
+			// A refusal (an unknown backend, a failed enumeration) is an Error with the reason.
+			FrictionAnswers.send(server, \kfListMice, nil, this.listMiceMsg(backend, path));
 			if(File.exists(path)) {
 				mice = File.readAllString(path).split($\n).reject(_.isEmpty).collect { |line|
 					var f = line.split($\t);

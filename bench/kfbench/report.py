@@ -174,15 +174,13 @@ def rtload_section(rt):
                      f"{f['skippedFrames'] + f['frameQueueOverflows']:.0f}", f"{f['watchdogTrips']:.0f}",
                      f"{m['reportP99S'] * 1e3:.3f}", f"{m['reportMaxS'] * 1e3:.3f}",
                      f"{f['deviceThreadPriority']:.0f} / {m['mouseThreadPriority']:.0f}",
-                     f"{r['client_xruns']}"))
-    floors = "; ".join(f"{'under load' if f['loaded'] else 'idle'}: max {f['max_us'] / 1e3:.3f} ms, mean "
-                       f"{f['avg_us']:.0f} us" for f in rt.get("floors", [])) or "not measured (no cyclictest)"
+                     f"{r['client_xruns']}",
+                     f"{r['witness']['max_us'] / 1e3:.3f}" if r.get("witness") else "-"))
     return render("rtload", cmd=CMD, seconds=rt["seconds"], load=rt["load"], priority=rt["jack_priority"],
-                  floors=floors,
                   table=table(["rate / period", "scheduling", "force p50 (ms)", "p99", "p99.9", "max",
                                "loop jitter p99 (ms)", "loop max (ms)", "missed deadlines", "missed frames",
                                "watchdog trips", "report to UGen p99 (ms)", "max", "device / reader thread",
-                               "JACK xruns"], rows))
+                               "JACK xruns", "machine wake-up max (ms)"], rows))
 
 
 def scale_section(sc):

@@ -7,12 +7,10 @@ Each run: jackd -d dummy (-R -P 70 with realtime scheduling), scsynth booted by 
 FrictionPilot on a simulated device (slot 0) and a FrictionMouseIn on a replayed 1 kHz mouse
 (slot 1), `seconds` long; then each device's /kfStatus reply (numbers, FrictionDevice.statusOf).
 """
-import re
-import shutil
-import subprocess
 import time
 
 from kfharness import jack, load, paths, sclang, status
+from kfharness.witness import Witness
 
 from . import scores
 from .common import log
@@ -37,10 +35,12 @@ def run_one(bench, sample_rate, period, realtime, loaded, seconds):
     with jack.JackServer(sample_rate=sample_rate, period=period, realtime_priority=priority) as server:
         if background:
             background.start()
+        witness = Witness().start()
         try:
             run = sclang.run_with_server(code, server, timeout=seconds + 90, name="bench-rtload",
                                          include_paths=bench.include_paths)
         finally:
+            witnessed = witness.stop()
             if background:
                 background.stop()
         jack_log = server.log_path.read_text(errors="replace")
@@ -51,43 +51,12 @@ def run_one(bench, sample_rate, period, realtime, loaded, seconds):
         raise SystemExit(f"rtload: no /kfStatus figures for both devices:\n{run.output[-4000:]}")
     return {"rate": sample_rate, "period": period, "realtime": realtime, "loaded": loaded, "seconds": seconds,
             "force": figures[0], "mouse": figures[1], "client_xruns": client_xruns(jack_log),
-            "driver_xruns": driver_xruns(jack_log), "wall_s": time.monotonic() - t}
-
-
-def machine_floor(seconds, loaded):
-    """What the machine itself allows a realtime thread: cyclictest (Debian rt-tests), one
-    SCHED_FIFO 90 thread per core waking every 1 ms for `seconds`, memory locked; the max and
-    mean wake-up latency (us) over the cores. None without cyclictest."""
-    if not shutil.which("cyclictest"):
-        return None
-    background = load.BackgroundLoad() if loaded else None
-    if background:
-        background.start()
-    try:
-        out = subprocess.run(["cyclictest", "-m", "-p", "90", "-t", "-a", "-i", "1000", "-D", f"{int(seconds)}",
-                              "-q", "-h", "100000"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
-    finally:
-        if background:
-            background.stop()
-    def values(name):
-        m = re.search(rf"^# {name} Latencies: ([\d ]+)$", out, re.M)
-        return [int(v) for v in m.group(1).split()] if m else []
-    if not values("Max"):
-        log(f"cyclictest gave no latencies:\n{out[-1000:]}")
-        return None
-    return {"loaded": loaded, "max_us": max(values("Max")), "avg_us": sum(values("Avg")) / len(values("Avg"))}
+            "driver_xruns": driver_xruns(jack_log), "witness": witnessed, "wall_s": time.monotonic() - t}
 
 
 def run_all(bench, seconds=20.0):
     if not load.realtime_allowed():
         log("rtload: this user may not use realtime scheduling; the realtime columns are measured without it")
-    floors = []
-    for loaded in (False, True):
-        floor = machine_floor(seconds, loaded)
-        if floor:
-            floors.append(floor)
-            log(f"rtload: the machine's own floor{' under load' if loaded else ''} (cyclictest, SCHED_FIFO 90): "
-                f"wake-up latency max {floor['max_us']} us, mean {floor['avg_us']:.0f} us")
     runs = []
     for rate, period in CONFIGS:
         for name, realtime, loaded in CONDITIONS:
@@ -99,7 +68,8 @@ def run_all(bench, seconds=20.0):
                 f"max {f['forceMaxS'] * 1e3:.3f} ms; loop p99 {f['loopP99S'] * 1e3:.3f} ms; missed deadlines "
                 f"{f['missedDeadlines']:.0f}; skipped {f['skippedFrames']:.0f}; watchdog {f['watchdogTrips']:.0f}; "
                 f"report to UGen p99 {m['reportP99S'] * 1e3:.3f} ms; device thread priority "
-                f"{f['deviceThreadPriority']:.0f}")
+                f"{f['deviceThreadPriority']:.0f}; the machine's own wake-up max in the same window "
+                f"{r['witness']['max_us'] / 1e3 if r['witness'] else float('nan'):.3f} ms")
             runs.append(r)
     return {"runs": runs, "seconds": seconds, "load": load.BackgroundLoad().describe(),
-            "jack_priority": REALTIME_PRIORITY, "floors": floors}
+            "jack_priority": REALTIME_PRIORITY}

@@ -44,7 +44,7 @@ UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions o
 UsbBoardBackend::~UsbBoardBackend() { close(); }
 
 void UsbBoardBackend::setError(const std::string& error) {
-  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  std::lock_guard<PiMutex> lock(telemetryMutex_);
   telemetry_.lastError = error;
 }
 
@@ -75,7 +75,7 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     error = "the board speaks protocol " + std::to_string(version.protocolMajor) + "." +
             std::to_string(version.protocolMinor) + ", this host " + std::to_string(board::kProtocolMajor) + ".x";
   } else {
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     telemetry_.version = version;
     telemetry_.serial = port_->openSerial();
     telemetry_.haveStatus = false;
@@ -160,7 +160,7 @@ void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
 void UsbBoardBackend::driveOff() { latestDrive_.store(0, std::memory_order_relaxed); }
 
 BoardTelemetry UsbBoardBackend::telemetry() const {
-  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  std::lock_guard<PiMutex> lock(telemetryMutex_);
   BoardTelemetry copy = telemetry_;
   copy.connected = connected_.load();
   copy.armed = armed_.load();
@@ -184,13 +184,13 @@ void UsbBoardBackend::submitSetPoint(int slot) {
   const usb::Result result = port_->submit(transfer);
   if (result == usb::Result::kOk) {
     outBusy_[slot] = true;
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     telemetry_.lastSequenceSent = sequence_;
     telemetry_.lastDriveSent = drive;
   } else if (result == usb::Result::kNoDevice) {
     markUnplugged();
   } else {
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     ++telemetry_.lostTransfers;
   }
 }
@@ -214,7 +214,7 @@ void UsbBoardBackend::submitIdle() {
 void UsbBoardBackend::markUnplugged() {
   if (unplugged_) return;
   unplugged_ = true;
-  std::lock_guard<std::mutex> lock(telemetryMutex_);
+  std::lock_guard<PiMutex> lock(telemetryMutex_);
   ++telemetry_.unplugs;
   telemetry_.lastError = "the friction board was unplugged";
 }
@@ -228,7 +228,7 @@ void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
   outBusy_[slot] = false;
   const double nowS = steadyS();
   {
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     switch (transfer.status) {
       case usb::TransferStatus::kCompleted:
         if (transfer.actualLength == transfer.length) {
@@ -274,7 +274,7 @@ void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
   if (transfer.status == usb::TransferStatus::kStall) {
     // A halted status endpoint is cleared in the loop like the set-point one.
     stallPending_ = true;
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     ++telemetry_.stalls;
     return;
   }
@@ -282,7 +282,7 @@ void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
   const bool valid = transfer.status == usb::TransferStatus::kCompleted &&
                      board::decodeStatus(transfer.buffer, static_cast<size_t>(transfer.actualLength), status);
   {
-    std::lock_guard<std::mutex> lock(telemetryMutex_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
     if (valid) {
       telemetry_.status = status;
       telemetry_.haveStatus = true;
@@ -352,7 +352,7 @@ void UsbBoardBackend::run() {
         stallPending_ = false;
         lastOutDoneS_ = -1.0;
         connected_.store(true);
-        std::lock_guard<std::mutex> telemetryLock(telemetryMutex_);
+        std::lock_guard<PiMutex> telemetryLock(telemetryMutex_);
         ++telemetry_.reopens;
         telemetry_.lastError.clear();
       } else {

@@ -20,6 +20,7 @@
 #include "board/BoardProtocol.hpp"
 #include "board/UsbPort.hpp"
 #include "core/ForceBackend.hpp"
+#include "core/PiMutex.hpp"
 #include "core/ThreadScheduling.hpp"
 
 namespace kf {
@@ -126,7 +127,8 @@ class UsbBoardBackend : public ForceBackend {
   std::mutex wakeMutex_;
   std::condition_variable wake_;
 
-  mutable std::mutex telemetryMutex_;
+  // Shared by the realtime event thread and status readers at normal priority (PiMutex.hpp).
+  mutable PiMutex telemetryMutex_;
   BoardTelemetry telemetry_;
 };
 

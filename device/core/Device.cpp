@@ -68,7 +68,7 @@ void Device::threadMain() {
     }
     const double nowS = std::chrono::duration<double>(now - openTime).count();
     if (lastPumpS_ >= 0.0) telemetry_.pumpPeriod.record(nowS - lastPumpS_);
-    std::lock_guard<std::mutex> lock(stateMutex_);
+    std::lock_guard<PiMutex> lock(stateMutex_);
     try {
       pumpLocked(nowS, scheduledS);
     } catch (const std::exception& e) {
@@ -102,13 +102,13 @@ void Device::failThread(const char* what) noexcept {
 
 void Device::pump(double nowS, double scheduledS) {
   if (options_.externalPump && !lockstep_ && !isClosed()) {
-    std::lock_guard<std::mutex> lock(stateMutex_);
+    std::lock_guard<PiMutex> lock(stateMutex_);
     pumpLocked(nowS, scheduledS < 0.0 ? nowS : std::min(scheduledS, nowS));
     return;
   }
   if (!lockstep_ || isClosed()) return;
   // try_lock: the audio thread never waits; a skipped round is caught up by the next one.
-  std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+  std::unique_lock<PiMutex> lock(stateMutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;
   pumpLocked(nowS - lockstepOriginS_, nowS - lockstepOriginS_);
 }
@@ -264,7 +264,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
 void Device::requestOff() {
   offRequested_.store(true, std::memory_order_release);
   if (!lockstep_ || isClosed()) return;
-  std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+  std::unique_lock<PiMutex> lock(stateMutex_, std::try_to_lock);
   if (lock.owns_lock() && lastPumpS_ >= 0.0 && offRequested_.exchange(false, std::memory_order_acq_rel))
     applyOffRequestLocked(lastPumpS_);
 }
@@ -286,7 +286,7 @@ void Device::close() {
   if (closed_.exchange(true, std::memory_order_acq_rel)) return;
   stopRequested_.store(true, std::memory_order_release);
   if (thread_.joinable()) thread_.join();
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   force_->driveOff();
   if (board_) board_->driveOff();
   safety_.resetToOff();
@@ -313,7 +313,7 @@ double Device::nowS() const {
 
 bool Device::pushForceFrame(const ForceFrame& frame) {
   if (lockstep_ && !isClosed()) {
-    std::unique_lock<std::mutex> lock(stateMutex_, std::try_to_lock);
+    std::unique_lock<PiMutex> lock(stateMutex_, std::try_to_lock);
     if (lock.owns_lock() && lastPumpS_ >= 0.0) {
       // Lockstep has one thread for both ends of the queue: earlier frames first.
       ForceFrame queued;
@@ -326,7 +326,7 @@ bool Device::pushForceFrame(const ForceFrame& frame) {
 }
 
 std::shared_ptr<ForceBackend> Device::attachBoard(std::shared_ptr<ForceBackend> board) {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   if (board_) board_->driveOff();
   if (board && !isClosed()) board->driveOff();  // from off; the next frame drives it
   std::swap(board_, board);
@@ -334,22 +334,22 @@ std::shared_ptr<ForceBackend> Device::attachBoard(std::shared_ptr<ForceBackend> 
 }
 
 std::shared_ptr<ForceBackend> Device::board() {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   return board_;
 }
 
 void Device::setCalibration(const CalibrationTable& table) {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   safety_.setCalibration(table);
 }
 
 uint64_t Device::driveLimitedFrames() {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   return safety_.driveLimitedFrames();
 }
 
 double Device::heatEstimate() {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   return safety_.heat();
 }
 
@@ -363,7 +363,7 @@ TelemetrySnapshot Device::telemetry() const {
 }
 
 bool Device::startRecording(const std::string& path, std::string& error) {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   if (isClosed()) {
     error = "the device is closed";
     return false;
@@ -372,13 +372,13 @@ bool Device::startRecording(const std::string& path, std::string& error) {
 }
 
 void Device::stopRecording() {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   recorder_.close();
   if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
 }
 
 std::string Device::recordingError() {
-  std::lock_guard<std::mutex> lock(stateMutex_);
+  std::lock_guard<PiMutex> lock(stateMutex_);
   return recorder_.error();
 }
 

@@ -14,6 +14,7 @@
 
 #include "core/ForceBackend.hpp"
 #include "core/MouseBackend.hpp"
+#include "core/PiMutex.hpp"
 #include "core/SpscQueue.hpp"
 #include "core/Telemetry.hpp"
 #include "core/files/SessionFile.hpp"
@@ -163,8 +164,9 @@ class Device {
   SpscQueue<ForceFrame> frameQueue_;
   Telemetry telemetry_;
 
-  // Guards the pumped state below against start/stopRecording and close.
-  std::mutex stateMutex_;
+  // Guards the pumped state below against start/stopRecording, the board, status and close:
+  // priority inheritance, since those come from normal-priority threads (PiMutex.hpp).
+  PiMutex stateMutex_;
   ForceSafety safety_;
   Recorder recorder_;
   double lastPumpS_ = -1.0;

@@ -115,8 +115,8 @@ def test_settings_that_would_hang_the_server_are_refused_by_name(tmp_path=paths.
         "kfOpenSim: stepS = 1e-12 is out of range 1e-06..0.01 s; not opened",
         "kfOpenSim: countMm = 1e+30 is out of range 0.0001..10 mm; not opened",
         f"kfOpenReplay: {session}:1: header: forceFramePeriodS = 1e-300 is out of range",
-        "kfOpenSim: more than 32 settings; refused\n",
-        "kfOpenSim: hand script value 3 of 4: a string, not a number",
+        "kfOpenSim: device 5: more than 32 settings; refused\n",
+        "kfOpenSim: device 6: hand script value 3 of 4: a string, not a number",
         "kfStatus: device index nan is not a slot number 0..15; refused",
     ]:
         assert message in log, f"missing {message!r}:\n{log[-3000:]}"

@@ -15,6 +15,7 @@ import re
 import time
 
 from kfharness import load, paths, readers, sclang, status
+from kfharness.witness import Witness
 from kfharness.jack import JackServer
 
 REALTIME_PRIORITY = 70  # jackd -R -P 70, as the realtime tests and the bench run it
@@ -97,7 +98,8 @@ def main():
             x0 = xruns(jack)
             base = baseline(jack, args.baseline_minutes * 60)
             x1 = xruns(jack)
-            dev = devices(jack, args.minutes * 60, record, -1 if realtime else 0)
+            with Witness() as witness:
+                dev = devices(jack, args.minutes * 60, record, -1 if realtime else 0)
             x2 = xruns(jack)
         finally:
             if background:
@@ -130,6 +132,9 @@ def main():
               f"force to magnet {f['forceP50S'] * ms:.3f}/{f['forceP99S'] * ms:.3f}/{f['forceP999S'] * ms:.3f}/"
               f"{f['forceMaxS'] * ms:.3f}; loop period p99 {f['loopP99S'] * ms:.3f} max {f['loopMaxS'] * ms:.3f}; "
               f"report to UGen p99 {f['reportP99S'] * ms:.3f} max {f['reportMaxS'] * ms:.3f}")
+    machine = witness.result
+    print("  the machine's own wake-up max in the same window (cyclictest, SCHED_FIFO 90 above our threads): "
+          + (f"{machine['max_us'] / 1e3:.3f} ms, mean {machine['avg_us']:.0f} us" if machine else "not measured"))
     header, records = readers.read_session(record)
     frames = sum(1 for tag, _ in records if tag == "F")
     print(f"\n[recorder] {record}: {len(records)} records, {frames} frames, last record {records[-1][0]}")
