@@ -53,6 +53,18 @@ double frictionFromMeanAbs(double meanAbs, const FrictionMapping& m) {
   return m.loForceN + (clipped - m.loDb) / (m.hiDb - m.loDb) * (m.hiForceN - m.loForceN);
 }
 
+FrictionMapping usableMapping(const FrictionMapping& wanted) {
+  const FrictionMapping paper;
+  const auto force = [](double n, double paperN) { return isUsable(n) ? std::max(n, 0.0) : paperN; };
+  FrictionMapping m;
+  m.loDb = isUsable(wanted.loDb) ? wanted.loDb : paper.loDb;
+  m.hiDb = isUsable(wanted.hiDb) ? wanted.hiDb : paper.hiDb;
+  m.loForceN = force(wanted.loForceN, paper.loForceN);
+  m.hiForceN = force(wanted.hiForceN, paper.hiForceN);
+  m.ref = isUsable(wanted.ref) && wanted.ref > 0.0 ? wanted.ref : paper.ref;
+  return m;
+}
+
 int windowSamples(double sampleRateHz, double windowS, int maxWindowSamples) {
   const double n = std::round(sampleRateHz * windowS);
   if (!(n >= 1.0)) return 1;  // also NaN
@@ -100,14 +112,7 @@ void LoudnessToFriction::resum() {
 }
 
 void LoudnessToFriction::setMapping(const FrictionMapping& wanted) {
-  FrictionMapping m = wanted;
-  // Parameters that would make the mapping undefined fall back to the paper's values.
-  const FrictionMapping paper;
-  if (!isUsable(m.loDb)) m.loDb = paper.loDb;
-  if (!isUsable(m.hiDb)) m.hiDb = paper.hiDb;
-  if (!isUsable(m.loForceN)) m.loForceN = paper.loForceN;
-  if (!isUsable(m.hiForceN)) m.hiForceN = paper.hiForceN;
-  if (!(isUsable(m.ref) && m.ref > 0.0)) m.ref = paper.ref;
+  const FrictionMapping m = usableMapping(wanted);
   mapping_ = m;
 
   // Reversed dB bounds give an inverse mapping: the clip is on the sorted bounds.
@@ -117,6 +122,8 @@ void LoudnessToFriction::setMapping(const FrictionMapping& wanted) {
   hiAbs_ = m.ref * std::pow(10.0, highDb / 20.0);
   forceAtLoAbs_ = static_cast<float>(rising ? m.loForceN : m.hiForceN);
   forceAtHiAbs_ = static_cast<float>(rising ? m.hiForceN : m.loForceN);
+  minForce_ = std::min(forceAtLoAbs_, forceAtHiAbs_);
+  maxForce_ = std::max(forceAtLoAbs_, forceAtHiAbs_);
   invRef_ = 1.0 / m.ref;
   // One sample at hiAbs_ * capacity_ saturates any window by itself, so clamping there changes
   // no output, and it keeps a huge value from wiping out the precision of the running sum.
@@ -161,7 +168,7 @@ inline float LoudnessToFriction::mapMeanAbs(double meanAbs) const {
   // Equation (2) inside the clip range: 20 log10(mean / ref) mapped linearly.
   // 20 log10(x) as 20 log10(e) ln(x): the same error, and glibc's log is much faster than log10.
   const double db = (20.0 * kLog10OfE) * std::log(meanAbs * invRef_);
-  return static_cast<float>(db * forcePerDb_ + forceOffset_);
+  return std::clamp(static_cast<float>(db * forcePerDb_ + forceOffset_), minForce_, maxForce_);
 }
 
 float LoudnessToFriction::peekForce(float a) const {
@@ -286,6 +293,7 @@ void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) 
   {
     const __m128 lo = _mm_set1_ps(loLevel_), hi = _mm_set1_ps(hiLevel_);
     const __m128 fLo = _mm_set1_ps(forceAtLoAbs_), fHi = _mm_set1_ps(forceAtHiAbs_);
+    const __m128 fMin = _mm_set1_ps(minForce_), fMax = _mm_set1_ps(maxForce_);
     const __m128 a = _mm_set1_ps(forcePerLog2_), b = _mm_set1_ps(forceAtLog2Zero_);
     const __m128i mantMask = _mm_set1_epi32(0x007fffff), one = _mm_set1_epi32(0x3f800000);
     const __m128i sqrt2 = _mm_set1_epi32(kSqrt2Bits), bias = _mm_set1_epi32(127);
@@ -313,7 +321,7 @@ void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) 
       p = _mm_add_ps(_mm_set1_ps(kP1), _mm_mul_ps(t, p));
       p = _mm_add_ps(_mm_set1_ps(kP0), _mm_mul_ps(t, p));
       const __m128 log2 = _mm_add_ps(_mm_cvtepi32_ps(ex), _mm_mul_ps(t, p));
-      __m128 f = _mm_add_ps(_mm_mul_ps(log2, a), b);
+      __m128 f = _mm_min_ps(_mm_max_ps(_mm_add_ps(_mm_mul_ps(log2, a), b), fMin), fMax);
       f = _mm_or_ps(_mm_and_ps(atLo, fLo), _mm_andnot_ps(atLo, f));
       f = _mm_or_ps(_mm_and_ps(atHi, fHi), _mm_andnot_ps(atHi, f));  // hi wins, as in mapMeanAbs
       _mm_storeu_ps(forceN + i, f);
@@ -323,7 +331,7 @@ void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) 
   for (; i < count; ++i) {  // the same operations, one at a time
     const float level = levels[i];
     const float m = std::min(std::max(level, loLevel_), hiLevel_);
-    const float f = fastLog2(m) * forcePerLog2_ + forceAtLog2Zero_;
+    const float f = std::clamp(fastLog2(m) * forcePerLog2_ + forceAtLog2Zero_, minForce_, maxForce_);
     forceN[i] = level >= hiLevel_ ? forceAtHiAbs_ : (level <= loLevel_ ? forceAtLoAbs_ : f);
   }
 }

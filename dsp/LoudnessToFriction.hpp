@@ -21,6 +21,11 @@ struct FrictionMapping {
   double ref = paper::mapping::ref;  // a_ref: the mean |a| that reads 0 dB
 };
 
+// The mapping setMapping uses for `wanted`: a level (loDb, hiDb) or force that is not finite,
+// or a ref that is not finite and > 0, is the paper's value; a negative force is 0 N (friction
+// never pushes). Everything else is kept: reversed bounds, a threshold (loDb == hiDb), huge values.
+FrictionMapping usableMapping(const FrictionMapping& wanted);
+
 // Equation (2) on one mean amplitude, in double: the reference the tests and benchmarks use.
 double frictionFromMeanAbs(double meanAbs, const FrictionMapping& mapping);
 
@@ -37,8 +42,8 @@ class LoudnessToFriction {
   int windowSamples() const { return windowSamples_; }
   void setMapping(const FrictionMapping& mapping);
 
-  // Force in N for each input sample. NaN/Inf input counts as silence. in and forceN may be
-  // the same array.
+  // Force in N for each input sample, always within [loForce, hiForce] of the usable mapping.
+  // NaN input counts as silence, Inf as the loudest level. in and forceN may be the same array.
   void process(const float* in, float* forceN, int numSamples);
   double meanAbs() const { return sum_ / windowSamples_; }
   // The force process() would give for `a` as the next sample, without taking it in: the
@@ -77,6 +82,9 @@ class LoudnessToFriction {
   // force is loForce, at or above hiAbs_ it is hiForce; in between, dB * forceSlope_ + offset.
   double loAbs_ = 0.0, hiAbs_ = 0.0;
   float forceAtLoAbs_ = 0.f, forceAtHiAbs_ = 0.f;
+  // The force range, sorted: every output is clamped into it, so that neither the fast
+  // logarithm's error nor rounding takes a force past loForce or hiForce.
+  float minForce_ = 0.f, maxForce_ = 0.f;
   double forcePerDb_ = 0.0, forceOffset_ = 0.0, invRef_ = 1.0;
   float maxAbs_ = 1e30f;  // |a| taken into the sum is clamped here (see setMapping)
   // The fast path of equation (2), on the level mean / ref in float: clip in the linear domain

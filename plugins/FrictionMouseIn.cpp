@@ -36,7 +36,7 @@ class FrictionMouseIn : public SCUnit {
       for (int c = 0; c < 4; ++c) std::fill_n(out(c), numSamples, 0.f);
       return;
     }
-    const kf::TrajectoryMode mode = kf::trajectoryModeFromCode(static_cast<int>(in0(kInterpolation)));
+    const kf::TrajectoryMode mode = kf::trajectoryModeFromCode(kf::sc::codeOf(in0(kInterpolation)));
     if (mSlot.isNew(slot.generation)) {
       // Joins the device where the puck is: the slot's reference for this mode already holds
       // this block's entries.
@@ -45,16 +45,7 @@ class FrictionMouseIn : public SCUnit {
       kf::sc::addEntries(mTrajectory, slot.trajectory->entries(), slot.trajectory->numEntries());
       mTrajectory.setMode(mode);
     }
-    // A NaN or infinite origin would make every position NaN: 0 instead, said once.
-    double originMm = in0(kOriginMm);
-    if (!std::isfinite(originMm)) {
-      if (!mWarnedOrigin)
-        kf::sc::postFromRt(mWorld, "FrictionMouseIn: origin %g is not finite; 0 used.\n", kf::sc::shownValue(originMm));
-      mWarnedOrigin = true;
-      originMm = 0.0;
-    } else {
-      mWarnedOrigin = false;
-    }
+    const double originMm = usableOriginMm();
     if (mCalcRate == calc_FullRate) {
       // The slot's own sample duration, so all readers compute the same times.
       mTrajectory.render(clock.startS, clock.sampleDurS, numSamples, originMm, out(0), out(1), out(2), out(3));
@@ -70,9 +61,23 @@ class FrictionMouseIn : public SCUnit {
     }
   }
 
+  // A NaN or infinite origin would make every position NaN: the last finite origin is kept (as
+  // SpatialBufRd does), 0 while there has been none, said once per unit.
+  double usableOriginMm() {
+    const float value = in0(kOriginMm);
+    if (std::isfinite(value)) return mGoodOriginMm = value;
+    if (mBadOrigin.first(0))
+      kf::sc::postFromRt(mWorld,
+                         "FrictionMouseIn: origin %g is not finite; the last finite origin is kept (0 before the "
+                         "first).\n",
+                         kf::sc::shownValue(value));
+    return mGoodOriginMm;
+  }
+
   kf::TrajectoryReconstructor mTrajectory;
   kf::sc::SlotFollower mSlot;
-  bool mWarnedOrigin = false;
+  kf::sc::FirstTimeOnly mBadOrigin;
+  double mGoodOriginMm = 0.0;  // the last finite origin, 0 before the first
 };
 
 }  // namespace

@@ -1,6 +1,10 @@
 // LoudnessToFriction: the paper's equations (1) and (2), audio in, force in N out.
 // Inputs: in, window (s), loDb, hiDb, loForce (N), hiForce (N), ref, maxWindow (s, fixed at
 // init). Everything but `in` is read once per block.
+// Bad inputs give a defined output and one message each, the first time (help: "Bad inputs"):
+// maxWindow NaN/0/negative is the paper's, beyond the history limit (inf too) the limit; window
+// NaN/0/negative is the paper's, beyond maxWindow (inf too) maxWindow; the mapping's fallbacks
+// are kf::usableMapping's. A failed history allocation leaves the force of silence (loForce).
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -12,23 +16,35 @@ namespace {
 
 enum Input { kIn, kWindowS, kLoDb, kHiDb, kLoForceN, kHiForceN, kRef, kMaxWindowS };
 
+// The kinds of bad input, each posted once per unit (FirstTimeOnly).
+enum BadInput { kBadWindow, kWindowBeyondMax, kBadLoDb, kBadHiDb, kBadLoForce, kBadHiForce, kBadRef };
+
 // Upper bound on the history, whatever maxWindow asks: 2^22 samples is 21 s at 192 kHz.
 constexpr int kMaxHistorySamples = 1 << 22;
+
+// Two inputs are the same value (NaN included: a NaN held does not re-map every block).
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
 class LoudnessToFrictionUGen : public SCUnit {
  public:
   LoudnessToFrictionUGen() {
-    const double maxWindowS = std::max<double>(in0(kMaxWindowS), in0(kWindowS));
-    const double wanted = std::ceil(sampleRate() * (std::isfinite(maxWindowS) ? maxWindowS : 0.0));
-    mCapacity = static_cast<int>(std::clamp(wanted, 1.0, double(kMaxHistorySamples)));
+    mCapacity = historySamples();
     mHistory = static_cast<float*>(RTAlloc(mWorld, sizeof(float) * mCapacity));
     if (mHistory == nullptr) {
-      kf::sc::clearUnitOnAllocFailure(this, "LoudnessToFriction");
+      // Not 0 N, which no device can give: the force of silence, following the mapping inputs.
+      kf::sc::postFromRt(mWorld,
+                         "LoudnessToFriction: RT memory allocation failed (%d kB for maxWindow %g s); the output "
+                         "stays at the force of silence (loForce). Raise ServerOptions.memSize.\n",
+                         static_cast<int>(sizeof(float) * mCapacity / 1024), mMaxWindowS);
+      mCore.emplace(&mSilence, 1);
+      mCalcFunc = make_calc_function<LoudnessToFrictionUGen, &LoudnessToFrictionUGen::nextWithoutHistory>();
+      nextWithoutHistory(1);
       return;
     }
     mCore.emplace(mHistory, mCapacity);
     mCalcFunc = make_calc_function<LoudnessToFrictionUGen, &LoudnessToFrictionUGen::next>();
-    updateParameters();
+    updateWindow();
+    updateMapping();
     out0(0) = mCore->peekForce(in0(kIn));  // initial value, without consuming the first sample
   }
 
@@ -38,25 +54,89 @@ class LoudnessToFrictionUGen : public SCUnit {
 
  private:
   void next(int numSamples) {
-    updateParameters();
+    updateWindow();
+    updateMapping();
     mCore->process(in(kIn), out(0), numSamples);
   }
 
-  void updateParameters() {
-    mCore->setWindowSamples(kf::windowSamples(sampleRate(), in0(kWindowS), mCapacity));
-    const kf::FrictionMapping mapping{in0(kLoDb), in0(kHiDb), in0(kLoForceN), in0(kHiForceN), in0(kRef)};
-    if (mapping.loDb != mMapping.loDb || mapping.hiDb != mMapping.hiDb || mapping.loForceN != mMapping.loForceN ||
-        mapping.hiForceN != mMapping.hiForceN || mapping.ref != mMapping.ref) {
-      mMapping = mapping;
-      mCore->setMapping(mapping);  // a few pow()s: only when a parameter moved
+  // The history could not be allocated: the core runs on one silent sample it never takes in.
+  void nextWithoutHistory(int numSamples) {
+    updateMapping();
+    std::fill_n(out(0), numSamples, mCore->peekForce(0.f));
+  }
+
+  // The history's length from maxWindow, and mMaxWindowS: NaN, 0 and negative are the paper's
+  // maxWindow; beyond kMaxHistorySamples (inf too) the limit. Read once, at init.
+  int historySamples() {
+    mMaxWindowS = in0(kMaxWindowS);
+    if (!(mMaxWindowS > 0.0)) {
+      kf::sc::postFromRt(mWorld, "LoudnessToFriction: maxWindow %g s is not > 0; the paper's %g s used.\n",
+                         kf::sc::shownValue(mMaxWindowS), kf::paper::mapping::maxWindowS);
+      mMaxWindowS = kf::paper::mapping::maxWindowS;
     }
+    const double wanted = std::ceil(sampleRate() * mMaxWindowS);
+    if (wanted > kMaxHistorySamples) {
+      const double limitS = kMaxHistorySamples / sampleRate();
+      kf::sc::postFromRt(mWorld,
+                         "LoudnessToFriction: maxWindow %g s is beyond the history limit of %d samples; %g s used.\n",
+                         mMaxWindowS, kMaxHistorySamples, limitS);
+      mMaxWindowS = limitS;
+      return kMaxHistorySamples;
+    }
+    return std::max(1, static_cast<int>(wanted));
+  }
+
+  // window NaN, 0 or negative: the paper's window (at most maxWindow); beyond maxWindow (inf
+  // too): maxWindow. A window below half a sample is one sample.
+  void updateWindow() {
+    double windowS = in0(kWindowS);
+    if (!(windowS > 0.0)) {
+      if (mBadInputs.first(kBadWindow))
+        kf::sc::postFromRt(mWorld, "LoudnessToFriction: window %g s is not > 0; the paper's %g s used.\n",
+                           kf::sc::shownValue(windowS), kf::paper::mapping::windowS);
+      windowS = std::min(kf::paper::mapping::windowS, mMaxWindowS);
+    } else if (windowS > mMaxWindowS) {
+      if (mBadInputs.first(kWindowBeyondMax))
+        kf::sc::postFromRt(mWorld, "LoudnessToFriction: window %g s is beyond maxWindow %g s; maxWindow used.\n",
+                           windowS, mMaxWindowS);
+      windowS = mMaxWindowS;
+    }
+    mCore->setWindowSamples(kf::windowSamples(sampleRate(), windowS, mCapacity));
+  }
+
+  void updateMapping() {
+    const kf::FrictionMapping wanted{in0(kLoDb), in0(kHiDb), in0(kLoForceN), in0(kHiForceN), in0(kRef)};
+    if (mMapped && same(wanted.loDb, mWanted.loDb) && same(wanted.hiDb, mWanted.hiDb) &&
+        same(wanted.loForceN, mWanted.loForceN) && same(wanted.hiForceN, mWanted.hiForceN) &&
+        same(wanted.ref, mWanted.ref))
+      return;  // a few pow()s: only when a parameter moved
+    mMapped = true;
+    mWanted = wanted;
+    const kf::FrictionMapping used = kf::usableMapping(wanted);
+    noticeReplaced(kBadLoDb, "loDb", wanted.loDb, used.loDb, " dB", "a finite level");
+    noticeReplaced(kBadHiDb, "hiDb", wanted.hiDb, used.hiDb, " dB", "a finite level");
+    noticeReplaced(kBadLoForce, "loForce", wanted.loForceN, used.loForceN, " N", "a finite force >= 0");
+    noticeReplaced(kBadHiForce, "hiForce", wanted.hiForceN, used.hiForceN, " N", "a finite force >= 0");
+    noticeReplaced(kBadRef, "ref", wanted.ref, used.ref, "", "a finite amplitude > 0");
+    mCore->setMapping(used);
+  }
+
+  void noticeReplaced(BadInput kind, const char* name, double wanted, double used, const char* unit, const char* rule) {
+    if (wanted == used || !mBadInputs.first(kind)) return;
+    kf::sc::postFromRt(mWorld, "LoudnessToFriction: %s %g%s is not %s; %g%s used.\n", name, kf::sc::shownValue(wanted),
+                       unit, rule, used, unit);
   }
 
   float* mHistory = nullptr;
+  float mSilence = 0.f;  // the history of one sample when the allocation failed
   int mCapacity = 1;
+  double mMaxWindowS = 0.0;  // maxWindow as used (the input, the paper's or the limit)
   // The core lives inside the unit, made once the history is allocated: no other allocation.
   std::optional<kf::LoudnessToFriction> mCore;
-  kf::FrictionMapping mMapping;
+  // The inputs the mapping was last made from.
+  kf::FrictionMapping mWanted;
+  bool mMapped = false;
+  kf::sc::FirstTimeOnly mBadInputs;
 };
 
 }  // namespace

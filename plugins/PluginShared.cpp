@@ -49,16 +49,6 @@ void postFromRt(World* world, const char* format, ...) {
   if (!SendMsgFromRT(world, msg)) gSlotBusy[index].store(false, std::memory_order_release);
 }
 
-void clearUnitOnAllocFailure(Unit* unit, const char* ugenName) {
-  postFromRt(unit->mWorld,
-             "%s: RT memory allocation failed; the UGen outputs silence. "
-             "Raise ServerOptions.memSize.\n",
-             ugenName);
-  unit->mCalcFunc = reinterpret_cast<UnitCalcFunc>(ft->fClearUnitOutputs);
-  ft->fClearUnitOutputs(unit, 1);
-  unit->mDone = true;
-}
-
 }  // namespace kf::sc
 
 PluginLoad(KineticFriction) {

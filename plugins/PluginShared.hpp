@@ -4,6 +4,7 @@
 #include <SC_PlugIn.hpp>
 
 #include <cmath>
+#include <cstdint>
 
 extern InterfaceTable* ft;
 
@@ -12,16 +13,35 @@ namespace kf::sc {
 // A value for a message: NaN without the sign printf would show ("-nan").
 inline double shownValue(double value) { return std::isnan(value) ? std::fabs(value) : value; }
 
+// An input read as an integer code (an interpolation mode): NaN, inf and values beyond int give
+// -1, which is no code (the UGen's default mode), where a cast would be undefined.
+inline int codeOf(float input) { return input > -1e9f && input < 1e9f ? static_cast<int>(input) : -1; }
+
 // Posts a message without doing I/O on the audio thread: the text is formatted into static
 // storage and printed by the NRT thread (directly when rendering a Score, where there is no
 // realtime audio thread to protect).
 void postFromRt(World* world, const char* format, ...) __attribute__((format(printf, 2, 3)));
 
-// Turns a unit whose RTAlloc failed into one that outputs silence, with one message.
-void clearUnitOnAllocFailure(Unit* unit, const char* ugenName);
+// Each kind of bad input of one unit is posted once, the first time it happens: a bad value
+// held for an hour posts one line, not one a block, and so does an input that flips between good
+// and bad every block (a kind is never re-armed: a storm of lines is the harm this prevents).
+// The UGen numbers its kinds 0..31.
+class FirstTimeOnly {
+ public:
+  bool first(int kind) {
+    const uint32_t bit = uint32_t{1} << kind;
+    const bool isFirst = (posted_ & bit) == 0;
+    posted_ |= bit;
+    return isFirst;
+  }
+
+ private:
+  uint32_t posted_ = 0;
+};
 
 // Which device a device UGen follows: one warning while its slot is closed (again after a device
-// came and went), and word of a device it has not seen yet, so that it resets its state.
+// came and went), one for a device input that is no slot number (once per unit, as every bad
+// input), and word of a device it has not seen yet, so that it resets its state.
 class SlotFollower {
  public:
   void closed(World* world, const char* ugenName, int index, const char* consequence) {
@@ -33,8 +53,7 @@ class SlotFollower {
   // The device input is no slot number (NaN, inf, negative, 16 or more).
   void badIndex(World* world, const char* ugenName, float input, int numSlots, const char* consequence) {
     generation_ = 0;
-    if (warned_) return;
-    warned_ = true;
+    if (!badIndex_.first(0)) return;
     postFromRt(world, "%s: device %g is not a slot number 0..%d; %s\n", ugenName, shownValue(input), numSlots - 1,
                consequence);
   }
@@ -49,6 +68,7 @@ class SlotFollower {
  private:
   uint32_t generation_ = 0;
   bool warned_ = false;
+  FirstTimeOnly badIndex_;
 };
 
 }  // namespace kf::sc

@@ -20,8 +20,10 @@ SpatialBufRd : MultiOutUGen {
 
 	argNamesInputsOffset { ^2 }
 
+	// Literal values are checked here; values from controls reach the server unchecked, where a bad
+	// samplesPerMm or origin keeps the last good one with a message (help: Bad inputs).
 	checkInputs {
-		var interpolation = inputs[4], samplesPerMm = inputs[2];
+		var interpolation = inputs[4], samplesPerMm = inputs[2], origin = inputs[3];
 		if(rate == 'audio' and: { inputs[1].rate != 'audio' }) {
 			^"position must be audio rate for SpatialBufRd.ar (got %); use K2A.ar or SpatialBufRd.kr".format(
 				inputs[1].rate)
@@ -29,8 +31,11 @@ SpatialBufRd : MultiOutUGen {
 		if(interpolation.isNumber and: { [1, 2, 4].includes(interpolation).not }) {
 			^"interpolation must be 1 (none), 2 (linear) or 4 (cubic), got %".format(interpolation)
 		};
-		if(samplesPerMm.isNumber and: { samplesPerMm.isNaN or: { samplesPerMm.abs == inf } }) {
-			^"samplesPerMm must be finite, got %".format(samplesPerMm)
+		if(samplesPerMm.isNumber and: { samplesPerMm.isNaN or: { samplesPerMm == inf } or: { samplesPerMm <= 0 } }) {
+			^"samplesPerMm must be a finite number > 0, got %".format(samplesPerMm)
+		};
+		if(origin.isNumber and: { origin.isNaN or: { origin.abs == inf } }) {
+			^"origin must be finite, got %".format(origin)
 		};
 		^this.checkValidInputs
 	}

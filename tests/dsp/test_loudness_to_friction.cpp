@@ -182,6 +182,30 @@ TEST_CASE("extreme and reversed mappings") {
     CHECK(runCore(c, std::vector<float>(16, 1.f)).back() == 0.5f);
     CHECK(runCore(c, std::vector<float>(16, 0.f)).back() == 0.14f);
   }
+  SECTION("a negative force is 0 N: friction never pushes") {
+    Core c(8);
+    c.core.setWindowSamples(8);
+    c.core.setMapping(FrictionMapping{-30.0, 0.0, -1.0, -0.5, 1.0});
+    CHECK(runCore(c, std::vector<float>(16, 1.f)).back() == 0.f);
+    CHECK(runCore(c, std::vector<float>(16, 0.f)).back() == 0.f);
+  }
+  SECTION("usableMapping says what setMapping uses") {
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    const FrictionMapping paper;
+    const FrictionMapping bad = kf::usableMapping(FrictionMapping{nan, -inf, inf, -2.0, 0.0});
+    CHECK(bad.loDb == paper.loDb);
+    CHECK(bad.hiDb == paper.hiDb);
+    CHECK(bad.loForceN == paper.loForceN);
+    CHECK(bad.hiForceN == 0.0);
+    CHECK(bad.ref == paper.ref);
+    // Reversed, threshold and huge values are kept as they are.
+    const FrictionMapping kept = kf::usableMapping(FrictionMapping{1e30, -1e30, 3e38, 0.0, 1e-30});
+    CHECK(kept.loDb == 1e30);
+    CHECK(kept.hiDb == -1e30);
+    CHECK(kept.loForceN == 3e38);
+    CHECK(kept.hiForceN == 0.0);
+    CHECK(kept.ref == 1e-30);
+  }
   SECTION("a tiny ref moves 0 dB down") {
     FrictionMapping m;
     m.ref = 1e-6;
@@ -189,6 +213,40 @@ TEST_CASE("extreme and reversed mappings") {
     c.core.setWindowSamples(8);
     c.core.setMapping(m);
     CHECK(runCore(c, std::vector<float>(16, 1e-6f)).back() == Approx(0.5f));
+  }
+}
+
+// Every output lies within [loForce, hiForce]: the fast logarithm's error and rounding are
+// clamped away at both ends, for rising, reversed and far-off mappings. The last two went past
+// a bound by about 1e-7 N without the clamp (found by a random search near the bounds).
+TEST_CASE("the force never leaves [loForce, hiForce]") {
+  const FrictionMapping mappings[] = {FrictionMapping{},
+                                      {0.0, -30.0, 0.14, 0.5, 1.0},
+                                      {-30.0, 0.0, 0.5, 0.14, 1.0},
+                                      {-1e30, 1e30, 0.14, 1.4, 1.0},
+                                      {-3.0, -2.0, 0.0, 1000.0, 1.0},
+                                      {-18.776998966811725, -3.0221598034845396, 0.516272664, 0.843547344, 1.0},
+                                      {-7.1003481379589743, 1.9105385349107724, 0.103913911, 0.445142716, 1.0}};
+  for (const FrictionMapping& m : mappings) {
+    Core c(1);
+    c.core.setWindowSamples(1);  // the output is the mapping of |a| itself
+    c.core.setMapping(m);
+    // Levels across and beyond the clip range, and the 64 floats on each side of each bound.
+    std::vector<float> in;
+    for (int i = 0; i <= 4096; ++i) in.push_back(static_cast<float>(std::pow(10.0, (-80.0 + 100.0 * i / 4096) / 20.0)));
+    for (double db : {m.loDb, m.hiDb}) {
+      const float x = static_cast<float>(m.ref * std::pow(10.0, db / 20.0));
+      float below = x, above = x;
+      for (int k = 0; k < 64; ++k) {
+        in.push_back(below = std::nextafter(below, 0.f));
+        in.push_back(above = std::nextafter(above, 1e30f));
+      }
+    }
+    const std::vector<float> out = runCore(c, in);
+    const float lo = static_cast<float>(std::min(m.loForceN, m.hiForceN));
+    const float hi = static_cast<float>(std::max(m.loForceN, m.hiForceN));
+    for (float f : out)
+      if (!(f >= lo && f <= hi)) FAIL_CHECK("force " << f << " N outside [" << lo << ", " << hi << "]");
   }
 }
 

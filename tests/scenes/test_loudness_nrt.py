@@ -1,5 +1,7 @@
 """LoudnessToFriction rendered by scsynth -N against equations (1) and (2) recomputed in double
 (kfharness.reference)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -89,12 +91,22 @@ def test_control_rate_and_bad_arguments():
             { LoudnessToFriction.ar(DC.kr(0)) },
             { LoudnessToFriction.ar(DC.ar(0), maxWindow: \\w.kr(0.1)) },
             { LoudnessToFriction.ar(DC.ar(0), 0.2, maxWindow: 0.1) },
-            { LoudnessToFriction.ar(DC.ar(0), ref: 0) }
+            { LoudnessToFriction.ar(DC.ar(0), ref: 0) },
+            // Non-finite literals, and SpatialBufRd's (the server's replacements are for controls).
+            { LoudnessToFriction.ar(DC.ar(0), maxWindow: inf) },
+            { LoudnessToFriction.ar(DC.ar(0), 0/0) },
+            { LoudnessToFriction.ar(DC.ar(0), ref: 0/0) },
+            { SpatialBufRd.ar(1, 0, DC.ar(0), 0) },
+            { SpatialBufRd.ar(1, 0, DC.ar(0), 100, inf) }
         ].do { |f| try { SynthDef(\\bad, f).add } { |e| errors.add(e.errorString) } };
         errors.do(_.postln);
-        if(errors.size != 4) { Error("expected 4 errors, got %".format(errors.size)).throw };
+        if(errors.size != 9) { Error("expected 9 errors, got %".format(errors.size)).throw };
     """)
     assert "in must be audio rate" in out
     assert "maxWindow is fixed at init" in out
-    assert "window must be > 0 and <= maxWindow" in out
-    assert "ref must be > 0" in out
+    assert "maxWindow must be > 0 s and finite, got inf" in out
+    # sclang shows 0/0 as -nan on x86-64, nan elsewhere
+    assert re.search(r"window must be > 0 and <= maxWindow \(0\.05 s\), got -?nan", out)
+    assert "ref must be > 0 and finite, got 0" in out and re.search(r"ref must be > 0 and finite, got -?nan", out)
+    assert "samplesPerMm must be a finite number > 0, got 0" in out
+    assert "origin must be finite, got inf" in out
