@@ -1,24 +1,47 @@
-"""Every code:: example of every help file runs on a booted realtime server (JACK dummy).
+"""Every code:: example of every help file runs on a booted realtime server (JACK dummy), fails
+when it fails, and posts what its text says it posts.
 
 Each block is split as a user evaluates it in the IDE: a region between a line holding only "("
 and a line starting with ")" is one piece, every other non-blank line is one piece. (If a piece
 alone does not compile, the whole block runs as one piece.) Pieces run in order on AppClock, a
-short pause after each; a block gets ~1.5 s. Blocks of a file run in order, so later ones see the
-~variables and synths of earlier ones; after the last block of a file, s.freeAll and every device
-slot is closed (FREE_EACH_BLOCK = True frees nodes after every block instead).
+short pause after each, and each piece's value is posted as "-> value", as the IDE does; a block
+gets ~1.5 s. Blocks of a file run in order, so later ones see the ~variables and synths of
+earlier ones; after the last block of a file, s.freeAll and every device slot is closed
+(FREE_EACH_BLOCK = True frees nodes after every block instead).
 
 A block whose first line is a comment beginning "// needs " ("// needs a mouse") needs hardware
 this machine may not have: it is skipped (it still has to compile: tests/scenes/test_help.py).
 
-The test fails on any sclang error (thrown by a piece, or posted as ERROR from a routine or a
-responder it started), on a piece that does not compile, and when scsynth exits.
-GUI examples (.plot, .scope, Window) run headless with QT_QPA_PLATFORM=offscreen.
+An example fails (FAILURES) on a line of the server or sclang saying something went wrong:
+"FAILURE IN SERVER", "Node <n> not found", a line starting "ERROR" (sclang errors, and the
+refusals FrictionAnswers posts), "*** ERROR", an sclang exception (a piece that threw,
+DoesNotUnderstand, a call stack), a piece that does not compile, a command the server refused
+("kfZero: no device is open at index 7"), scsynth exiting or crashing; the whole run fails on a
+non-zero exit or a time-out, naming the piece that was running. Each failure names the file, the
+block (SCDoc's code block number, from 0, and its first line) and the offending line.
+
+An example that shows an error on purpose says so, and only that error is then allowed; what it
+posts is checked against what its text says, by comments the runner reads (ANNOTATIONS):
+
+  // expect error: <text>  this block must post a failure line containing <text>; any other
+                           failure line still fails it
+  // -> <value>            a piece's value: the line "-> <value>" is posted, as in the IDE
+  // posts: <text>         a line containing <text> is posted
+  // writes: <file> (<n> channels, <d> s)
+                           the file (in Platform.defaultTempDir unless absolute) is written
+                           during the run; a WAV file has n channels and lasts d s (both optional)
+
+Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
+A block's output is what is posted from its start to the end of its file: an NRT render or a
+server reply may come after the block's 1.5 s on a loaded machine.
+test_broken_examples_are_reported shows that each rule fails a broken example.
 """
 import os
 import re
+import time
 from pathlib import Path
 
-from kfharness import paths, sclang
+from kfharness import paths, readers, sclang
 from kfharness.jack import JackServer
 
 HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or paths.REPO_DIR / "HelpSource")
@@ -31,6 +54,7 @@ FREE_EACH_BLOCK = False
 
 RUNNER = r"""
 var files = [%(files)s];
+var markers = ["// -> ", "// posts: ", "// writes: ", "// expect error: "];
 var codeBlocks, piecesOf, serverAlive, restart;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -72,6 +96,7 @@ restart = {
 	"KF-SCSYNTH-PID %%".format(s.pid).postln;
 };
 
+"KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
 files.do { |path|
 	var doc = SCDoc.parseFileFull(path), blocks;
 	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%".format(path).postln } {
@@ -79,19 +104,31 @@ files.do { |path|
 		"KF-HELP-FILE %% (%% blocks)".format(path, blocks.size).postln;
 		blocks.do { |code, b|
 			var pieces = piecesOf.(code), start = Main.elapsedTime;
+			var lines = code.split($\n), first = lines.detect { |l| l.stripWhiteSpace.notEmpty and: { l.stripWhiteSpace != "(" } };
+			// The block and what its comments say it does, for the test to check.
+			"KF-HELP-BLOCK %% %% %%".format(path, b, (first ? "").stripWhiteSpace.keep(70)).postln;
+			lines.do { |line|
+				markers.do { |marker|
+					line.find(marker) !? { |at| ("KF-HELP-EXPECT " ++ marker.drop(3) ++ line.drop(at + marker.size)).postln }
+				}
+			};
 			if(code.stripWhiteSpace.beginsWith("// needs ")) {
 				"KF-HELP-SKIPPED %% %% (needs hardware)".format(path, b).postln;
 				pieces = [];
 				start = start - %(block_time)f;  // no time to wait for
 			};
 			pieces.do { |piece, p|
-				var fn = piece.compile;
+				var fn = piece.compile, value, threw = false;
 				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
 				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%".format(path, b, p).postln } {
-					try { fn.value } { |error|
+					// The value is kept before it is posted: with "-> " ++ fn.value inside the try,
+					// an error caught within the piece left 1.0 in place of the pending "-> ".
+					try { value = fn.value } { |error|
 						error.reportError;
+						threw = true;
 						"KF-HELP-THROWN %% %% %%".format(path, b, p).postln;
 					};
+					if(threw.not) { ("-> " ++ value.asString).postln };
 				};
 				%(piece_pause)f.wait;
 			};
@@ -113,58 +150,243 @@ files.do { |path|
 "KF-HELP-ALL-DONE".postln;
 """
 
-PROBLEM_PATTERNS = [
+FAILURES = [
+    (re.compile(r"FAILURE IN SERVER"), "the server failed a command"),
+    (re.compile(r"Node -?\d+ not found"), "a node that is not there"),
     (re.compile(r"^ERROR"), "sclang error"),
+    (re.compile(r"\*\*\* ERROR"), "an error"),
     (re.compile(r"^KF-HELP-THROWN"), "a piece threw"),
+    (re.compile(r"DoesNotUnderstand|^(PROTECTED )?CALL STACK"), "an sclang exception"),
     (re.compile(r"^KF-HELP-COMPILE-FAILED"), "a piece does not compile"),
     (re.compile(r"^KF-HELP-PARSE-FAILED"), "the help file does not parse"),
     (re.compile(r"^KF-HELP-SERVER-DIED"), "scsynth exited"),
     (re.compile(r"^Server '\w+' exited"), "scsynth exited"),
     (re.compile(r"^(Segmentation fault|Aborted|terminate called)"), "a crash"),
-    # Every line the device commands post, but kfStatus, reports a failed command.
-    (re.compile(r"^kf(OpenSim|OpenReplay|Record|Close)\b.*: "), "a device command failed"),
-    (re.compile(r"^kfBoard\w+: "), "a board command failed"),
     (re.compile(r"RT memory allocation failed"), "RT memory allocation failed"),
+    # The plugin's commands post only their refusals as "<command>: <reason>"; kfListMice also
+    # posts its count so, and kfOpenReplay a warning about the file it still plays.
+    (re.compile(r"^kf\w+: (?!warning: |\w+: \d+ mice$)"), "a command refused by the server"),
 ]
-NOTE_PATTERNS = [re.compile(p) for p in (r"^FAILURE IN SERVER", r"^WARNING", r"^KF-HELP-NOTE",
-                                         r"no device is open", r"^kf\w+: ")]
+NOTES = [re.compile(p) for p in (r"^WARNING", r"^KF-HELP-NOTE", r"no device is open", r"^kf\w+: ")]
+EXPECT = re.compile(r"^KF-HELP-EXPECT (->|posts:|writes:|expect error:) (.*)$")
+NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+
+
+class Example:
+    """One code block: what its comments expect, what was posted while it and the rest of its
+    file ran, and the failure lines posted while it ran."""
+
+    def __init__(self, path, block, first_line):
+        self.path, self.block, self.first_line = path, block, first_line
+        self.expects = []  # (kind, text)
+        self.output = []
+        self.failures = []  # (piece, what, line)
+
+    def __str__(self):
+        return f"{self.path} block {self.block} ({self.first_line})"
+
+
+def matcher(text, whole_line=False):
+    """A function telling whether a posted line holds `text`, its numbers to the precision written."""
+    parts = re.split(f"(?<![\\w.])({NUMBER})(?![\\d.])", text.strip())
+    pattern, wanted = "", []
+    for i, part in enumerate(parts):
+        if i % 2:
+            decimals = len(part.split(".")[1].split("e")[0].split("E")[0]) if "." in part else 0
+            exponent = int(re.split("[eE]", part)[1]) if re.search("[eE]", part) else 0
+            wanted.append((float(part), 0.5 * 10.0 ** (exponent - decimals)))
+            pattern += f"(?<![\\w.])({NUMBER})(?![\\d.])"
+        else:
+            pattern += r"\s+".join(re.escape(word) for word in part.split(" ")) if part.strip() else re.escape(part)
+    regex = re.compile(f"^{pattern}$" if whole_line else pattern)
+
+    def holds(line):
+        for m in regex.finditer(line.strip()):
+            if all(abs(float(got) - value) <= tolerance for got, (value, tolerance) in zip(m.groups(), wanted)):
+                return True
+        return False
+    return holds
+
+
+def check_written(text, temp_dir, since):
+    """Why the file `text` names was not written as it says, or None."""
+    m = re.fullmatch(r"(\S+)(?: \((.*)\))?", text.strip())
+    path = Path(temp_dir) / m[1]
+    if not path.exists() or path.stat().st_mtime < since:
+        return f"{path} was not written"
+    for detail in (m[2] or "").split(", "):
+        if not detail:
+            continue
+        data, rate = readers.read_wav(path)
+        if c := re.fullmatch(r"(\d+) channels?", detail):
+            if data.shape[1] != int(c[1]):
+                return f"{path} has {data.shape[1]} channels, not {c[1]}"
+        elif d := re.fullmatch(f"({NUMBER}) s", detail):
+            if abs(len(data) / rate - float(d[1])) > 0.01:
+                return f"{path} lasts {len(data) / rate:.4f} s, not {d[1]} s"
+        else:
+            return f"cannot check '{detail}' of {path}"
+    return None
+
+
+def run_examples(files, jack, timeout=240):
+    """Runs every example of `files` on one server booted against `jack`. Returns (run, examples,
+    problems, notes): problems are the failures and unmet expectations, each naming its example."""
+    since = time.time()
+    run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
+                                               piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
+                                               free_each_block=str(FREE_EACH_BLOCK).lower()),
+                                 jack, name="help", timeout=timeout)
+    examples, in_file, current, notes, problems = [], [], None, [], []
+    where, temp_dir, finished, in_stack = "(before the first example)", "/tmp", False, False
+    for line in run.output.splitlines():
+        # An error dump's call stack prints the runner's variables, the examples' code among them:
+        # not output, and not failures of their own (the dump's ERROR line is). It ends with a
+        # "^^ ..." line, or at the runner's next line.
+        if in_stack:
+            in_stack = not line.startswith(("^^", "KF-HELP-"))
+            if in_stack:
+                continue
+        in_stack = bool(re.match(r"(PROTECTED )?CALL STACK", line))
+        if line.startswith("KF-HELP-ALL-DONE"):
+            finished = True
+            break  # then the harness's own server quit
+        if line.startswith("KF-HELP-TEMPDIR "):
+            temp_dir = line.split(" ", 1)[1]
+            continue
+        if line.startswith("KF-HELP-BLOCK "):
+            path, block, first_line = (line.split(" ", 3) + [""])[1:4]
+            current = Example(path, int(block), first_line)
+            examples.append(current)
+            in_file.append(current)
+            where = "piece -"
+            continue
+        if m := EXPECT.match(line):
+            current.expects.append((m[1].rstrip(":"), m[2]))
+            continue
+        if line.startswith("KF-HELP-PIECE "):
+            where = "piece " + line.split()[-1]
+        if line.startswith("KF-HELP-FILE-DONE "):
+            in_file = []
+        if not line.startswith("KF-HELP-"):
+            for example in in_file:
+                example.output.append(line)
+        for pattern, what in FAILURES:
+            if pattern.search(line):
+                if current is None:
+                    problems.append(f"{where}: {what}: {line}")
+                else:
+                    current.failures.append((where, what, line))
+                break
+        else:
+            if any(p.search(line) for p in NOTES):
+                notes.append(f"{current or where}: {line}")
+    if not finished or not run.ok:
+        why = "timed out" if "timed out" in run.output or "KF-SCRIPT-TIMEOUT" in run.output else \
+            f"exited with {run.returncode}"
+        problems.append(f"the run {why} while running {current} {where}; log {run.log_path}")
+
+    for example in examples:
+        expected_errors = [text for kind, text in example.expects if kind == "expect error"]
+        seen, reported = set(), set()
+        for piece, what, line in example.failures:
+            shown = [text for text in expected_errors if text in line]
+            seen.update(shown)
+            if not shown and (piece, what) not in reported:  # one line of each kind a piece: no call stacks
+                reported.add((piece, what))
+                problems.append(f"{example} {piece}: {what}: {line}")
+        for kind, text in example.expects:
+            if kind == "expect error":
+                ok = text in seen
+            elif kind == "->":
+                ok = any(map(matcher("-> " + text, whole_line=True), example.output))
+            elif kind == "posts":
+                ok = any(map(matcher(text), example.output))
+            else:
+                why = check_written(text, temp_dir, since)
+                if why:
+                    problems.append(f"{example}: // writes: {text}: {why}")
+                continue
+            if not ok:
+                # What came instead: lines holding the text before its first number, or its values.
+                head = re.split(NUMBER, text)[0].strip() if kind == "posts" else ""
+                came = [line for line in example.output if (line.startswith("-> ") if not head else head in line)]
+                label = kind if kind == "->" else kind + ":"
+                problems.append(f"{example}: // {label} {text}: not posted (posted: {came[:4]})")
+    return run, examples, problems, notes
 
 
 def test_every_help_example_runs_on_a_realtime_server():
     files = sorted(HELP_DIR.rglob("*.schelp"))
     assert files, "no help files"
     with JackServer() as jack:
-        run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
-                                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
-                                          free_each_block=str(FREE_EACH_BLOCK).lower()),
-                            jack, name="help", timeout=240)
+        run, examples, problems, notes = run_examples(files, jack)
         jack_alive = jack.alive()
-
-    # Attribute every line to the piece that was running when it was posted.
-    problems, notes = [], []
-    where = "(before the first example)"
-    finished = False
-    for line in run.output.splitlines():
-        if line.startswith("KF-HELP-PIECE ") or line.startswith("KF-HELP-FILE "):
-            where = line.split(" ", 1)[1]
-        if line.startswith("KF-HELP-ALL-DONE"):
-            finished = True
-        if finished:
-            continue  # the harness's own server quit
-        for pattern, what in PROBLEM_PATTERNS:
-            if pattern.search(line):
-                problems.append(f"{where}: {what}: {line}")
-                break
-        else:
-            if any(p.search(line) for p in NOTE_PATTERNS):
-                notes.append(f"{where}: {line}")
 
     summary = paths.work_dir() / "help-examples-summary.txt"
     summary.write_text("\n".join(["PROBLEMS"] + problems + ["", "NOTES"] + notes) + "\n")
     print(f"log {run.log_path}\nsummary {summary}")
     print("\n".join(notes))
-    assert finished and run.ok, f"the runner did not finish (rc {run.returncode}), log {run.log_path}:\n{run.output[-5000:]}"
     assert jack_alive, "jackd died during the examples"
     for f in files:
-        assert f"KF-HELP-FILE-DONE {f}" in run.output, f"{f} did not run"
+        assert f"KF-HELP-FILE-DONE {f}" in run.output, f"{f} did not run, log {run.log_path}"
     assert not problems, "help examples with problems:\n" + "\n".join(problems)
+    assert sum(len(e.expects) for e in examples) >= 10, "the help's output annotations were not read"
+
+
+# Broken examples, one way each, and a good block: every broken one must be reported, the good
+# one not. One server run for all. (Node numbers far above those sclang allocates.)
+BROKEN_HELP = """title:: BrokenExamples
+summary:: Examples the help-example test must report
+categories:: KineticFriction
+
+description::
+
+code::
+s.sendMsg("/n_set", 99999, \\freq, 1);
+::
+
+code::
+Error("a broken example").throw;
+nil.kfNoSuchMethod;
+::
+
+code::
+(1 + 1).postln;  // posts: 3
+0.5 + 0.25;  // -> 0.9
+1 + 1;  // writes: kf-help-never-written.wav
+::
+
+code::
+// expect error: Node 99997 not found
+s.sendMsg("/n_free", 99996);
+::
+
+code::
+// expect error: Node 99998 not found
+s.sendMsg("/n_free", 99998);
+(1 + 1).postln;  // posts: 2
+0.5 + 0.25;  // -> 0.75
+::
+"""
+# (block, what its report says)
+BROKEN = [(0, "FAILURE IN SERVER /n_set Node 99999 not found"), (1, "ERROR: a broken example"),
+          (1, "Message 'kfNoSuchMethod' not understood"), (2, "// posts: 3: not posted"),
+          (2, "// -> 0.9: not posted"), (2, "kf-help-never-written.wav was not written"),
+          (3, "FAILURE IN SERVER /n_free Node 99996 not found"),
+          (3, "// expect error: Node 99997 not found: not posted")]
+GOOD = 4
+
+
+def test_broken_examples_are_reported(tmp_path):
+    help_file = tmp_path / "HelpSource" / "Classes" / "BrokenExamples.schelp"
+    help_file.parent.mkdir(parents=True)
+    help_file.write_text(BROKEN_HELP)
+    with JackServer() as jack:
+        run, examples, problems, notes = run_examples([help_file], jack, timeout=120)
+    print("\n".join(problems))
+    assert run.ok and [e.block for e in examples] == list(range(GOOD + 1)), run.output[-3000:]
+    for block, what in BROKEN:
+        assert any(p.startswith(f"{help_file} block {block} ") and what in p for p in problems), \
+            f"broken block {block} not reported as '{what}':\n" + "\n".join(problems)
+    assert not [p for p in problems if p.startswith(f"{help_file} block {GOOD} ")], problems
