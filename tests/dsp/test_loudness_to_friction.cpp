@@ -23,6 +23,17 @@ struct Core {
   explicit Core(int maxWindow) : history(maxWindow), core(history.data(), maxWindow) {}
 };
 
+// Equation (2) as the paper writes it, in double and written here, not taken from dsp/: the level
+// L = 20 log10(mean / ref) dB places the force linearly between loForce at loDb and hiForce at
+// hiDb, held at the ends (silence is L = -inf). Reversed bounds hold the same way (the fraction
+// is clamped to [0, 1]); equal bounds are a threshold.
+double paperEquation2(double meanAbs, const FrictionMapping& m) {
+  const double levelDb = meanAbs > 0.0 ? 20.0 * std::log10(meanAbs / m.ref) : -HUGE_VAL;
+  if (m.hiDb == m.loDb) return levelDb >= m.hiDb ? m.hiForceN : m.loForceN;
+  const double fraction = std::min(1.0, std::max(0.0, (levelDb - m.loDb) / (m.hiDb - m.loDb)));
+  return m.loForceN + fraction * (m.hiForceN - m.loForceN);
+}
+
 // Equations (1) and (2) straight from the paper, in double, with zeros before the start.
 struct Reference {
   std::deque<double> window;
@@ -36,7 +47,7 @@ struct Reference {
     window.pop_front();
     double sum = 0;
     for (double v : window) sum += v;
-    return kf::frictionFromMeanAbs(sum / n, mapping);
+    return paperEquation2(sum / n, mapping);
   }
 };
 
@@ -64,6 +75,10 @@ TEST_CASE("reference mapping: the paper's end points and the full-scale sine") {
   CHECK(kf::frictionFromMeanAbs(std::pow(10.0, -1.5), m) == Approx(0.14));
   CHECK(kf::frictionFromMeanAbs(2.0 / kPi, m) == Approx(0.14 + 0.36 * (1 + 20 * std::log10(2 / kPi) / 30)));
   CHECK(kf::frictionFromMeanAbs(2.0 / kPi, m) == Approx(0.4530).margin(1e-4));
+  // The tests' own equation (2) gives the paper's numbers too.
+  CHECK(paperEquation2(0.0, m) == 0.14);
+  CHECK(paperEquation2(1.0, m) == 0.5);
+  CHECK(paperEquation2(2.0 / kPi, m) == Approx(0.4530).margin(1e-4));
 }
 
 TEST_CASE("window length is round(sr x window), clamped to [1, max]") {
@@ -136,7 +151,7 @@ TEST_CASE("NaN and Inf input never reach the output") {
   }
   CHECK(out[210] == 0.5f);  // Inf is as loud as it gets
   // ...and the running sum recovers once the Inf has left the window.
-  CHECK(out[999] == Approx(kf::frictionFromMeanAbs(0.5, FrictionMapping{})).margin(1e-6));
+  CHECK(out[999] == Approx(paperEquation2(0.5, FrictionMapping{})).margin(1e-6));
 }
 
 TEST_CASE("denormals and tiny levels read as loForce") {
@@ -270,7 +285,7 @@ TEST_CASE("the window can change while running, up to the maximum") {
       all.push_back(in[i]);
       double sum = 0;
       for (int k = 0; k < used && k < static_cast<int>(all.size()); ++k) sum += std::fabs(all[all.size() - 1 - k]);
-      REQUIRE(o[i] == Approx(kf::frictionFromMeanAbs(sum / used, FrictionMapping{})).margin(1e-6));
+      REQUIRE(o[i] == Approx(paperEquation2(sum / used, FrictionMapping{})).margin(1e-6));
     }
   }
 }
@@ -293,7 +308,7 @@ TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation"
       // Recompute the last n samples' mean in double and compare every 10^8 samples.
       double sum = 0;
       for (int k = 0; k < n; ++k) sum += std::fabs(double(in[kBlock - 1 - k]));
-      const double want = kf::frictionFromMeanAbs(sum / n, FrictionMapping{});
+      const double want = paperEquation2(sum / n, FrictionMapping{});
       worstN = std::max(worstN, std::fabs(out[kBlock - 1] - want));
       REQUIRE(out[kBlock - 1] == Approx(want).margin(1e-6));
       REQUIRE(c.core.meanAbs() == Approx(sum / n).epsilon(1e-12));
@@ -321,7 +336,7 @@ TEST_CASE("fast logarithm: worst error over the clip range, and when it is not u
     c.core.process(in.data(), out.data(), static_cast<int>(in.size()));
     double worst = 0;
     for (size_t i = 0; i < in.size(); ++i)
-      worst = std::max(worst, std::fabs(out[i] - kf::frictionFromMeanAbs(in[i], FrictionMapping{})));
+      worst = std::max(worst, std::fabs(out[i] - paperEquation2(in[i], FrictionMapping{})));
     INFO("worst |error| " << worst << " N");
     CHECK(worst <= 1e-6);
   }
@@ -335,7 +350,7 @@ TEST_CASE("fast logarithm: worst error over the clip range, and when it is not u
     for (size_t i = 0; i < in.size(); ++i) in[i] = static_cast<float>(std::pow(10.0, (-3.1 + 1.2 * i / 4095) / 20.0));
     c.core.process(in.data(), out.data(), 4096);
     for (size_t i = 0; i < in.size(); ++i) {
-      const double want = kf::frictionFromMeanAbs(in[i], steep);
+      const double want = paperEquation2(in[i], steep);
       REQUIRE(out[i] == Approx(want).margin(std::max(1e-6, want * 1e-7)));  // float output
     }
   }

@@ -76,17 +76,17 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
     assert got["opened"] and all(m.group(2) == "connected" and m.group(3) == "disarmed" for m in got["opened"])
     assert currents("disarmed") == [0.0] * 3, "a disarmed board is not driven"
     assert all(m.group(3) == "armed" and m.group(4) == "armed" for m in got["armed"])
-    # On a loaded machine an audio hiccup longer than the 10 ms watchdog may catch a read at 0;
-    # the board carries the commanded drive otherwise.
-    assert max(currents("armed")) == pytest.approx(0.5, abs=0.001)  # linear: (0.77 - 0.14) / 1.26
-    assert max(currents("calibrated")) == pytest.approx(0.25, abs=0.001)  # exact at a table point
-    assert currents("freed") == [0.0] * 3, "synth freed: the device's watchdog drove the board off"
+    # Every read while armed carries the commanded drive: the device thread runs realtime, so no
+    # stall reaches the 10 ms watchdog (a 0.0 here is the magnet dropping out on stage).
+    assert currents("armed") == [pytest.approx(0.5, abs=0.001)] * 3  # linear: (0.77 - 0.14) / 1.26
+    assert currents("calibrated") == [pytest.approx(0.25, abs=0.001)] * 3  # exact at a table point
+    assert currents("freed") == [0.0] * 3, "synth freed: the last FrictionOut gone drove the board off"
     assert got["removed"] == [], "no board after removeBoard"
     # The same through the reply sclang gets (FrictionDevice.boardStatus).
     replies = [l for l in lines if l.startswith("KF-BOARD-STATUS ")]
     assert len(replies) == 1, run.output[-3000:]
     assert replies[0].startswith("KF-BOARD-STATUS [ true, true, true, armed, "), replies
-    assert replies[0].endswith(", true ]") and (" 0.5," in replies[0] or " 0.0," in replies[0]), replies
+    assert replies[0].endswith(", true ]") and " 0.5," in replies[0], replies
     timing = [TIMING_LINE.match(l) for l in lines if TIMING_LINE.match(l)]
     assert timing, "kfStatus reports the frames per pump"
     print("\n".join(l for l in lines if l.startswith("kfStatus 5:")))

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from kfharness import paths, sclang
-from kfharness.jack import JackServer
 from kfharness.xvfb import Xvfb
 
 # --- screenshots as arrays ---------------------------------------------------------------------
@@ -171,26 +170,21 @@ def display():
         yield xvfb
 
 
-def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display):
+def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display, jack):
     ARTEFACTS.mkdir(parents=True, exist_ok=True)
     for old in ARTEFACTS.glob("shot*.png"):
         old.unlink()
-    for attempt in (1, 2):
-        with JackServer() as jack:
-            run = sclang.run_with_server(script(), jack, name="view", timeout=120, env=display.env())
-        print(f"log {run.log_path}\nscreenshots {ARTEFACTS}/shot1.png {ARTEFACTS}/shot2.png")
-        sclang.require_ok(run, "the view session")
-        assert not run.error_lines(), run.error_lines()
-        one, two = shot_info(run, "shot1"), shot_info(run, "shot2")
-        # The device cannot move faster than 127 counts per report (333 mm/s). Faster steps mean
-        # the machine stalled the simulated device's thread, which then caught up at once: the
-        # crossing did not happen as a user makes it. Such a run is taken again, once.
-        hist = two["history"]
-        fastest = max(np.abs(hist[:, 2]).max(), np.abs(np.diff(hist[:, 1]) / np.diff(hist[:, 0])).max())
-        if fastest <= MAX_SPEED_MM_PER_S * 1.2:
-            break
-        print(f"attempt {attempt}: the device jumped at {fastest:.0f} mm/s (a stalled machine)")
-    assert fastest <= MAX_SPEED_MM_PER_S * 1.2, f"the machine stalled the simulated device twice ({fastest:.0f} mm/s)"
+    run = sclang.run_with_server(script(), jack, name="view", timeout=120, env=display.env())
+    print(f"log {run.log_path}\nscreenshots {ARTEFACTS}/shot1.png {ARTEFACTS}/shot2.png")
+    sclang.require_ok(run, "the view session")
+    assert not run.error_lines(), run.error_lines()
+    one, two = shot_info(run, "shot1"), shot_info(run, "shot2")
+    # The device cannot move faster than 127 counts per report (333 mm/s). Faster steps would
+    # mean the simulated device's thread stalled and caught up at once: with its realtime
+    # scheduling (and JACK's, the `jack` fixture) that is a defect, not the machine's.
+    hist = two["history"]
+    fastest = max(np.abs(hist[:, 2]).max(), np.abs(np.diff(hist[:, 1]) / np.diff(hist[:, 0])).max())
+    assert fastest <= MAX_SPEED_MM_PER_S * 1.2, f"the simulated device jumped at {fastest:.0f} mm/s"
     start_mm, end_mm = two["fragment"]
     assert start_mm == pytest.approx(ORIGIN_MM) and end_mm == pytest.approx(ORIGIN_MM + 23999 / 500, abs=1e-3)
 
@@ -278,9 +272,11 @@ def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display
     assert (inside & (moving | resting)).sum() >= 15 and outside.sum() >= 30, (inside.sum(), outside.sum())
     off = outside & (np.abs(forces - floor) > 3 * px_n + 0.005)
     assert not off.any(), f"off the fragment but not at the floor: {list(zip(times[off], position[off], forces[off]))}"
-    if (inside & moving).sum() >= 5:
-        assert np.median(forces[inside & moving]) >= floor + 0.15
-        assert np.mean(forces[inside & moving] >= floor + 0.05) >= 0.95, forces[inside & moving]
+    # The hand pulls the puck across the 48 mm fragment at 40 mm/s, 1.2 s: columns that are
+    # clearly moving on it are always there (a run without them would check nothing: it fails).
+    assert (inside & moving).sum() >= 5, f"{(inside & moving).sum()} moving columns on the fragment"
+    assert np.median(forces[inside & moving]) >= floor + 0.15
+    assert np.mean(forces[inside & moving] >= floor + 0.05) >= 0.95, forces[inside & moving]
     expected = pilot_force(position[inside & resting])
     assert np.all(np.abs(forces[inside & resting] - expected) <= 3 * px_n + 0.005), \
         list(zip(position[inside & resting], forces[inside & resting], expected))
@@ -368,10 +364,9 @@ dev.close; buf.free; bus.free; posBus.free;
 """
 
 
-def test_any_device_and_player_cmd_period_and_close():
-    with JackServer() as jack:
-        run = sclang.require_ok(sclang.run_with_server(ANY_PLAYER.replace("@HID@", sclang.sc_string(HID_FILE)), jack,
-                                          name="view-any", timeout=90))
+def test_any_device_and_player_cmd_period_and_close(jack):
+    run = sclang.require_ok(sclang.run_with_server(ANY_PLAYER.replace("@HID@", sclang.sc_string(HID_FILE)), jack,
+                                                   name="view-any", timeout=90))
     print(f"log {run.log_path}")
     frames, force, commanded, signal_frames, time_s = (float(v) for v in run.lines("KF-BEFORE ")[0][:5])
     # The monitor started (late on a loaded machine) and sends 30 frames per s of server time
