@@ -76,33 +76,37 @@ inline SimRender renderAgainstSim(const HandScript& hand, double seconds, Trajec
 
 struct LagFit {
   double rmsErrorMm = 0.0;       // rendered against true position, at zero shift
-  double lagS = 0.0;             // the shift of the truth (0..30 ms) that minimises the RMS error
+  double lagS = 0.0;             // the shift of the truth (-30..30 ms) that minimises the RMS error;
+                                 // negative: the rendered trajectory leads the truth
   double rmsErrorAtLagMm = 0.0;  // the RMS error at that shift
 };
 
-// The lag of the rendered trajectory behind the truth, to the sample: a search in steps of 4
-// samples, then the samples around the best. The first skipS are left out.
+// The lag of the rendered trajectory behind the truth, to the sample, searched both ways (a
+// predictor may lead): steps of 4 samples, then the samples around the best. The first skipS
+// are left out.
 inline LagFit fitLag(const SimRender& render, double sampleRateHz, double skipS) {
-  const size_t skip = static_cast<size_t>(skipS * sampleRateHz);
+  const long skip = static_cast<long>(skipS * sampleRateHz);
   const std::vector<double>& truth = render.truthMm;
   const std::vector<double>& rendered = render.renderedMm;
-  auto rmsAtShift = [&](size_t shift) {
+  const long size = static_cast<long>(std::min(truth.size(), rendered.size()));
+  auto rmsAtShift = [&](long shift) {  // rendered[i] against truth[i - shift]
     double sum = 0.0;
-    size_t count = 0;
-    for (size_t i = skip + shift; i < rendered.size(); ++i, ++count) sum += std::pow(rendered[i] - truth[i - shift], 2);
-    return std::sqrt(sum / std::max<size_t>(count, 1));
+    long count = 0;
+    for (long i = std::max(skip, skip + shift); i < std::min(size, size + shift); ++i, ++count)
+      sum += std::pow(rendered[i] - truth[i - shift], 2);
+    return std::sqrt(sum / std::max<long>(count, 1));
   };
   LagFit fit;
   fit.rmsErrorMm = rmsAtShift(0);
   fit.rmsErrorAtLagMm = fit.rmsErrorMm;
-  size_t best = 0;
-  auto consider = [&](size_t shift) {
+  long best = 0;
+  auto consider = [&](long shift) {
     if (const double e = rmsAtShift(shift); e < fit.rmsErrorAtLagMm) fit.rmsErrorAtLagMm = e, best = shift;
   };
-  const size_t maxShift = static_cast<size_t>(0.03 * sampleRateHz);
-  for (size_t shift = 4; shift <= maxShift; shift += 4) consider(shift);
-  const size_t coarse = best;
-  for (size_t shift = coarse > 3 ? coarse - 3 : 1; shift <= coarse + 3; ++shift) consider(shift);
+  const long maxShift = static_cast<long>(0.03 * sampleRateHz);
+  for (long shift = -maxShift; shift <= maxShift; shift += 4) consider(shift);
+  const long coarse = best;
+  for (long shift = coarse - 3; shift <= coarse + 3; ++shift) consider(shift);
   fit.lagS = best / sampleRateHz;
   return fit;
 }
