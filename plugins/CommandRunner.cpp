@@ -48,13 +48,12 @@ OscArgReader readerOf(sc_msg_iter* msg) {
 
 // Refused commands post one line each, and the same refusal at most once a second (a flood
 // of one bad command must not flood the post window; different problems all show).
-void postRefusal(World* world, const char* name, const char* reason) {
+void postRefusal(World* world, const char* reason) {
   constexpr int kCauses = 16;
   static PostLimiter limiters[kCauses];
   static uint32_t causes[kCauses] = {};
-  uint32_t hash = 2166136261u;  // FNV-1a of command and message: the cause
-  for (const char* c : {name, reason})
-    for (; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
+  uint32_t hash = 2166136261u;  // FNV-1a of the reason (it names the command): the cause
+  for (const char* c = reason; *c != '\0'; ++c) hash = (hash ^ static_cast<uint8_t>(*c)) * 16777619u;
   int slot = static_cast<int>(hash % kCauses);
   if (causes[slot] != hash) {  // another cause had this slot: start afresh
     causes[slot] = hash;
@@ -159,7 +158,7 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
       failWith(data, "%s: device %d: %s; refused", name, data->args.index, error);
     else
       failWith(data, "%s: %s; refused", name, error);
-    postRefusal(world, name, data->reason);
+    postRefusal(world, data->reason);
     replyFailure(world, data);
     freeCommand(world, data);
     return nullptr;
