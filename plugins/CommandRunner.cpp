@@ -10,7 +10,7 @@
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 #include "PostLimiter.hpp"
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 #include "core/spec/SettingBounds.hpp"
 
 namespace kf::sc {

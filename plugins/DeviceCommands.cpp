@@ -30,7 +30,7 @@
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 #include "board/UsbBoardBackend.hpp"
-#include "core/DeviceMessages.hpp"
+#include "core/threads/DeviceMessages.hpp"
 
 namespace {
 

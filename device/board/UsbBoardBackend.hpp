@@ -20,8 +20,8 @@
 #include "board/BoardProtocol.hpp"
 #include "board/UsbPort.hpp"
 #include "core/ForceBackend.hpp"
-#include "core/PiMutex.hpp"
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/PiMutex.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 namespace kf {
 

@@ -8,7 +8,7 @@
 #include <exception>
 #include <string>
 
-#include "core/DeviceMessages.hpp"
+#include "core/threads/DeviceMessages.hpp"
 
 namespace kf {
 
@@ -363,17 +363,35 @@ TelemetrySnapshot Device::telemetry() const {
 }
 
 bool Device::startRecording(const std::string& path, std::string& error) {
+  if (isClosed()) {
+    error = "the device is closed";
+    return false;
+  }
+  stopRecording();  // a recording in progress ends first, its file complete
+  // Opened outside the lock (truncating a long file takes time); a realtime device's lines are
+  // written by a thread of their own, so the disk never holds up the device thread.
+  std::unique_ptr<RecordingWriter> writer =
+      RecordingWriter::open(path, sessionHeader(spec_), !lockstep_, options_.thread.slot, error);
+  if (!writer) return false;
   std::lock_guard<PiMutex> lock(stateMutex_);
   if (isClosed()) {
     error = "the device is closed";
     return false;
   }
-  return recorder_.open(path, spec_, error);
+  recorder_.attach(std::move(writer));
+  return true;
 }
 
 void Device::stopRecording() {
+  std::unique_ptr<RecordingWriter> writer;
+  {
+    std::lock_guard<PiMutex> lock(stateMutex_);
+    writer = recorder_.detach();
+  }
+  if (!writer) return;
+  writer->finish();  // the last writes, outside the lock: the device thread pumps on meanwhile
   std::lock_guard<PiMutex> lock(stateMutex_);
-  recorder_.close();
+  recorder_.noteFinished(*writer);
   if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
 }
 

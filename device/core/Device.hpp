@@ -14,7 +14,7 @@
 
 #include "core/ForceBackend.hpp"
 #include "core/MouseBackend.hpp"
-#include "core/PiMutex.hpp"
+#include "core/threads/PiMutex.hpp"
 #include "core/SpscQueue.hpp"
 #include "core/Telemetry.hpp"
 #include "core/files/SessionFile.hpp"

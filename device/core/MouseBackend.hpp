@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 #include "core/spec/Report.hpp"
 
 namespace kf {

@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "core/LatencyHistogram.hpp"
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 namespace kf {
 

@@ -1,15 +1,11 @@
 #include "core/files/SessionFile.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <mutex>
 #include <sstream>
 #include <utility>
 
@@ -64,105 +60,36 @@ bool parseFloat(const std::string& token, float& value) {
   return true;
 }
 
-// Files being recorded, by (device, inode): two paths to one file are one file. Never destroyed:
-// the plugin's exit hook, itself a static destructor, closes recorders after this file's own
-// statics may be gone.
-struct RecordingFiles {
-  std::mutex mutex;
-  std::vector<std::pair<unsigned long long, unsigned long long>> keys;
-};
-RecordingFiles& recordingFiles() {
-  static RecordingFiles* files = new RecordingFiles;
-  return *files;
-}
-
-constexpr size_t kRecorderBufferBytes = 64 * 1024;  // written out when a pump fills it
-
-bool writeAll(int fd, const char* data, size_t size, int& code) {
-  while (size > 0) {
-    const ssize_t written = ::write(fd, data, size);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      code = errno;
-      return false;
-    }
-    if (written == 0) {
-      code = EIO;
-      return false;
-    }
-    data += written;
-    size -= static_cast<size_t>(written);
-  }
-  return true;
-}
+constexpr size_t kRecorderBufferBytes = 64 * 1024;  // handed over when a pump fills it
 
 }  // namespace
 
-bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string& error) {
-  close();
-  error_.clear();
-  newFailure_ = false;
-  if (path.empty()) {
-    error = "no file given (empty path)";
-    return false;
-  }
-  // No O_TRUNC yet: a file another Recorder writes must not be cut. O_NONBLOCK: a FIFO
-  // without a reader must not block the command thread.
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    const int code = errno;
-    if (code == ENXIO)  // a FIFO without a reader, a device without its driver
-      error = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
-    else
-      error = "cannot write " + path + ": " + std::strerror(code);
-    return false;
-  }
-  struct stat info {};
-  std::string problem;
-  if (::fstat(fd, &info) != 0)
-    problem = "cannot write " + path + ": " + std::strerror(errno);
-  else if (S_ISDIR(info.st_mode))
-    problem = path + " is a directory";
-  else if (!S_ISREG(info.st_mode))
-    problem = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
-  if (problem.empty()) {
-    RecordingFiles& files = recordingFiles();
-    std::lock_guard<std::mutex> lock(files.mutex);
-    const std::pair<unsigned long long, unsigned long long> key{info.st_dev, info.st_ino};
-    if (std::find(files.keys.begin(), files.keys.end(), key) != files.keys.end()) {
-      problem = "cannot record to " + path + ": another device is recording to this file";
-    } else if (::ftruncate(fd, 0) != 0 || ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
-      problem = "cannot write " + path + ": " + std::strerror(errno);
-    } else {
-      files.keys.push_back(key);
-      fileDevice_ = key.first;
-      fileInode_ = key.second;
-    }
-  }
-  if (!problem.empty()) {
-    ::close(fd);
-    error = problem;
-    return false;
-  }
-  path_ = path;
-  bytesWritten_ = 0;
-  buffer_.clear();
-  buffer_.reserve(kRecorderBufferBytes + 512);
-  fd_.store(fd, std::memory_order_release);
+std::string sessionHeader(const DeviceSpec& spec) {
   std::string header = std::string(kSessionFormatName) + " " + std::to_string(kSessionFormatVersion);
   char field[96];
   for (const SpecField& entry : kSpecFields) {
     const int length = std::snprintf(field, sizeof field, " %s=%.17g", entry.name, entry.get(spec));
     header.append(field, static_cast<size_t>(std::min<int>(length, sizeof field - 1)));
   }
-  header += '\n';
-  append(header.data(), static_cast<int>(header.size()));
-  // The header reaches the file now: a recording that cannot even write that fails here.
-  if (!flush()) {
-    error = error_;
-    newFailure_ = false;
-    return false;
-  }
+  return header + '\n';
+}
+
+void Recorder::attach(std::unique_ptr<RecordingWriter> writer) {
+  close();
+  error_.clear();
+  newFailure_ = false;
+  failureSeen_ = false;
+  buffer_.clear();
+  buffer_.reserve(kRecorderBufferBytes + 512);
+  writer_ = std::move(writer);
+  signalWriter_.store(writer_.get(), std::memory_order_release);
+}
+
+bool Recorder::open(const std::string& path, const DeviceSpec& spec, std::string& error) {
+  close();
+  std::unique_ptr<RecordingWriter> writer = RecordingWriter::open(path, sessionHeader(spec), false, 0, error);
+  if (!writer) return false;
+  attach(std::move(writer));
   return true;
 }
 
@@ -197,50 +124,45 @@ void Recorder::writeOff(double hostTimeS) {
 }
 
 bool Recorder::flush() {
-  const int fd = fd_.load(std::memory_order_acquire);
-  if (fd < 0) return error_.empty();
-  if (buffer_.empty()) return true;
-  int code = 0;
-  if (!writeAll(fd, buffer_.data(), buffer_.size(), code)) {
-    // Part of the chunk may be in the file: cut it back to the last whole line written.
-    if (::ftruncate(fd, static_cast<off_t>(bytesWritten_)) != 0) {
-    }
-    fail("writing", code);
-    return false;
-  }
-  bytesWritten_ += buffer_.size();
-  buffer_.clear();
-  return true;
+  if (!writer_) return error_.empty();
+  if (failureSeen_) return false;
+  if (writer_->hand(buffer_)) return true;
+  failureSeen_ = true;
+  newFailure_ = true;
+  return false;
 }
 
-void Recorder::fail(const char* what, int code) {
-  buffer_.clear();  // never written; what is in the file stays
-  error_ = std::string(what) + " " + path_ + " failed (" + std::strerror(code) + "); recording stopped, " +
-           std::to_string(bytesWritten_) + " bytes kept";
-  newFailure_ = true;
-  close();
+std::unique_ptr<RecordingWriter> Recorder::detach() {
+  if (!writer_) return nullptr;
+  flush();
+  signalWriter_.store(nullptr, std::memory_order_release);
+  buffer_.clear();
+  return std::move(writer_);
+}
+
+void Recorder::noteFinished(const RecordingWriter& writer) {
+  std::string why = writer.error();
+  if (why.empty()) return;
+  // A failure the recording thread saw was flagged then; a close error is new.
+  if (!failureSeen_) newFailure_ = true;
+  error_ = std::move(why);
 }
 
 void Recorder::close() {
-  const int fd = fd_.load(std::memory_order_acquire);
-  if (fd < 0) return;
-  flush();
-  if (!isOpen()) return;  // flush failed and closed
-  fd_.store(-1, std::memory_order_release);
-  int code = 0;
-  if (::close(fd) != 0 && error_.empty()) {
-    code = errno;
-    error_ = "closing " + path_ + " failed (" + std::strerror(code) + ")";
-    newFailure_ = true;
-  }
-  RecordingFiles& files = recordingFiles();
-  std::lock_guard<std::mutex> lock(files.mutex);
-  const std::pair<unsigned long long, unsigned long long> key{fileDevice_, fileInode_};
-  files.keys.erase(std::remove(files.keys.begin(), files.keys.end(), key), files.keys.end());
+  std::unique_ptr<RecordingWriter> writer = detach();
+  if (!writer) return;
+  writer->finish();
+  noteFinished(*writer);
+}
+
+std::string Recorder::error() const {
+  if (writer_) return failureSeen_ ? writer_->error() : std::string();
+  return error_;
 }
 
 void Recorder::appendOffFromSignal(double hostTimeS) const {
-  const int fd = fd_.load(std::memory_order_acquire);
+  const RecordingWriter* writer = signalWriter_.load(std::memory_order_acquire);
+  const int fd = writer ? writer->fileDescriptor() : -1;
   if (fd < 0) return;
   // "\nO <seconds>.<nanoseconds>\n" by hand: snprintf is not async-signal-safe.
   char text[48];

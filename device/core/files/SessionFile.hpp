@@ -1,13 +1,16 @@
 // SessionFile: the "kf-session" text format of recorded device sessions (docs/record-format.md)
-// — writing it line by line (Recorder) and reading a whole file back (for ReplayBackend).
+// — formatting it line by line (Recorder; the file itself is RecordingWriter's) and reading a
+// whole file back (for ReplayBackend).
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/files/RecordingWriter.hpp"
 #include "core/spec/DeviceSpec.hpp"
 #include "core/spec/Report.hpp"
 
@@ -36,11 +39,12 @@ struct SessionData {
   std::string warning;            // e.g. a last line cut mid-way (dropped); empty if none
 };
 
-// Writes one session. Not thread-safe; the Device serialises access (appendOffFromSignal
-// excepted). Records are gathered in memory and handed to the OS as whole lines, so the file
-// ends at a line boundary after every flush. A failed write stops the recording: the file is
-// closed keeping what was written, and error() says why. One Recorder per file: a second one
-// opening a file that is being recorded (under any path) is refused.
+// The header line of a session recorded with `spec` (its newline included).
+std::string sessionHeader(const DeviceSpec& spec);
+
+// Formats one session's records as whole lines and hands them to its RecordingWriter. Not
+// thread-safe; the Device serialises access (appendOffFromSignal excepted). A failed write
+// stops the recording: the file keeps what was written, and error() says why.
 class Recorder {
  public:
   Recorder() = default;
@@ -48,20 +52,27 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  // Refuses what is not a regular file (a FIFO would block, a device is no recording), and a
-  // file another Recorder is writing; truncates only then.
+  // Records into `writer` (opened with sessionHeader); a recording in progress is closed first.
+  void attach(std::unique_ptr<RecordingWriter> writer);
+  // attach() of a direct RecordingWriter::open(path, sessionHeader(spec)); false and `error`
+  // when the file is refused.
   bool open(const std::string& path, const DeviceSpec& spec, std::string& error);
   void writeReport(double hostTimeS, const MouseReport& report);
   void writeFrame(double hostTimeS, const ForceFrame& frame, float commandedForceN);
   void writeOff(double hostTimeS);
-  // Hands what was written to the OS, so that a reader opening the file now (a replay of a
-  // session still being recorded) sees every record up to here. False once a write failed.
+  // Hands the lines written since to the writer (the file, or a threaded writer's queue).
+  // False once the recording failed.
   bool flush();
+  // Ends the recording here and returns its writer with every line handed over, for the caller
+  // to finish() outside its lock (the last writes may wait on the disk); then noteFinished().
+  std::unique_ptr<RecordingWriter> detach();
+  void noteFinished(const RecordingWriter& writer);
+  // detach(), finish() and noteFinished() in one.
   void close();
-  bool isOpen() const { return fd_.load(std::memory_order_acquire) >= 0; }
-  // Why the last recording stopped by itself (a write error), or empty.
-  const std::string& error() const { return error_; }
-  // True once after a write failed: the caller posts error().
+  bool isOpen() const { return writer_ != nullptr && !failureSeen_; }
+  // Why the last recording stopped by itself (a write error) or could not close, or empty.
+  std::string error() const;
+  // True once after a failure: the caller posts error().
   bool takeFailure() {
     const bool failed = newFailure_;
     newFailure_ = false;
@@ -70,18 +81,17 @@ class Recorder {
 
   // Async-signal-safe (no allocation, no stdio, no lock): appends an off record at hostTimeS
   // with write(2), for the signal handlers that drive the magnet off on the way out. A blank
-  // line first, so the record stands on its own line whatever a concurrent write left.
+  // line first, so the record stands on its own line whatever a concurrent write left. Lines a
+  // threaded writer had not written yet (at most its 10 ms period's) are lost with the process.
   void appendOffFromSignal(double hostTimeS) const;
 
  private:
   void append(const char* text, int length);
-  void fail(const char* what, int code);
 
-  std::atomic<int> fd_{-1};
-  std::string path_;
-  std::string buffer_;
-  uint64_t bytesWritten_ = 0;
-  unsigned long long fileDevice_ = 0, fileInode_ = 0;  // the registry key of one writer per file
+  std::unique_ptr<RecordingWriter> writer_;
+  std::atomic<RecordingWriter*> signalWriter_{nullptr};  // writer_, for signal handlers
+  std::string buffer_;  // lines not yet handed over
+  bool failureSeen_ = false;
   std::string error_;
   bool newFailure_ = false;
 };

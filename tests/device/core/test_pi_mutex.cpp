@@ -11,7 +11,7 @@
 #include <mutex>
 #include <thread>
 
-#include "core/PiMutex.hpp"
+#include "core/threads/PiMutex.hpp"
 
 using Clock = std::chrono::steady_clock;
 

@@ -2,6 +2,7 @@
 // the recording cleanly with what was written kept, and are posted; special files and a
 // second writer of one file are refused. The magnet goes off when the device thread dies of
 // an exception, and from a signal handler (emergencyOff) with an off record appended.
+#include <dirent.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -20,7 +21,7 @@
 
 #include "DeviceFactory.hpp"
 #include "core/Device.hpp"
-#include "core/DeviceMessages.hpp"
+#include "core/threads/DeviceMessages.hpp"
 #include "core/files/SessionFile.hpp"
 #include "sim/SimDevice.hpp"
 
@@ -210,4 +211,113 @@ TEST_CASE("emergencyOff: magnet off and an off record, without a lock", "[record
   REQUIRE(session.offTimesS.size() == 1);
   CHECK(session.offTimesS[0] == Approx(1.5));
   CHECK(session.frames.back().commandedForceN == Approx(1.4f));
+}
+
+namespace {
+
+// The names of this process's threads (/proc/self/task/*/comm).
+std::vector<std::string> threadNames() {
+  std::vector<std::string> names;
+  DIR* tasks = ::opendir("/proc/self/task");
+  if (!tasks) return names;
+  while (dirent* entry = ::readdir(tasks)) {
+    if (entry->d_name[0] == '.') continue;
+    std::ifstream comm(std::string("/proc/self/task/") + entry->d_name + "/comm");
+    std::string name;
+    std::getline(comm, name);
+    names.push_back(name);
+  }
+  ::closedir(tasks);
+  return names;
+}
+
+bool hasThread(const std::string& name) {
+  for (const std::string& each : threadNames())
+    if (each == name) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("a realtime device's recording is written by a thread of its own, completely", "[recording]") {
+  const std::string path = outputPath("threaded.txt");
+  DeviceOptions options;
+  options.thread.slot = 7;
+  auto sim = std::make_shared<SimDevice>(DeviceSpec{}, SimParams{}, HandScript::speeds({{100.0, 5.0}}));
+  Device device(DeviceSpec{}, sim, sim, false, options);
+  device.start();
+  std::string error;
+  REQUIRE(device.startRecording(path, error));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  CHECK(hasThread("kf-rec-7"));  // named as it starts: by now
+  device.stopRecording();
+  CHECK_FALSE(hasThread("kf-rec-7"));  // finished with its recording
+  const TelemetrySnapshot telemetry = device.telemetry();
+  device.close();
+  SessionData session;
+  REQUIRE(readSessionFile(path, DeviceSpec{}, session, error));
+  CHECK(session.warning.empty());
+  // Every report the device thread received while recording is in the file: at 125 Hz, 300 ms
+  // holds about 37 of them, and the device counted no more than that in its whole life.
+  CHECK(session.reports.size() >= 30);
+  CHECK(session.reports.size() <= telemetry.reports);
+  for (size_t i = 1; i < session.reports.size(); ++i)
+    CHECK(session.reports[i].hostTimeS >= session.reports[i - 1].hostTimeS);
+}
+
+TEST_CASE("a realtime device's write error is posted once and the file keeps whole lines", "[recording]") {
+  const std::string path = outputPath("threaded-full.txt");
+  ::unlink(path.c_str());
+  setDeviceMessageSink(collectMessage);
+  takeMessages();
+  {
+    FileSizeLimit limit(4096);
+    auto sim = std::make_shared<SimDevice>(DeviceSpec{}, SimParams{}, HandScript::speeds({{100.0, 5.0}}));
+    Device device(DeviceSpec{}, sim, sim, false);
+    device.start();
+    std::string error;
+    REQUIRE(device.startRecording(path, error));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    for (int frame = 0; device.recordingError().empty() && std::chrono::steady_clock::now() < deadline; ++frame) {
+      device.pushForceFrame(ForceFrame{device.nowS(), 0.4f});
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    CHECK(contains(device.recordingError(), "File too large"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // later pumps post nothing more
+    device.stopRecording();
+    device.close();
+  }
+  const std::vector<std::string> messages = takeMessages();
+  REQUIRE(messages.size() == 1);
+  CHECK(contains(messages[0], "kfRecord: writing "));
+  setDeviceMessageSink(nullptr);
+  const std::string text = readAll(path);
+  CHECK(text.size() <= 4096);
+  REQUIRE(!text.empty());
+  CHECK(text.back() == '\n');
+  // Another recording may have the file at once.
+  Recorder again;
+  std::string error;
+  CHECK(again.open(path, DeviceSpec{}, error));
+}
+
+TEST_CASE("a disk that falls behind stops the recording instead of the device thread", "[recording]") {
+  const std::string path = outputPath("behind.txt");
+  std::string error;
+  std::unique_ptr<RecordingWriter> writer = RecordingWriter::open(path, "header\n", true, 0, error);
+  REQUIRE(writer);
+  std::string lines = "R 1\n";
+  REQUIRE(writer->hand(lines));
+  CHECK(lines.empty());
+  // More than the queue holds in one hand-over: as a disk that stalled for half a minute.
+  std::string flood(RecordingWriter::kQueueBytes, 'x');
+  flood.back() = '\n';
+  CHECK_FALSE(writer->hand(flood));
+  CHECK(contains(writer->error(), "MiB behind"));
+  lines = "R 2\n";
+  CHECK_FALSE(writer->hand(lines));  // stopped for good
+  writer->finish();
+  CHECK(writer->failed());
+  CHECK(contains(writer->error(), "recording stopped"));
+  CHECK(readAll(path) == "header\nR 1\n");  // what came before is kept, and nothing after
 }

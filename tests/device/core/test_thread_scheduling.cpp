@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "DeviceFactory.hpp"
-#include "core/DeviceMessages.hpp"
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/DeviceMessages.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 using namespace kf;
 

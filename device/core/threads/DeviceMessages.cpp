@@ -1,4 +1,4 @@
-#include "core/DeviceMessages.hpp"
+#include "core/threads/DeviceMessages.hpp"
 
 #include <atomic>
 #include <cstdio>

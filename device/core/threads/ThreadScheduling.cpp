@@ -1,4 +1,4 @@
-#include "core/ThreadScheduling.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -13,7 +13,7 @@
 #include <cstring>
 #include <mutex>
 
-#include "core/DeviceMessages.hpp"
+#include "core/threads/DeviceMessages.hpp"
 
 namespace kf {
 
