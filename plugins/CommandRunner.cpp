@@ -10,8 +10,8 @@
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 #include "PostLimiter.hpp"
-#include "core/threads/ThreadScheduling.hpp"
 #include "core/spec/SettingBounds.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 namespace kf::sc {
 

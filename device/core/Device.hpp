@@ -14,7 +14,6 @@
 
 #include "core/ForceBackend.hpp"
 #include "core/MouseBackend.hpp"
-#include "core/threads/PiMutex.hpp"
 #include "core/SpscQueue.hpp"
 #include "core/Telemetry.hpp"
 #include "core/files/SessionFile.hpp"
@@ -22,6 +21,7 @@
 #include "core/force/ForceSafety.hpp"
 #include "core/spec/DeviceSpec.hpp"
 #include "core/spec/Report.hpp"
+#include "core/threads/PiMutex.hpp"
 
 namespace kf {
 

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "core/threads/ThreadScheduling.hpp"
 #include "core/spec/Report.hpp"
+#include "core/threads/ThreadScheduling.hpp"
 
 namespace kf {
 

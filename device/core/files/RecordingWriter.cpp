@@ -219,8 +219,7 @@ std::string RecordingWriter::error() const {
   if (failed()) {
     if (errorCode_ == 0)
       return "writing " + path_ + " fell " + std::to_string(kQueueBytes >> 20) +
-             " MiB behind (the disk is too slow); recording stopped, " + std::to_string(bytesWritten_) +
-             " bytes kept";
+             " MiB behind (the disk is too slow); recording stopped, " + std::to_string(bytesWritten_) + " bytes kept";
     return "writing " + path_ + " failed (" + std::strerror(errorCode_) + "); recording stopped, " +
            std::to_string(bytesWritten_) + " bytes kept";
   }

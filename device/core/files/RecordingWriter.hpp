@@ -67,8 +67,8 @@ class RecordingWriter {
 
   // Threaded only.
   PiMutex queueMutex_;
-  std::string queue_;    // handed over, not yet written (queueMutex_)
-  std::string writing_;  // the writer thread's: being written
+  std::string queue_;                    // handed over, not yet written (queueMutex_)
+  std::string writing_;                  // the writer thread's: being written
   std::atomic<bool> overflowed_{false};  // a hand-over found the queue full
   std::thread writer_;
   std::mutex wakeMutex_;

@@ -90,7 +90,7 @@ class Recorder {
 
   std::unique_ptr<RecordingWriter> writer_;
   std::atomic<RecordingWriter*> signalWriter_{nullptr};  // writer_, for signal handlers
-  std::string buffer_;  // lines not yet handed over
+  std::string buffer_;                                   // lines not yet handed over
   bool failureSeen_ = false;
   std::string error_;
   bool newFailure_ = false;

@@ -21,8 +21,8 @@
 
 #include "DeviceFactory.hpp"
 #include "core/Device.hpp"
-#include "core/threads/DeviceMessages.hpp"
 #include "core/files/SessionFile.hpp"
+#include "core/threads/DeviceMessages.hpp"
 #include "sim/SimDevice.hpp"
 
 using namespace kf;
