@@ -160,15 +160,16 @@ def plot_scale(scale, path):
         ax.plot(v, [r["avg_cpu"] for r in st], "o-", color="C0", label="scsynth avg CPU %")
         ax.plot(v, [r["peak_cpu"] for r in st], "s", color="C1", ms=4, label="scsynth peak CPU %")
         ax2 = ax.twinx()
-        ax2.bar(v, [max(r["client_xruns"], 0.5) for r in st], width=max(v) * 0.015, color="C3", alpha=0.5,
-                label="xruns in the window")
+        ax2.bar(v, [max(max(r["window_xruns"]), 0.5) for r in st], width=max(max(v), 1) * 0.015, color="C3",
+                alpha=0.5, label="xruns in the worst window")
         ax2.axhline(sc["xrun_limit"], color="C3", ls="--", lw=0.8)
         ax2.set_yscale("log")
         ax2.set_ylabel("JACK: scsynth not finished (per window)", color="C3", fontsize=8)
-        ax.axvline(sc["max_without_xrun"], color="k", ls=":", lw=0.8)
+        ax.axvline(max(sc["max_without_xrun"], 0), color="k", ls=":", lw=0.8)
         ax.set_xlabel("voices")
         ax.set_ylabel("%")
-        ax.set_title(f"{int(rate) // 1000} kHz: {sc['max_without_xrun']} voices before the first failing step", fontsize=10)
+        ax.set_title(f"{int(rate) // 1000} kHz, the median search: {sc['max_without_xrun']} voices without an xrun",
+                     fontsize=10)
         ax.legend(fontsize=7, loc="upper left")
         ax.grid(alpha=0.3)
     _save(fig, path)

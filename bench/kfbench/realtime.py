@@ -3,8 +3,9 @@ kfharness.sclang.run_with_server: a JACK server of its own per run, teardown by 
 
     e2e    a FrictionPilot synth on FrictionDevice.sim (device thread, realtime) for a while, then
            kfStatus: the 1 kHz loop's period, report-to-UGen and force-to-magnet latencies
-    scale  voices of the pilot chain on one simulated device, added stepwise until JACK reports
-           that scsynth did not finish a period in time (an xrun)
+    scale  voices of the pilot chain on one simulated device: the most whose every window has no
+           xrun (JACK: scsynth did not finish a period in time), by a search that re-tests its
+           answer, three times; then once with 1 % of the periods allowed to be missed
 """
 import re
 import time
@@ -74,16 +75,18 @@ def run_e2e(bench, seconds=10.0, sample_rate=48000):
     return status
 
 
-def run_scale(bench, sample_rate, window_s=2.0, settle_s=0.75, max_voices=8192, budget_s=150.0, realtime=True,
-              xrun_fraction=0.01):
-    """Voices until more than xrun_fraction of a window's periods are missed (twice)."""
+def run_scale(bench, sample_rate, window_s=2.0, settle_s=0.75, max_voices=8192, budget_s=300.0, realtime=True,
+              xrun_fraction=0.0, repeats=3):
+    """The largest count of voices whose every window (`repeats` of them per step) has no more than
+    xrun_fraction of its periods missed, by a search that re-tests its own answer (scale.scd)."""
     priority = REALTIME_PRIORITY if realtime else None
     with jack.JackServer(sample_rate=sample_rate, realtime_priority=priority) as server:
         code = scores.code("scale", jack_log=sclang.sc_string(server.log_path), window=window_s, settle=settle_s,
-                           max_voices=max_voices, budget=budget_s, xrun_fraction=xrun_fraction, len_mm=SIGNAL_MM,
-                           spm=MAPPINGS[0], mappings=MAPPINGS, window_s=MAPPING["windowS"], lo_db=MAPPING["loDb"],
-                           hi_db=MAPPING["hiDb"], lo_force_n=MAPPING["loForceN"], hi_force_n=MAPPING["hiForceN"],
-                           ref=MAPPING["ref"], audio_delay_s=round(profile.audio_delay_s(), 9))
+                           max_voices=max_voices, budget=budget_s, xrun_fraction=xrun_fraction, repeats=repeats,
+                           len_mm=SIGNAL_MM, spm=MAPPINGS[0], mappings=MAPPINGS, window_s=MAPPING["windowS"],
+                           lo_db=MAPPING["loDb"], hi_db=MAPPING["hiDb"], lo_force_n=MAPPING["loForceN"],
+                           hi_force_n=MAPPING["hiForceN"], ref=MAPPING["ref"],
+                           audio_delay_s=round(profile.audio_delay_s(), 9))
         t = time.monotonic()
         # The search stops itself after budget_s; the margin is for a loaded machine (sclang starved
         # by a SCHED_FIFO scsynth at full load on one core and the other busy) to finish and quit.
@@ -91,32 +94,43 @@ def run_scale(bench, sample_rate, window_s=2.0, settle_s=0.75, max_voices=8192, 
                                      include_paths=bench.include_paths, server_options=SCALE_SERVER_OPTIONS)
     if not run.ok:
         _failed(f"scale run at {sample_rate} Hz", run)
-    steps = [{"voices": int(f[0]), "client_xruns": int(f[1]), "driver_xruns": int(f[2]), "peak_cpu": float(f[3]),
-              "avg_cpu": float(f[4]), "retry_client_xruns": int(float(f[5])), "retry_peak_cpu": float(f[6])}
+    steps = [{"voices": int(f[0]), "window_xruns": [int(x) for x in f[1:4] if int(x) >= 0],
+              "driver_xruns": int(f[4]), "peak_cpu": float(f[5]), "avg_cpu": float(f[6])}
              for f in run.lines("KF-SCALE ")]
-    res = run.lines("KF-SCALE-RESULT ")
-    if not res:
+    res, check = run.lines("KF-SCALE-RESULT "), run.lines("KF-SCALE-CHECK ")
+    if not res or not check:
         _failed(f"scale run at {sample_rate} Hz (no result)", run)
     lo, hi = int(res[0][0]), int(res[0][1])
-    out = {"sample_rate": sample_rate, "window_s": window_s, "settle_s": settle_s, "steps": steps,
-           "realtime_jack": realtime, "xrun_fraction": xrun_fraction,
+    out = {"sample_rate": sample_rate, "window_s": window_s, "settle_s": settle_s, "repeats": repeats,
+           "steps": steps, "realtime_jack": realtime, "xrun_fraction": xrun_fraction,
            "xrun_limit": int(run.lines("KF-SCALE-LIMIT ")[0][0]),
            "max_without_xrun": lo, "first_with_xrun": hi if hi >= 0 else None,
+           # the search's own check: its answer re-tested (1) or the budget ran out first (0), and
+           # how many re-tests contradicted an earlier one
+           "confirmed": check[0][0] == "1", "reversals": int(check[0][1]),
            "capped": bool(run.lines("KF-SCALE-CAP")), "wall_s": time.monotonic() - t,
            # the step at which scsynth stopped answering /sync (JACK no longer ran it), if any
            "unresponsive_at": next((int(f[0]) for f in run.lines("KF-SCALE-UNRESPONSIVE ")), None)}
-    log(f"scale {sample_rate} Hz: {lo} voices without an xrun, first xrun at {out['first_with_xrun']} "
-        f"({len(steps)} steps, {out['wall_s']:.0f} s)")
+    log(f"scale {sample_rate} Hz, at most {out['xrun_limit']} xruns a window: {lo} voices, first failing "
+        f"{out['first_with_xrun']} ({len(steps)} steps, {out['reversals']} reversals, "
+        f"{'confirmed' if out['confirmed'] else 'NOT confirmed'}, {out['wall_s']:.0f} s)")
     return out
 
 
-def run_scale_searches(bench, rate, runs):
-    """`runs` searches at one rate; the median one (the lower middle for an even count) is reported
-    in full, with every search's voices."""
+def run_scale_searches(bench, rate, runs, tolerant_fraction=0.01):
+    """`runs` searches at one rate for the count without any xrun; the reported count is the one
+    every search reached (their minimum: it passed each time), the median search in full beside
+    it. Then one search at tolerant_fraction of missed periods: what the VM carries if the misses
+    its own scheduling causes at any load are let through."""
     found = []
     for i in range(runs):
-        log(f"scale at {rate} Hz, run {i + 1} of {runs}")
+        log(f"scale at {rate} Hz without xruns, search {i + 1} of {runs}")
         found.append(run_scale(bench, rate))
     best = dict(sorted(found, key=lambda r: r["max_without_xrun"])[(len(found) - 1) // 2])
     best["all_runs"] = [r["max_without_xrun"] for r in found]
+    best["in_every_search"] = min(best["all_runs"])
+    best["all_reversals"] = [r["reversals"] for r in found]
+    best["all_confirmed"] = all(r["confirmed"] for r in found)
+    log(f"scale at {rate} Hz with {100 * tolerant_fraction:g} % of periods missed allowed")
+    best["tolerant"] = run_scale(bench, rate, xrun_fraction=tolerant_fraction)
     return best

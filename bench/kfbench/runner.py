@@ -1,14 +1,16 @@
 """The parts in order: build, log, the NRT renders (timing, spatial, loudness, drift), the drift
-test, reconstruction, the realtime parts; then the summary, the goals, results.json (merged with
-the previous run's parts not run this time), the report and the plots."""
+test, reconstruction, the realtime parts; then the summary, the goals, results.json (the parts not
+run this time kept as they were, each with the commit and date that measured it), the report and
+the plots."""
 import json
 import time
 
 from kfharness import nrt
 
-from . import build, drift, goals, loudness, native, plots, realtime, report, rtload, scores, spatial, timing
+from . import build, drift, goals, loudness, native, plots, provenance, realtime, report, rtload, scores, spatial, \
+    timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
-from .summary import key_numbers, summary_lines
+from .summary import summary_lines
 
 RESULTS_PATH = BENCH_DIR / "results.json"
 REPORT_PATH = BENCH_DIR / "REPORT.md"
@@ -118,18 +120,13 @@ def write_plots(results):
         plots.plot_spatial_tradeoff(results["timing"], results["spatial"], BENCH_DIR / "spatial_tradeoff.png")
 
 
-def merge_with_previous(results):
-    """Parts not run this time keep their previous numbers; the previous run's headline numbers
-    are kept for the repeatability table."""
+def merge_with_previous(results, stamp):
+    """Parts not run this time keep their numbers and their own provenance (results["measured"]:
+    per part the commit, date, machine and processor that measured it)."""
     old = json.loads(RESULTS_PATH.read_text()) if RESULTS_PATH.exists() else {}
-    old.pop("previous", None)
-    merged = {**old, **results}
-    if old:
-        merged["previous"] = {"date": old.get("meta", {}).get("date", "?"), "keys": {}}
-        try:
-            merged["previous"]["keys"] = {k: list(v) for k, v in key_numbers(old).items()}
-        except (KeyError, TypeError, ValueError):
-            pass  # an older results.json without these numbers
+    old.pop("previous", None)  # written by older versions of the bench
+    measured = {part: stamp for part in results if part != "meta"}
+    merged = {**old, **results, "measured": {**old.get("measured", {}), **measured}}
     for v in merged.get("spatial", {}).get("index", {}).values():
         v.pop("_traces", None)
     return merged
@@ -158,7 +155,7 @@ def main(args):
     log(f"bench took {results['meta']['bench_s'] / 60:.1f} min after {build_s:.0f} s of building")
     if not args.no_report:
         write_plots(results)
-        merged = merge_with_previous(results)
+        merged = merge_with_previous(results, provenance.stamp(results['meta']['date']))
         RESULTS_PATH.write_text(json.dumps(merged, indent=1, default=float))
         report.write(merged, REPORT_PATH, bench.relative(bench.build))
         log(f"wrote {REPORT_PATH} and {RESULTS_PATH}")

@@ -1,5 +1,5 @@
-"""The summary the run prints (and the report quotes), and the headline numbers compared with the
-previous run (results.json keeps them under `previous`)."""
+"""The summary the run prints (and the report quotes), and the headline numbers with their spread
+over the repeated measurements of the run."""
 import numpy as np
 
 from .common import BLOCK, MAPPING, MAPPINGS, SR, fmt
@@ -77,9 +77,13 @@ def summary_lines(results):
     scale = results.get("scale")
     if scale:
         for rate, sc in scale.items():
-            lines.append(f"scale {int(rate) // 1000} kHz: {sc['max_without_xrun']} voices without missed periods, "
-                         f"first failing step {sc['first_with_xrun']} voices"
-                         + (f" (runs: {', '.join(str(x) for x in sc['all_runs'])})" if sc.get("all_runs") else ""))
+            tol = sc.get("tolerant")
+            lines.append(f"scale {int(rate) // 1000} kHz: {voices(sc.get('in_every_search', sc['max_without_xrun']))} "
+                         f"without an xrun in any of {sc.get('repeats', 1)} windows, in every search (searches: "
+                         f"{', '.join(str(x) for x in sc.get('all_runs', [sc['max_without_xrun']]))}; reversals "
+                         f"{', '.join(str(x) for x in sc.get('all_reversals', []))})"
+                         + (f"; {voices(tol['max_without_xrun'])} with up to {100 * tol['xrun_fraction']:g} % of "
+                            f"periods missed" if tol else ""))
     lc = results.get("log")
     if lc:
         for r in lc["rows"]:
@@ -137,32 +141,17 @@ def key_numbers(results):
     if sc:
         for rate, e in sc.items():
             runs = e.get("all_runs", [e["max_without_xrun"]])
-            k[f"voices at {int(rate) // 1000} kHz"] = (e["max_without_xrun"], f"{min(runs)}..{max(runs)} over "
-                                                       f"{len(runs)} searches", None)
+            k[f"voices without xruns at {int(rate) // 1000} kHz"] = (
+                e["max_without_xrun"], f"{min(runs)}..{max(runs)} over {len(runs)} searches", None)
     return k
 
 
-def repeatability_table(cur, previous_keys):
-    lines = ["| number | this run | spread in this run | previous run | change |", "| --- | --- | --- | --- | --- |"]
+def voices(count):
+    return "no count" if count < 0 else f"{count} voices"
+
+
+def repeatability_table(cur):
+    lines = ["| number | median in this run | spread in this run |", "| --- | --- | --- |"]
     for label, (v, spread, _) in cur.items():
-        p = previous_keys.get(label)
-        pv = p[0] if p else None
-        change = f"{100 * (v - pv) / pv:+.1f} %" if pv not in (None, 0) else ""
-        lines.append(f"| {label} | {fmt(v, 4)} | {spread} | {fmt(pv, 4) if pv is not None else ''} | {change} |")
+        lines.append(f"| {label} | {fmt(v, 4)} | {spread} |")
     return "\n".join(lines)
-
-
-def repeatability_changes(cur, previous_keys):
-    """The largest relative change since the previous run per group of numbers, and how many of the
-    previous CPU ratios lie inside this run's min..max over rounds."""
-    def largest(pred):
-        out = [abs(v - previous_keys[label][0]) / abs(previous_keys[label][0]) for label, (v, _, _) in cur.items()
-               if pred(label) and previous_keys.get(label) and previous_keys[label][0]]
-        return f"{100 * max(out):.0f} %" if out else "(not in the previous run)"
-
-    inside = [rng[0] <= previous_keys[label][0] <= rng[1] for label, (_, _, rng) in cur.items()
-              if label.startswith("CPU ") and rng and previous_keys.get(label)]
-    return {"cpu_ratios": largest(lambda x: x.startswith("CPU ")), "inside": sum(inside), "compared": len(inside),
-            "ns": largest(lambda x: x.endswith("(ns/sample)")),
-            "ns_ratio": largest(lambda x: x == "reconstruction CPU predictive/linear"),
-            "latencies": largest(lambda x: x.startswith("realtime")), "voices": largest(lambda x: x.startswith("voices"))}

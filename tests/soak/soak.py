@@ -121,14 +121,15 @@ def main():
             print(f"  scsynth CPU avg {sum(c[1] for c in cpu) / len(cpu):.1f} %, peak {max(c[2] for c in cpu):.1f} %")
     figures = status.parse(dev.output, "KF-STATUS")
     print("\n[devices] each device's /kfStatus at the end: device thread priority (0 normal), reports, frames, "
-          "watchdog trips, missed deadlines, lost reports/frames (queue overflows; frames also skipped); latencies "
+          "watchdog trips, missed deadlines, lost reports/frames (queue overflows), frames superseded (the older "
+          "frames due at a late wake-up: the newest goes to the magnet); latencies "
           "p50/p99/p99.9/max ms")
     ms = 1e3
     for index in sorted(figures):
         f = figures[index]
         print(f"  {index}: thread {f['deviceThreadPriority']:.0f}, reports {f['reports']:.0f}, frames {f['frames']:.0f}, "
               f"trips {f['watchdogTrips']:.0f}, missed deadlines {f['missedDeadlines']:.0f}, lost "
-              f"{f['reportQueueOverflows']:.0f}/{f['frameQueueOverflows'] + f['skippedFrames']:.0f}; "
+              f"{f['reportQueueOverflows']:.0f}/{f['frameQueueOverflows']:.0f}, superseded {f['skippedFrames']:.0f}; "
               f"force to magnet {f['forceP50S'] * ms:.3f}/{f['forceP99S'] * ms:.3f}/{f['forceP999S'] * ms:.3f}/"
               f"{f['forceMaxS'] * ms:.3f}; loop period p99 {f['loopP99S'] * ms:.3f} max {f['loopMaxS'] * ms:.3f}; "
               f"report to UGen p99 {f['reportP99S'] * ms:.3f} max {f['reportMaxS'] * ms:.3f}")
