@@ -1,0 +1,183 @@
+#include "UgenModes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace kf::rules {
+
+namespace {
+
+constexpr int ar = calc_FullRate;
+constexpr int kr = calc_BufRate;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Input c(float value) { return Input::constant(value); }
+
+// A control that holds `a` for 20 blocks, then `b` for 20, and so on: a value that changes.
+Input alternating(float a, float b) {
+  return Input::control([a, b](int64_t block) { return (block / 20) % 2 == 0 ? a : b; });
+}
+
+// A position (mm) sweeping 0..100 mm and back every 4 s, at audio or control rate.
+float sweepMm(double timeS) { return static_cast<float>(50.0 - 50.0 * std::cos(timeS * 3.14159265 / 2.0)); }
+Input sweepAr() {
+  return Input::audio([](int64_t sample) { return sweepMm(sample / FakeServer::kSampleRate); });
+}
+Input sweepKr() {
+  return Input::control(
+      [](int64_t block) { return sweepMm(block * FakeServer::kBlockSamples / FakeServer::kSampleRate); });
+}
+
+// A tone whose loudness swells and fades over 2 s (loudness to friction sweeps its range).
+Input toneAr() {
+  return Input::audio([](int64_t sample) {
+    const double t = sample / FakeServer::kSampleRate;
+    return static_cast<float>(std::sin(t * 2.0 * 3.14159265) * std::sin(t * 2764.6));
+  });
+}
+
+}  // namespace
+
+// FrictionMouseIn -> SpatialBufRd -> LoudnessToFriction -> FrictionOut on slot 0, as the paper's
+// patch: every UGen fed by the one before.
+std::unique_ptr<Synth> chainSynth(FakeServer& server, ChainWatch& watch) {
+  auto synth = server.newSynth("chain");
+  Unit* mouse = synth->add(server.unitDef("FrictionMouseIn"), ar, {c(0), c(0), c(1)}, 4, "device 0, linear");
+  Unit* reader =
+      synth->add(server.unitDef("SpatialBufRd"), ar, {c(0), Input::from(synth->out(mouse, 0)), c(20), c(0), c(4), c(0)},
+                 1, "buffer 0, cubic, at the puck");
+  Unit* loudness =
+      synth->add(server.unitDef("LoudnessToFriction"), ar,
+                 {Input::from(synth->out(reader, 0)), c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), c(0.05f)}, 1,
+                 "the paper's mapping");
+  Unit* out = synth->add(server.unitDef("FrictionOut"), ar, {c(0), Input::from(synth->out(loudness, 0))}, 1,
+                         "device 0, force from LoudnessToFriction");
+  const float* x = synth->out(mouse, 0)->mBuffer;
+  const float* force = synth->out(out, 0)->mBuffer;
+  synth->watch([&watch, x, force] {
+    watch.largestXMm.store(std::max(watch.largestXMm.load(), std::fabs(x[FakeServer::kBlockSamples - 1])));
+    watch.largestForceN.store(std::max(watch.largestForceN.load(), force[FakeServer::kBlockSamples - 1]));
+  });
+  return synth;
+}
+
+// Every interpolation at audio and control rate, a moving origin, and the bad inputs.
+std::unique_ptr<Synth> mouseModesSynth(FakeServer& server) {
+  auto synth = server.newSynth("mouse modes");
+  const auto& mouse = server.unitDef("FrictionMouseIn");
+  synth->add(mouse, ar, {c(0), c(0), c(0)}, 4, "device 0, hold");
+  synth->add(mouse, ar, {c(0), c(0), c(2)}, 4, "device 0, predictive");
+  synth->add(mouse, kr, {c(0), c(0), c(1)}, 4, "device 0, linear");
+  synth->add(mouse, kr, {c(0), c(0), c(2)}, 4, "device 0, predictive");
+  synth->add(mouse, ar, {c(0), alternating(0, 25), alternating(0, 2)}, 4, "device 0, origin and mode moving");
+  synth->add(mouse, ar, {c(0), c(kNaN), c(1)}, 4, "device 0, origin NaN");
+  synth->add(mouse, ar, {c(0), c(0), c(kNaN)}, 4, "device 0, interpolation NaN");
+  synth->add(mouse, ar, {c(-1), c(0), c(1)}, 4, "device -1");
+  synth->add(mouse, ar, {c(kNaN), c(0), c(1)}, 4, "device NaN");
+  synth->add(mouse, kr, {c(16), c(0), c(1)}, 4, "device 16");
+  return synth;
+}
+
+// Interpolations 1, 2 and 4 with the position at audio and at control rate, with and without
+// keep (samplesPerMm and origin changing), the buffers of every kind and the bad inputs.
+std::unique_ptr<Synth> readersSynth(FakeServer& server) {
+  auto synth = server.newSynth("readers");
+  const auto& reader = server.unitDef("SpatialBufRd");
+  for (int interpolation : {1, 2, 4}) {
+    const std::string mode = "interpolation " + std::to_string(interpolation);
+    const auto code = static_cast<float>(interpolation);
+    synth->add(reader, ar, {c(0), sweepAr(), c(20), c(0), c(code), c(0)}, 1, mode + ", position ar");
+    synth->add(reader, kr, {c(0), sweepKr(), c(20), c(0), c(code), c(0)}, 1, mode + ", position kr");
+    synth->add(reader, ar, {c(0), sweepAr(), alternating(10, 40), alternating(0, 5), c(code), c(1)}, 1,
+               mode + ", position ar, keep");
+    synth->add(reader, kr, {c(0), sweepKr(), alternating(10, 40), alternating(0, 5), c(code), c(1)}, 1,
+               mode + ", position kr, keep");
+  }
+  synth->add(reader, ar, {c(0), sweepAr(), c(20), c(0), c(4)}, 1, "no keep input");
+  synth->add(reader, ar, {c(1), sweepAr(), c(20), c(0), c(4), c(0)}, 2, "stereo buffer");
+  synth->add(reader, ar, {c(FakeServer::kNumBuffers), sweepAr(), c(20), c(0), c(2), c(0)}, 1, "local buffer");
+  synth->add(reader, ar, {c(1), sweepAr(), c(20), c(0), c(4), c(0)}, 1, "channel mismatch");
+  synth->add(reader, ar, {c(2), sweepAr(), c(20), c(0), c(4), c(0)}, 1, "buffer not allocated");
+  synth->add(reader, ar, {alternating(0, 2), sweepAr(), c(20), c(0), c(4), c(0)}, 1, "buffer changing");
+  synth->add(reader, ar, {c(99), sweepAr(), c(20), c(0), c(4), c(0)}, 1, "bufnum 99");
+  synth->add(reader, ar, {c(kNaN), sweepAr(), c(20), c(0), c(4), c(0)}, 1, "bufnum NaN");
+  synth->add(reader, ar, {c(0), sweepAr(), alternating(kNaN, 10), c(0), c(4), c(1)}, 1, "samplesPerMm NaN, keep");
+  synth->add(reader, ar, {c(0), sweepAr(), c(0), c(0), c(4), c(0)}, 1, "samplesPerMm 0");
+  synth->add(reader, ar, {c(0), sweepAr(), c(20), c(kInf), c(4), c(0)}, 1, "origin inf");
+  synth->add(reader, ar, {c(0), sweepAr(), c(20), c(0), c(3), c(0)}, 1, "interpolation 3");
+  synth->add(
+      reader, ar,
+      {c(0), Input::audio([](int64_t sample) { return sample % 100 < 50 ? kNaN : 10.f; }), c(20), c(0), c(4), c(1)}, 1,
+      "position NaN at times, keep");
+  return synth;
+}
+
+// The window and maxWindow modes (paper's, moving, bad, beyond the limit: the history's
+// allocation fails), the mapping moving every block and bad, and control rate.
+std::unique_ptr<Synth> loudnessSynth(FakeServer& server) {
+  auto synth = server.newSynth("loudness");
+  const auto& loudness = server.unitDef("LoudnessToFriction");
+  auto add = [&](Input window, Input loDb, Input hiDb, Input loForce, Input hiForce, Input ref, float maxWindow,
+                 const char* what) {
+    synth->add(loudness, ar, {toneAr(), window, loDb, hiDb, loForce, hiForce, ref, c(maxWindow)}, 1, what);
+  };
+  add(c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), 0.05f, "the paper's mapping");
+  add(alternating(0.001f, 0.02f), c(-30), c(0), c(0.2f), c(2), c(1), 0.05f, "window moving");
+  add(c(kNaN), c(-30), c(0), c(0.2f), c(2), c(1), 0.05f, "window NaN");
+  add(c(0), c(-30), c(0), c(0.2f), c(2), c(1), 0.05f, "window 0");
+  add(c(1), c(-30), c(0), c(0.2f), c(2), c(1), 0.05f, "window beyond maxWindow");
+  add(c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), kNaN, "maxWindow NaN");
+  add(c(0.5f), c(-30), c(0), c(0.2f), c(2), c(1), 1.f, "maxWindow 1 s");
+  add(c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), 1e9f, "maxWindow beyond the limit, RT memory short");
+  add(c(0.001f), c(-30), Input::control([](int64_t block) { return -static_cast<float>(block % 7); }), c(0.2f), c(2),
+      c(1), 0.05f, "hiDb moving every block");
+  add(c(0.001f), c(kNaN), c(kInf), c(-1), c(kNaN), c(0), 0.05f, "bad mapping");
+  add(c(0.001f), c(0), c(-30), c(2), c(0.2f), c(1), 0.05f, "mapping reversed");
+  synth->add(loudness, kr, {sweepKr(), c(0.01f), c(-30), c(40), c(0.2f), c(2), c(1), c(0.05f)}, 1, "control rate");
+  synth->add(loudness, ar,
+             {Input::audio([](int64_t sample) { return sample % 3 == 0 ? kNaN : (sample % 3 == 1 ? kInf : 0.5f); }),
+              c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), c(0.05f)},
+             1, "in NaN and inf");
+  return synth;
+}
+
+// More writers of slot 0 (with the chain's, four): force at audio and control rate, bad forces,
+// bad device inputs, and one moving between slots 0 and 1.
+std::unique_ptr<Synth> writersSynth(FakeServer& server) {
+  auto synth = server.newSynth("writers");
+  const auto& out = server.unitDef("FrictionOut");
+  synth->add(out, ar, {c(0), Input::audio([](int64_t sample) { return 0.5f + 0.4f * std::sin(sample * 0.001f); })}, 1,
+             "device 0, force ar");
+  synth->add(out, ar, {c(0), alternating(0.3f, 1.5f)}, 1, "device 0, force kr");
+  synth->add(out, kr, {c(0), alternating(0.3f, 1.5f)}, 1, "device 0");
+  synth->add(out, ar, {c(0), Input::audio([](int64_t sample) { return sample % 2 == 0 ? kNaN : kInf; })}, 1,
+             "device 0, force NaN and inf");
+  synth->add(out, ar, {alternating(0, 1), c(1)}, 1, "device moving between 0 and 1");
+  synth->add(out, ar, {c(-1), c(1)}, 1, "device -1");
+  synth->add(out, ar, {c(kNaN), c(1)}, 1, "device NaN");
+  return synth;
+}
+
+// The replay device's slot: a reader and a writer.
+std::unique_ptr<Synth> slot1Synth(FakeServer& server) {
+  auto synth = server.newSynth("slot 1");
+  synth->add(server.unitDef("FrictionMouseIn"), ar, {c(1), c(0), c(2)}, 4, "device 1, predictive");
+  synth->add(server.unitDef("FrictionMouseIn"), kr, {c(1), c(0), c(1)}, 4, "device 1, linear");
+  synth->add(server.unitDef("FrictionOut"), ar, {c(1), c(0.8f)}, 1, "device 1, constant force");
+  return synth;
+}
+
+// Units constructed while the device is open (their constructors see it).
+std::unique_ptr<Synth> lateJoinersSynth(FakeServer& server) {
+  auto synth = server.newSynth("late joiners");
+  synth->add(server.unitDef("FrictionMouseIn"), ar, {c(0), c(0), c(1)}, 4, "device 0, linear");
+  synth->add(server.unitDef("FrictionOut"), ar, {c(0), c(1)}, 1, "device 0, constant force");
+  synth->add(server.unitDef("LoudnessToFriction"), ar,
+             {toneAr(), c(0.001f), c(-30), c(0), c(0.2f), c(2), c(1), c(0.05f)}, 1, "the paper's mapping");
+  return synth;
+}
+
+}  // namespace kf::rules
