@@ -82,4 +82,11 @@ class FrictionMouseIn : public SCUnit {
 
 }  // namespace
 
-void registerFrictionMouseIn() { registerUnit<FrictionMouseIn>(ft, "FrictionMouseIn"); }
+// Registered as a unit whose wire buffers must not alias (kUnitDef_CantAliasInputsToOutputs).
+// supernova otherwise gives an output that no unit reads (y, in a 1D graph) a wire buffer that is
+// free again at this very unit, and hands the same buffer to the next output (speedX): render()
+// writes y after speedX, so speedX read 0 throughout (measured: [m[0], m[2]] read 0 mm/s under
+// supernova, 105 mm/s under scsynth, whose unread outputs keep a buffer of their own). With the
+// flag, supernova reuses only buffers whose last reader came before this unit. In scsynth the
+// flag only keeps the (rare) audio-rate inputs apart from the outputs.
+void registerFrictionMouseIn() { registerUnit<FrictionMouseIn>(ft, "FrictionMouseIn", true); }
