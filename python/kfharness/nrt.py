@@ -7,6 +7,23 @@ import time
 from . import paths, readers, sclang
 
 
+def server():
+    """The server that renders: scsynth, or what KF_NRT_SERVER names (supernova)."""
+    return os.environ.get("KF_NRT_SERVER", "scsynth")
+
+
+def bundle_start_sample(time_s, sample_rate=48000, block_size=64):
+    """The first sample of the block in which the server runs a bundle stamped time_s. scsynth -N
+    runs it before the block that holds time_s (at a block border, the block that starts there).
+    supernova -N runs it one block later (time_s > 0): its logical clock, stepped by a block
+    truncated to OSC time units, runs a bundle at the first block that starts at or after its
+    stamp (measured: a synth at 0.5 s starts at sample 24064, under scsynth at 24000)."""
+    block = int(time_s * sample_rate / block_size + 1e-9)
+    if server() == "supernova" and time_s > 0:
+        block += 1
+    return block * block_size
+
+
 def plugin_path(extra_dirs=()):
     """scsynth's -U: the system plugins, the extension's plugin folder, and any extra folders."""
     dirs = [paths.SYSTEM_PLUGIN_DIR, paths.extension_dir() / "plugins", *extra_dirs]
@@ -16,8 +33,7 @@ def plugin_path(extra_dirs=()):
 def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, timeout=300,
            sample_format="float", memory_kb=65536, extra_args=(), plugin_dirs=()):
     """Renders an OSC score file; returns the server's output (an AssertionError if it failed)."""
-    server = os.environ.get("KF_NRT_SERVER", "scsynth")
-    cmd = [server, "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
+    cmd = [server(), "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
            "-o", str(channels), "-i", "0", "-z", str(block_size), "-U", plugin_path(plugin_dirs),
            "-m", str(memory_kb), *map(str, extra_args)]
     env = dict(os.environ)
@@ -27,7 +43,7 @@ def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, t
     proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           timeout=timeout, text=True, errors="replace", env=env)
     failed = proc.returncode != 0 or "FAILURE" in proc.stdout or "not installed" in proc.stdout
-    assert not failed, f"{server} -N failed ({proc.returncode}):\n{proc.stdout[-4000:]}"
+    assert not failed, f"{server()} -N failed ({proc.returncode}):\n{proc.stdout[-4000:]}"
     return proc.stdout
 
 

@@ -221,10 +221,28 @@ LOUDNESS_ROWS = [
 ]
 
 
+def loudness_rows():
+    """LOUDNESS_ROWS as the rendering server can give them. supernova -N hands RTAlloc plain
+    malloc (in NRT mode it bypasses the real-time pool that -m sizes: supernova's
+    sc_plugin_interface.cpp), so no history fails to fit there: maxinf's and max50's follow the
+    mapping with the paper's window, as every other row's, without the allocation message."""
+    if nrt.server() != "supernova":
+        return LOUDNESS_ROWS
+    rows = []
+    for name, args, messages, expected, mapping in LOUDNESS_ROWS:
+        if name == "maxinf":  # the history limit's message stays
+            messages, expected = messages[:1], 48
+        elif name == "max50":  # loForce 0.2
+            messages, expected, mapping = [], 48, dict(lo_force_n=0.2)
+        rows.append((name, args, messages, expected, mapping))
+    return rows
+
+
 def test_loudness_to_friction_bad_inputs_give_a_defined_force_and_one_message():
+    rows = loudness_rows()
     synths = ",\n".join(
         f"[0.0, Synth.basicNew(\\{name}, nil, {1000 + i}).newMsg(nil, [\\out, {i + 1}, {args}])]"
-        for i, (name, args, _, _, _) in enumerate(LOUDNESS_ROWS))
+        for i, (name, args, _, _, _) in enumerate(rows))
     data, log = nrt.score_and_render("loudnessbad", f"""
         // The same sound in every synth: a 50 Hz sine whose level sweeps -60..0 dB and back.
         var sound = {{ SinOsc.ar(50) * LFTri.ar(4, 3).exprange(0.001, 1) }};
@@ -254,19 +272,20 @@ def test_loudness_to_friction_bad_inputs_give_a_defined_force_and_one_message():
             [0.0, Synth.basicNew(\\sound, nil, 999).newMsg],
             {synths},
             [0.5, ['/c_set', 0, 0]]]);
-    """, channels=len(LOUDNESS_ROWS) + 1, memory_kb=8192)
+    """, channels=len(rows) + 1, memory_kb=8192)
     sound = data[:, 0]
     assert sound.max() > 0.9 and np.abs(sound).max() <= 1, "the sound spans the clip range"
-    for i, (_, _, messages, expected, mapping) in enumerate(LOUDNESS_ROWS):
+    for i, (name, _, messages, expected, mapping) in enumerate(rows):
         force = data[:, i + 1]
-        assert np.all(np.isfinite(force)), messages[0]
+        what = messages[0] if messages else name
+        assert np.all(np.isfinite(force)), what
         if isinstance(expected, int):
             worst = np.max(np.abs(force - reference.equations_1_and_2(sound, expected, **mapping)))
-            assert worst <= 1e-6, f"{messages[0]}: worst {worst} N"
+            assert worst <= 1e-6, f"{what}: worst {worst} N"
         elif isinstance(expected, float):
-            assert np.all(force == np.float32(expected)), f"{messages[0]}: {np.unique(force)}"
+            assert np.all(force == np.float32(expected)), f"{what}: {np.unique(force)}"
         else:
-            assert force.min() >= np.float32(0.14) and force.max() <= np.float32(0.5), messages[0]
+            assert force.min() >= np.float32(0.14) and force.max() <= np.float32(0.5), what
         for message in messages:
             assert log.count(f"LoudnessToFriction: {message}") == 1, f"{message!r}:\n{log[-4000:]}"
-    assert message_counts(log, "LoudnessToFriction:") == sum(len(row[2]) for row in LOUDNESS_ROWS), log
+    assert message_counts(log, "LoudnessToFriction:") == sum(len(row[2]) for row in rows), log

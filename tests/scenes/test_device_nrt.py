@@ -168,7 +168,7 @@ def test_specs_names_carry_units_old_names_still_work_and_audio_delay_is_one_ms(
 
 def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
     """Device time starts at the open, as in realtime: a hand script opened at 0.5 s runs from
-    0.5 s (whole blocks: 0.5 s is 375 blocks of 64 at 48 kHz)."""
+    the block the open ran at (scsynth: 0.5 s, 375 blocks of 64 at 48 kHz)."""
     hand = "FrictionHand.path([[0, 0], [0.3, 20], [0.6, 5]])"
     early, _ = render_device("open_early", f"FrictionDevice.sim(nil, 0, {hand})", 1.2)
     late, _ = nrt.score_and_render("open_late", f"""
@@ -183,11 +183,16 @@ def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
             [1.7, dev.closeMsg],
             [1.75, ['/c_set', 0, 0]]]);
     """, sample_rate=SR, channels=5)
-    shift = int(0.5 * SR)
+    # The block the open and the synth ran at: FrictionOut outputs the minimum force from its
+    # first block. 0.5 s under scsynth; one block later under supernova, which runs a bundle a
+    # block after scsynth does (nrt.bundle_start_sample): device time starts at that open.
+    shift = int(np.argmax(late[:, 4] != 0))
+    assert shift == nrt.bundle_start_sample(0.5, SR), f"the synth started at sample {shift}"
     n = int(1.1 * SR)
     assert np.max(np.abs(early[:n, 0])) > 3, "the puck moved"
-    # The same motion, 0.5 s later. Not bit for bit: report times are rendered against absolute
-    # audio time, so a report may land one sample apart (a speed step a sample early or late).
+    # The same motion, from the open on. Not bit for bit: report times are rendered against
+    # absolute audio time, so a report may land one sample apart (a speed step a sample early or
+    # late).
     np.testing.assert_allclose(late[shift:shift + n, 0], early[:n, 0], atol=0.021)
     speed_differs = np.abs(late[shift:shift + n, 2] - early[:n, 2]) > 1e-3
     assert np.mean(speed_differs) < 1e-3
