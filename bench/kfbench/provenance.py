@@ -11,12 +11,13 @@ OUTPUTS = ("bench/REPORT.md", "bench/results.json")  # and the plots: bench/*.pn
 
 
 def _git(*args):
+    # Not stripped: a status line starts with its two status columns, the first often a space.
     return subprocess.run(["git", "-C", str(REPO), *args], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                          text=True).stdout.strip()
+                          text=True).stdout
 
 
 def commit():
-    head = _git("rev-parse", "--short=12", "HEAD") or "unknown"
+    head = _git("rev-parse", "--short=12", "HEAD").strip() or "unknown"
     changed = [line[3:] for line in _git("status", "--porcelain", "--untracked-files=no").splitlines()]
     changed = [path for path in changed if path not in OUTPUTS and not (path.startswith("bench/") and path.endswith(".png"))]
     return head + (" with uncommitted changes" if changed else "")
