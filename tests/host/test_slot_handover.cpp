@@ -5,6 +5,7 @@
 // hands them over into slots already in use, reads their status, records, and closes and
 // deletes what the RT stage handed back, and each device's own thread pumps. The two threads
 // meet only through lock-free queues, as scsynth's stages do.
+#include <unistd.h>
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -12,7 +13,6 @@
 #include <cstdlib>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 #include "DeviceFactory.hpp"

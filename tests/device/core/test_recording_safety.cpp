@@ -51,6 +51,19 @@ std::vector<std::string> takeMessages() {
   return std::move(gMessages);
 }
 
+// A recording stopped by a write error: posted once, and its file holds whole lines within the
+// size limit.
+void checkStoppedByWriteError(const std::string& path, size_t limitBytes) {
+  const std::vector<std::string> messages = takeMessages();
+  REQUIRE(messages.size() == 1);
+  CHECK(contains(messages[0], "kfRecord: writing "));
+  setDeviceMessageSink(nullptr);
+  const std::string text = readAll(path);
+  CHECK(text.size() <= limitBytes);
+  REQUIRE(!text.empty());
+  CHECK(text.back() == '\n');
+}
+
 // Limits the size of files this process writes (EFBIG past it), for the scope.
 struct FileSizeLimit {
   explicit FileSizeLimit(rlim_t bytes) {
@@ -156,15 +169,8 @@ TEST_CASE("a write error stops the recording, keeps what was written and is post
     // Later pumps neither write nor post again.
     for (int i = 0; i < 10; ++i) device->pump(timeS += 0.001);
   }
-  const std::vector<std::string> messages = takeMessages();
-  REQUIRE(messages.size() == 1);
-  CHECK(contains(messages[0], "kfRecord: writing "));
-  setDeviceMessageSink(nullptr);
-  // What was written is whole lines, all of them readable.
-  const std::string text = readAll(path);
-  CHECK(text.size() <= 4096);
-  REQUIRE(!text.empty());
-  CHECK(text.back() == '\n');
+  checkStoppedByWriteError(path, 4096);
+  // What was written is readable.
   SessionData session;
   std::string error;
   REQUIRE(readSessionFile(path, DeviceSpec{}, session, error));
@@ -287,14 +293,7 @@ TEST_CASE("a realtime device's write error is posted once and the file keeps who
     device.stopRecording();
     device.close();
   }
-  const std::vector<std::string> messages = takeMessages();
-  REQUIRE(messages.size() == 1);
-  CHECK(contains(messages[0], "kfRecord: writing "));
-  setDeviceMessageSink(nullptr);
-  const std::string text = readAll(path);
-  CHECK(text.size() <= 4096);
-  REQUIRE(!text.empty());
-  CHECK(text.back() == '\n');
+  checkStoppedByWriteError(path, 4096);
   // Another recording may have the file at once.
   Recorder again;
   std::string error;
