@@ -23,6 +23,12 @@ struct FailureCopy {
 };
 
 void replyFailureFromNrt(World* world, const CommandData* data) {
+  // A non-realtime server (a Score rendering) runs every stage on its one thread, and scsynth's
+  // has no audio driver to take a message to the RT side (SendMsgToRT crashed it): reply here.
+  if (!world->mRealTime) {
+    replyFailure(world, data);
+    return;
+  }
   auto* copy = static_cast<FailureCopy*>(NRTAlloc(sizeof(FailureCopy)));
   if (copy == nullptr) return;
   std::memcpy(&copy->data, data, sizeof(CommandData));
