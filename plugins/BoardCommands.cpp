@@ -3,12 +3,15 @@
 // looks the slot's device up; opening, arming, loading and closing run in NRT stages.
 //
 //   kfBoardOpen      index serial emulate inFlight   serial "" = the first board; emulate 1 =
-//                                                    the board emulator instead of libusb
+//                                                    the board emulator instead of libusb;
+//                                                    refused on a device that cannot carry a
+//                                                    board (boardRefusal)
 //   kfBoardArm       index arm                       1 arms, 0 disarms
 //   kfBoardCalibrate index path                      a kf-calibration file; "" = linear
 //   kfBoardClose     index                           drive 0, disarm, release, close
 //   kfBoardStatus    index                           replies /kfBoardStatus (to /notify clients):
-//                    index, then kBoardStatusFields values (BoardStatusField order)
+//                    index, then kBoardStatusFields values (BoardStatusField order); a device
+//                    without a board answers hasBoard 0, an empty slot is refused (no reply)
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -21,6 +24,7 @@
 #include "board/EmulatedUsb.hpp"
 #include "board/UsbBoardBackend.hpp"
 #include "core/force/CalibrationTable.hpp"
+#include "recordings/ReplayBackend.hpp"
 
 namespace {
 
@@ -66,9 +70,27 @@ kf::UsbBoardBackend* boardOf(CommandData* data, std::shared_ptr<kf::ForceBackend
 
 // --- kfBoardOpen ---------------------------------------------------------------------------
 
+// Why `device` cannot carry a board, or null. The board is a magnet under a live puck, driven
+// one set-point per ms of real time: a lockstep device (NRT rendering, a Score) runs on audio
+// time, faster or slower than the clock, and a replay's puck is a recording, not the one on the
+// magnet. A live puck is a real mouse or a simulated hand (the emulator's tests use one).
+const char* boardRefusal(kf::Device& device) {
+  if (device.isLockstep())
+    return "renders in lockstep (a Score or NRT server) and a board runs in real time only: add it on a realtime "
+           "server";
+  if (dynamic_cast<const kf::ReplayBackend*>(&device.mouseBackend()) != nullptr)
+    return "replays a recording, whose puck is not the one on the magnet: add the board to a mouse (or simulated) "
+           "device";
+  return nullptr;
+}
+
 bool openStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   if (!haveDevice(data)) return false;
+  if (const char* why = boardRefusal(*data->device)) {
+    failWith(data, "kfBoardOpen: device %d %s; refused", data->args.index, why);
+    return false;
+  }
   kf::BoardOptions options;
   const bool emulate = data->args.numbers[0] != 0.0;
   options.ids.serial = data->args.which;
@@ -164,7 +186,8 @@ void closeCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 bool collectStatusStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
   std::fill_n(data->replyValues, static_cast<int>(kBoardStatusFields), 0.0f);
-  if (data->device == nullptr) return true;  // replies all zeros: no device, no board
+  // Refused as arm and calibrate are: zeros would read as "a device without a board".
+  if (!haveDevice(data)) return false;
   const kf::TelemetrySnapshot t = data->device->telemetry();
   const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
   data->replyValues[kOnePerPump] = pumps > 0 ? static_cast<float>(t.framesPerPump[1] / double(pumps)) : 0.0f;
@@ -196,6 +219,7 @@ bool collectStatusStage(World*, void* raw) {  // NRT
 // RT, at the end: the reply goes from the root group to every client that asked for
 // notifications (sclang's default).
 void replyStatus(World* world, CommandData* data) {
+  if (data->failed) return;  // the refusal is the answer
   // The plugin headers do not define Group; the server's starts with its Node (SC_Group.h).
   SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfBoardStatus", kBoardStatusFields,
                 data->replyValues);

@@ -129,9 +129,19 @@ void replyFailure(World* world, int index, const char* reason) {
 
 void replyFailure(World* world, const CommandData* data) { replyFailure(world, data->args.index, data->reason); }
 
+void replySuccess(World* world, const CommandData* data) {
+  float codes[kMaxReasonChars];
+  int n = 0;
+  for (; n < kMaxReasonChars && data->name[n] != '\0'; ++n) codes[n] = static_cast<unsigned char>(data->name[n]);
+  SendNodeReply(reinterpret_cast<Node*>(world->mTopGroup), data->args.index, "/kfDone", n, codes);
+}
+
+// The cleanup of every command (RT, after its last stage; also of one refused before its
+// stages): its end reply, then /kfDone unless it failed (a failure was answered already).
 void freeCommand(World* world, void* raw) {
   auto* data = static_cast<CommandData*>(raw);
   if (data->onEnd != nullptr) data->onEnd(world, data);
+  if (!data->failed) replySuccess(world, data);
   if (data->args.values != nullptr) RTFree(world, data->args.values);
   RTFree(world, data);
 }

@@ -1,9 +1,17 @@
 // The machinery every plugin command shares (DeviceCommands, MouseCommands, BoardCommands):
 // arguments read and checked in the RT stage by CommandArgs (never past the packet), refusals
 // posted at most once a second per cause, the stages run as SC's asynchronous commands with
-// `/done cmdName` on success and `/kfFail` (replyFailure) on failure, whatever failed: the
-// arguments, RT memory or a stage. Every command gets exactly one of the two. Also the stages
-// the open and slot commands have in common.
+// `/done cmdName` and `/kfDone` (replySuccess) on success and `/kfFail` (replyFailure) on
+// failure, whatever failed: the arguments, RT memory or a stage. Every command gets exactly one
+// outcome. Also the stages the open and slot commands have in common.
+//
+// Why `/kfDone` beside `/done`: SC's own commands answer `/done /b_alloc bufnum`, but a plugin's
+// /done is sent by the server (DoAsynchronousCommand's last stage, scsynth and supernova alike)
+// with the command's name only, and the plugin interface has no call that replies to the sender
+// with more. So the slot comes in `/kfDone`, a node reply shaped as `/kfFail` is: node 0, reply
+// ID the slot, the command's name as character codes. Two commands of one name in flight are
+// then told apart by slot (an open that fails in its last stage answers after a later one's
+// /done). `/done cmdName` stays for clients that wait for it.
 #pragma once
 
 #include <SC_PlugIn.hpp>
@@ -38,6 +46,9 @@ void failWith(CommandData* data, const char* format, ...) __attribute__((format(
 // codes, which starts with the command's name ("kfRecord: ...").
 void replyFailure(World* world, int index, const char* reason);
 void replyFailure(World* world, const CommandData* data);
+// RT: the success to the notified clients: /kfDone, node 0, reply ID the device (-1 for a
+// command without one), then the command's name as character codes.
+void replySuccess(World* world, const CommandData* data);
 
 // RT: a command with its arguments read and checked for `shape`; null if they do not fit or RT
 // memory is short (then the refusal is answered and posted).

@@ -1,9 +1,12 @@
-// The answers to FrictionDevice's asynchronous commands (the plugin's CommandRunner): /done with
-// the command's name when it succeeded, /kfFail (node 0, reply ID the slot, then the reason as
-// character codes, starting with the command's name) when the server refused it, whatever was
-// wrong; nothing only when the server is gone, so a timeout.
-// One pair of responders per server; the commands awaiting an answer, by server, in the order
-// they were sent.
+// The answers to FrictionDevice's asynchronous commands (the plugin's CommandRunner), both node
+// replies to the clients registered with /notify (sclang is by default): /kfDone when the
+// command succeeded and /kfFail when the server refused it, whatever was wrong; each from node
+// 0, reply ID the slot (-1 when the device argument itself was wrong, or the command has none),
+// then character codes: the command's name (/kfDone) or the reason, which starts with it
+// (/kfFail). Nothing only when the server is gone, so a timeout. The server's /done cmdName
+// carries no slot (a plugin's /done cannot: CommandRunner.hpp), so it is not used here: two
+// commands of one name in flight are matched by (command, slot), not by the order they answer.
+// One pair of responders per server; the commands awaiting an answer, by server.
 FrictionAnswers {
 	classvar pending, responders, <>timeout = 5;
 
@@ -17,29 +20,44 @@ FrictionAnswers {
 	// returns at once and a refusal is posted as an ERROR when it comes. block false: never waits
 	// and does not need the server marked running (at ServerBoot, re-opening, it is not yet).
 	*send { |server, cmd, index, msg, onDone, onFail, block = true|
-		var cond, answer, inRoutine = block and: { thisThread.isKindOf(Routine) };
+		this.sendSequence(server, index, [[cmd, msg]], onDone, onFail, block)
+	}
+
+	// Sends steps ([cmd, msg] pairs, all on slot index) one after the other, each once the one
+	// before succeeded, and answers once for all, as send does: onDone when the last succeeded;
+	// at the first refusal, the rest are not sent, onFail is called with the reason and the
+	// failed step's number, and what it returns (a String: what it undid) ends the refusal's text.
+	*sendSequence { |server, index, steps, onDone, onFail, block = true|
+		var cond, answer, step, inRoutine = block and: { thisThread.isKindOf(Routine) };
 		if(server.isNil) { ^this };
 		if(block) { FrictionCheck.serverRunning(server, "FrictionDevice") };
 		cond = Condition(false);
-		this.expect(server, cmd, index, {
-			answer = \done;
-			onDone.value;
-			cond.test = true; cond.signal;
-		}, { |reason|
-			answer = reason;
-			onFail.value(reason);
-			if(inRoutine.not) { ("ERROR: " ++ this.failText(cmd, reason)).postln };
-			cond.test = true; cond.signal;
-		});
-		server.listSendMsg(msg);
+		step = { |i|
+			var cmd, msg;
+			if(i >= steps.size) {
+				answer = \done;
+				onDone.value;
+				cond.test = true; cond.signal;
+			} {
+				#cmd, msg = steps[i];
+				this.expect(server, cmd, index, { step.(i + 1) }, { |reason|
+					var undone = onFail.value(reason, i);
+					answer = this.failText(cmd, reason) ++ (if(undone.isString) { "; " ++ undone } { "" });
+					if(inRoutine.not) { ("ERROR: " ++ answer).postln };
+					cond.test = true; cond.signal;
+				});
+				server.listSendMsg(msg);
+			}
+		};
+		step.(0);
 		if(inRoutine) {
 			cond.wait;
-			if(answer != \done) { Error(this.failText(cmd, answer)).throw };
+			if(answer != \done) { Error(answer).throw };
 		};
 	}
 
-	// Calls done when /done cmd comes, fail with the reason when /kfFail for the slot comes or
-	// nothing came within timeout s.
+	// Calls done when /kfDone for cmd and the slot comes, fail with the reason when /kfFail for
+	// them comes or nothing came within timeout s.
 	*expect { |server, cmd, index, done, fail|
 		var list = pending[server] ?? { List.new };
 		var entry = (cmd: cmd, index: index, done: done, fail: fail);
@@ -48,11 +66,11 @@ FrictionAnswers {
 		responders[server] ?? {
 			responders[server] = [
 				OSCFunc({ |msg|
-					var found = list.detect { |e| e[\cmd] == msg[1] };
+					var found = this.awaiting(list, this.textOf(msg).asSymbol, msg[2]);
 					found !? { list.remove(found); found[\done].value };
-				}, '/done', server.addr).permanent_(true),
+				}, '/kfDone', server.addr).permanent_(true),
 				OSCFunc({ |msg|
-					var reason = msg[3..].collect { |c| c.asInteger.asAscii }.join;
+					var reason = this.textOf(msg);
 					var found = this.awaiting(list, reason.split($:).first.asSymbol, msg[2]);
 					found !? { list.remove(found); found[\fail].value(reason) };
 				}, '/kfFail', server.addr).permanent_(true)
@@ -67,8 +85,11 @@ FrictionAnswers {
 		});
 	}
 
-	// The first command cmd awaiting an answer for device index: a refusal's reply ID is -1 when
-	// the device argument itself was wrong (or the command has none, kfListMice).
+	// The text of a /kfDone or /kfFail: character codes after node and reply ID.
+	*textOf { |msg| ^msg[3..].collect { |c| c.asInteger.asAscii }.join }
+
+	// The first command cmd awaiting an answer for device index: a reply ID of -1 is a refusal of
+	// the device argument itself (or a command without one, kfListMice), for any slot.
 	*awaiting { |list, cmd, index|
 		^list.detect { |e| e[\cmd] == cmd and: { index < 0 or: { e[\index] == index } } }
 	}

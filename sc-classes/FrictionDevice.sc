@@ -10,6 +10,9 @@ FrictionDevice {
 	var <server, <index, <specs, <kind, <source, <overrides;
 	// busSynths: the writer of forceBus and the reader of positionBus, by role (\writer, \reader).
 	var <state = \described, <replace = false, forceBus, positionBus, busSynths;
+	// The board the device carries, opened with it (and again at a reboot): nil, or an Event of
+	// addBoard's arguments and the calibration (FrictionDeviceBoard.sc).
+	var <boardSetup;
 
 	*initClass {
 		// The names specs had before every name carried its unit. A user may have typed them, so
@@ -72,6 +75,21 @@ FrictionDevice {
 			Error("FrictionDevice.replay: no such file: %".format(path)).throw
 		};
 		^this.new.prInit(server, index, \replay, path, profile, replace).prOpen
+	}
+
+	// A real mouse and the friction board with its calibration, opened as one device: one answer
+	// for the whole (inside a Routine it waits and a refusal is an Error; elsewhere a refusal is
+	// posted). When the board or its calibration is refused, the mouse opened for it is closed
+	// again. mouse, profile, index, backend, grab: as FrictionDevice.mouse's which, profile...;
+	// board: nil (the first board found), a serial String, or \emulate (the board emulator);
+	// calibration: as calibrate takes it (a FrictionCalibration written to a file, a path, nil).
+	// Why a sequence of the server's own commands (kfOpenMouse, kfBoardOpen, kfBoardCalibrate)
+	// rather than one composite command: each part already answers with its own reason, and a
+	// failed part is undone by one kfClose; a composite would repeat the mouse's and the board's
+	// arguments and stages in the plugin for the same outcome. See ARCHITECTURE.md.
+	*hardware { |server, mouse, board, profile, calibration, index = 0, backend = \hidapi, grab = false|
+		^this.new.prInitMouse(server, index, mouse, backend, profile, grab)
+		.prInitBoard(board, calibration, "FrictionDevice.hardware").prOpen
 	}
 
 	// The devices open (or opening) in sclang, on all servers.
@@ -218,11 +236,28 @@ FrictionDevice {
 		state = \opening;
 		// The server decides whether the slot is free (or replaced): it holds the devices of
 		// every client. Its answer updates what sclang holds.
-		this.prSendAnswered(this.openCommand, this.openMsg, {
+		FrictionAnswers.sendSequence(server, index, this.prOpenSteps, {
 			this.prHold;
-		}, {
+		}, { |reason, step|
 			state = \failed;
+			this.prUndoOpen(step)
 		});
+	}
+
+	// The commands that open the device: the open, then its board and calibration if it has one.
+	prOpenSteps {
+		^[[this.openCommand, this.openMsg]] ++ (boardSetup !? { |b|
+			[[\kfBoardOpen, this.addBoardMsg(b[\serial], b[\emulate], b[\inFlight])],
+				[\kfBoardCalibrate, this.calibrateMsg(b[\calibration])]]
+		} ? [])
+	}
+
+	// After step (of prOpenSteps) was refused: the device opened by the first is closed again (the
+	// server runs commands in order, so one sent after this finds the slot free); what was undone.
+	prUndoOpen { |step|
+		if(step == 0) { ^nil };
+		server.listSendMsg(this.closeMsg);
+		^"the % device it opened in slot % was closed again".format(kind, index)
 	}
 
 	prHold {
@@ -234,7 +269,7 @@ FrictionDevice {
 		this.prStartBusSynths;
 	}
 
-	// Sends msg and awaits /done cmd or /kfFail for this slot (FrictionAnswers.send).
+	// Sends msg and awaits /kfDone or /kfFail for cmd on this slot (FrictionAnswers.send).
 	prSendAnswered { |cmd, msg, onDone, onFail, block = true|
 		FrictionAnswers.send(server, cmd, index, msg, onDone, onFail, block)
 	}
@@ -299,11 +334,12 @@ FrictionDevice {
 		forceBus !? { server.audioBusAllocator.reserve(forceBus.index, 1, false) };
 		positionBus !? { server.controlBusAllocator.reserve(positionBus.index, 4, false) };
 		state = \opening;
-		this.prSendAnswered(this.openCommand, this.openMsg, {
+		FrictionAnswers.sendSequence(server, index, this.prOpenSteps, {
 			state = \open;
 			this.prStartBusSynths;
-		}, {
+		}, { |reason, step|
 			this.prForget(\failed);
+			this.prUndoOpen(step)
 		}, false);
 	}
 

@@ -1,6 +1,7 @@
 """sclang side of the friction board: FrictionCalibration (validation, file round trip, the
-inverse the server computes) and FrictionDevice's board messages for Scores."""
-from kfharness import paths, sclang
+inverse the server computes), FrictionDevice's board messages, and a Score's board refused (a
+board runs in real time only)."""
+from kfharness import nrt, paths, sclang
 
 
 def test_calibration_tables_validate_round_trip_and_invert():
@@ -57,3 +58,14 @@ def test_board_messages_for_scores():
     assert len(errors) == 4 and "none" not in [e.split(" ", 1)[1] for e in errors], errors
     assert "write the FrictionCalibration to a file first" in errors[2]
     assert "KF-SPECS [ 0.01, 1 ]" in out
+
+
+def test_a_score_cannot_carry_a_board():
+    _, log = nrt.score_and_render("board_nrt", """
+        var dev = FrictionDevice.sim(nil, 0);
+        score = Score([[0.0, dev.openMsg], [0.0, dev.addBoardMsg(emulate: true)], [0.01, dev.armMsg],
+            [0.02, ['/c_set', 0, 0]]]);
+    """)
+    assert "kfBoardOpen: device 0 renders in lockstep (a Score or NRT server) and a board runs in real time" in log
+    assert "kfBoardOpen 0 board" not in log  # never opened
+    assert "kfBoardArm: device 0 has no board" in log
