@@ -2,7 +2,7 @@
 emulator: answers matched to their callers by (command, slot), not by the order they come;
 FrictionDevice.hardware's one answer for the mouse, the board and the calibration, and the device
 it opened closed again when a later part is refused; addBoard refused on a replay device; the
-board methods waiting for their answers.
+board methods waiting for their answers; the board opened again after a reboot.
 
 No mouse here (CI has none): hardware() itself is run to its refusal of the mouse; its board
 sequence (prInitBoard, then the open of FrictionDevice.hardware) is run on simulated devices,
@@ -85,6 +85,14 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
         catch.("ARM-NO-BOARD", { a.arm });
         AppClock.sched(0, { dev.boardStatus; nil });  // posted when it comes
         0.3.wait;
+
+        // 7. A reboot opens the device again with its board and calibration (disarmed).
+        s.quit;
+        while { s.serverRunning } { 0.05.wait };
+        s.bootSync;
+        while { dev.state == \opening } { 0.05.wait };
+        e = dev.boardStatus;
+        ("KF-REBOOT " ++ [dev.state, e[\hasBoard], e[\armed]]).postln;
         [a, b, dev, replay].do(_.close);
         s.sync;
     """, table=sclang.sc_string(table), hid=sclang.sc_string(HID)), jack, name="hardware"))
@@ -133,3 +141,7 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
     assert line("KF-STATUS-EMPTY") == "ERROR FrictionDevice kfBoardStatus: no device is open at index 9"
     assert "has no board" in line("KF-ARM-NO-BOARD")
     assert re.search(r"^FrictionDevice\(sim, 5\) board status: \(", out, re.M), out[-3000:]
+    # 7. Re-opened after the reboot with its board, calibrated again.
+    assert line("KF-REBOOT") == "[ open, true, false ]"
+    after = out.split("KF-ARM-NO-BOARD")[1]
+    assert re.search(r"^kfBoardOpen 5 board KF-EMU-0001", after, re.M) and "kfBoardCalibrate" not in after
