@@ -1,11 +1,36 @@
 #include "hid/HidMouseDecoder.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <string>
 
 namespace kf {
 
 void HidMouseDecoder::noteExtent(Layout& layout, const Element& element) {
   layout.minBytes = std::max<size_t>(layout.minBytes, (element.bitOffset + element.bitSize + 7) / 8);
+}
+
+HidMouseDecoder::Axis HidMouseDecoder::axisOf(const HidField& field, const Element& element) {
+  // What the field's bits hold; the logical range narrows it when the descriptor gives one
+  // (minimum below maximum: a descriptor without one leaves both 0, as Linux also reads it).
+  const int64_t span = int64_t(1) << element.bitSize;
+  Axis axis{element, element.isSigned ? -span / 2 : 0, element.isSigned ? span / 2 - 1 : span - 1};
+  axis.highest = std::min<int64_t>(axis.highest, INT32_MAX);  // an unsigned 32-bit delta is no mouse's
+  if (field.logicalMin < field.logicalMax) {
+    axis.lowest = std::max(axis.lowest, field.logicalMin);
+    axis.highest = std::min(axis.highest, field.logicalMax);
+  }
+  return axis;
+}
+
+int32_t HidMouseDecoder::readAxis(const uint8_t* bytes, size_t size, bool have, const Axis& axis, bool& saturated) {
+  int64_t value = 0;
+  if (!have || !extractHidBits(bytes, size, axis.element.bitOffset, axis.element.bitSize, axis.element.isSigned, value))
+    return 0;
+  value = std::clamp(value, axis.lowest, axis.highest);
+  // 0 is no movement, whatever the range (an unsigned axis would otherwise saturate at rest).
+  if (value != 0 && (value == axis.lowest || value == axis.highest)) saturated = true;
+  return static_cast<int32_t>(value);
 }
 
 bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& error) {
@@ -31,11 +56,11 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
         const HidUsage usage = field.usageOfElement(i);
         const Element element{field.bitOffset + i * field.bitSize, field.bitSize, field.isSigned()};
         if (usage == kX && field.isRelative() && !layout.haveX) {
-          layout.x = element;
+          layout.x = axisOf(field, element);
           layout.haveX = true;
           noteExtent(layout, element);
         } else if (usage == kY && field.isRelative() && !layout.haveY) {
-          layout.y = element;
+          layout.y = axisOf(field, element);
           layout.haveY = true;
           noteExtent(layout, element);
         } else if (usage >> 16 == kHidPageButton && (usage & 0xFFFF) >= 1 && (usage & 0xFFFF) <= 32 &&
@@ -64,6 +89,11 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
                  layouts_.end());
   if (layouts_.empty()) {
     error = "the HID report descriptor has no relative Generic Desktop X or Y input";
+    if (!descriptor.skipNotes.empty())
+      error +=
+          " (" + descriptor.skipNotes.front() +
+          (descriptor.skippedItems > 1 ? "; " + std::to_string(descriptor.skippedItems - 1) + " more skipped" : "") +
+          ")";
     return false;
   }
   return true;
@@ -90,11 +120,9 @@ bool HidMouseDecoder::decode(const uint8_t* bytes, size_t size, HidMouseDelta& o
 
   out = HidMouseDelta{};
   out.reportId = reportId;
+  out.dxCounts = readAxis(bytes, size, layout->haveX, layout->x, out.saturated);
+  out.dyCounts = readAxis(bytes, size, layout->haveY, layout->y, out.saturated);
   int64_t value = 0;
-  if (layout->haveX && extractHidBits(bytes, size, layout->x.bitOffset, layout->x.bitSize, layout->x.isSigned, value))
-    out.dxCounts = static_cast<int32_t>(value);
-  if (layout->haveY && extractHidBits(bytes, size, layout->y.bitOffset, layout->y.bitSize, layout->y.isSigned, value))
-    out.dyCounts = static_cast<int32_t>(value);
   for (const auto& [element, button] : layout->buttonBits)
     if (extractHidBits(bytes, size, element.bitOffset, element.bitSize, false, value) && value != 0)
       out.buttons |= 1u << (button - 1);

@@ -1,5 +1,7 @@
 // HidMouseDecoder: finds, in a parsed report descriptor, the relative Generic Desktop X/Y
-// inputs and the buttons of each report ID, and decodes raw input reports to dx, dy, buttons.
+// inputs and the buttons of each report ID, and decodes raw input reports to dx, dy, buttons,
+// flagging a delta at its field's limit (the descriptor's logical minimum or maximum, within
+// what the field's bits hold) as saturated.
 #pragma once
 
 #include <cstddef>
@@ -16,6 +18,10 @@ struct HidMouseDelta {
   int32_t dxCounts = 0;
   int32_t dyCounts = 0;
   uint32_t buttons = 0;  // bit i = Button usage i + 1
+  // dx or dy at its field's limit: the sensor moved at least that far, maybe more (the excess
+  // is lost). A value beyond the logical range is clamped to it first, as Linux's input layer
+  // and Windows do, so hidraw and evdev give the same counts.
+  bool saturated = false;
 };
 
 class HidMouseDecoder {
@@ -40,6 +46,12 @@ class HidMouseDecoder {
     uint32_t bitSize = 0;
     bool isSigned = false;
   };
+  // An X or Y element and the range its values are clamped to; a value at either end (other
+  // than 0) is a saturated delta.
+  struct Axis {
+    Element element;
+    int64_t lowest = 0, highest = 0;
+  };
   // One element of an array item; its selectable usages are shared by all elements of the
   // item (arrayUsages_[usagesIndex]), never copied per element.
   struct ButtonArray {
@@ -51,12 +63,15 @@ class HidMouseDecoder {
     uint8_t reportId = 0;
     size_t minBytes = 0;  // without the ID byte
     bool haveX = false, haveY = false;
-    Element x, y;
+    Axis x, y;
     std::vector<std::pair<Element, uint32_t>> buttonBits;  // element, button number (1-based)
     std::vector<ButtonArray> buttonArrays;
   };
 
   void noteExtent(Layout& layout, const Element& element);
+  static Axis axisOf(const HidField& field, const Element& element);
+  // The axis' value in `bytes` (0 if it has none), clamped to its range; `saturated` set at a limit.
+  static int32_t readAxis(const uint8_t* bytes, size_t size, bool have, const Axis& axis, bool& saturated);
 
   std::vector<Layout> layouts_;
   std::vector<std::vector<HidUsage>> arrayUsages_;

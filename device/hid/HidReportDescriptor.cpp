@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <utility>
 
 namespace kf {
@@ -34,6 +35,7 @@ struct LocalUsage {
 struct LocalState {
   std::vector<LocalUsage> usages;
   bool haveMin = false, haveMax = false;
+  bool tooManyUsages = false;  // more than kMaxUsageRange usages before one main item
   LocalUsage usageMin, usageMax;
 };
 
@@ -50,6 +52,16 @@ HidUsage fullUsage(const LocalUsage& usage, uint16_t page) {
 
 std::string at(size_t offset, const std::string& what) {
   return "HID report descriptor, byte " + std::to_string(offset) + ": " + what;
+}
+
+const char* kindName(HidField::Kind kind) {
+  return kind == HidField::Kind::kInput ? "input" : kind == HidField::Kind::kOutput ? "output" : "feature";
+}
+
+void noteSkipped(HidReportDescriptor& out, size_t offset, const std::string& what) {
+  ++out.skippedItems;
+  if (out.skipNotes.size() < HidReportDescriptor::kMaxSkipNotes)
+    out.skipNotes.push_back("byte " + std::to_string(offset) + ": " + what);
 }
 
 }  // namespace
@@ -74,7 +86,7 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
   LocalState local;
   std::vector<int> openCollections;
   std::map<std::pair<int, int>, uint64_t> nextBit;  // (kind, report ID) -> bit offset
-  bool haveFieldWithoutId = false;
+  std::set<std::pair<int, int>> droppedReports;     // (kind, report ID) with an item beyond our bounds
   size_t totalUsages = 0;
   if (size > kMaxDescriptorBytes) {
     error =
@@ -118,18 +130,34 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
         const HidField::Kind kind = tag == 0x8   ? HidField::Kind::kInput
                                     : tag == 0x9 ? HidField::Kind::kOutput
                                                  : HidField::Kind::kFeature;
-        if (global.reportSize > kMaxReportSizeBits) {
-          error = at(itemStart, "report size " + std::to_string(global.reportSize) + " too large");
-          return false;
-        }
-        uint64_t& bit = nextBit[{static_cast<int>(kind), global.reportId}];
+        const std::pair<int, int> report{static_cast<int>(kind), global.reportId};
+        uint64_t& bit = nextBit[report];
         const uint64_t fieldBits = uint64_t(global.reportSize) * global.reportCount;
-        if (bit + fieldBits > kMaxReportBits) {
-          error = at(itemStart, "report longer than 4096 bytes");
-          return false;
+        uint64_t rangeCount = 0;
+        HidUsage first = 0;
+        std::string problem;
+        if (global.reportSize > kMaxReportSizeBits) {
+          problem = "report size " + std::to_string(global.reportSize) + " too large";
+        } else if (bit + fieldBits > kMaxReportBits) {
+          problem = "report longer than 4096 bytes";
+        } else if (local.tooManyUsages) {
+          problem = "more than " + std::to_string(kMaxUsageRange) + " usages before one main item";
+        } else if (local.haveMin && local.haveMax) {
+          first = fullUsage(local.usageMin, global.usagePage);
+          const HidUsage last = fullUsage(local.usageMax, global.usagePage);
+          if (last < first || last - first >= kMaxUsageRange)
+            problem = "bad usage minimum/maximum range";
+          else
+            rangeCount = uint64_t(last) - first + 1;
         }
-        if (global.reportId == 0) haveFieldWithoutId = true;
-        if (fieldBits > 0) {
+        if (problem.empty() && totalUsages + local.usages.size() + rangeCount > kMaxTotalUsages)
+          problem = "more than " + std::to_string(kMaxTotalUsages) + " usages in all";
+        if (!problem.empty()) {
+          // Its offsets, and those after it in the report, would be guesses: the report goes.
+          droppedReports.insert(report);
+          noteSkipped(out, itemStart,
+                      problem + ": " + kindName(kind) + " report " + std::to_string(global.reportId) + " skipped");
+        } else if (!droppedReports.count(report) && fieldBits > 0) {
           HidField field;
           field.kind = kind;
           field.reportId = global.reportId;
@@ -141,29 +169,14 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
           // A maximum is signed only when the minimum is negative (as the Linux parser does).
           field.logicalMax = field.logicalMin < 0 ? signExtend(global.logicalMaxRaw, global.logicalMaxBytes)
                                                   : int64_t(global.logicalMaxRaw);
-          uint64_t rangeCount = 0;
-          HidUsage first = 0;
-          if (local.haveMin && local.haveMax) {
-            first = fullUsage(local.usageMin, global.usagePage);
-            const HidUsage last = fullUsage(local.usageMax, global.usagePage);
-            if (last < first || last - first >= kMaxUsageRange) {
-              error = at(itemStart, "bad usage minimum/maximum range");
-              return false;
-            }
-            rangeCount = uint64_t(last) - first + 1;
-          }
           totalUsages += local.usages.size() + rangeCount;
-          if (totalUsages > kMaxTotalUsages) {
-            error = at(itemStart, "more than " + std::to_string(kMaxTotalUsages) + " usages in all");
-            return false;
-          }
           for (const LocalUsage& usage : local.usages) field.usages.push_back(fullUsage(usage, global.usagePage));
           // Counted, not compared with `last`: a range ending at 0xFFFFFFFF must not wrap.
           for (uint64_t i = 0; i < rangeCount; ++i) field.usages.push_back(static_cast<HidUsage>(first + i));
           field.collection = openCollections.empty() ? -1 : openCollections.back();
           out.fields.push_back(std::move(field));
         }
-        bit += fieldBits;
+        if (problem.empty()) bit += fieldBits;
       } else if (tag == 0xA) {  // collection
         HidCollection collection;
         collection.type = static_cast<uint8_t>(data);
@@ -178,8 +191,7 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
         }
         openCollections.pop_back();
       } else {
-        error = at(itemStart, "unknown main item tag " + std::to_string(tag));
-        return false;
+        noteSkipped(out, itemStart, "reserved main item tag " + std::to_string(tag) + " skipped");
       }
       local = LocalState{};
     } else if (type == 1) {  // global
@@ -206,10 +218,6 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
         case 0x8:
           if (data == 0 || data > 255) {
             error = at(itemStart, "report ID " + std::to_string(data) + " out of 1..255");
-            return false;
-          }
-          if (haveFieldWithoutId) {
-            error = at(itemStart, "Report ID after fields without a report ID");
             return false;
           }
           global.reportId = static_cast<uint8_t>(data);
@@ -240,11 +248,10 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
     } else if (type == 2) {  // local
       const LocalUsage usage{data, dataBytes};
       if (tag == 0x0) {
-        if (local.usages.size() >= kMaxUsageRange) {
-          error = at(itemStart, "more than " + std::to_string(kMaxUsageRange) + " usages before one main item");
-          return false;
-        }
-        local.usages.push_back(usage);
+        if (local.usages.size() >= kMaxUsageRange)
+          local.tooManyUsages = true;  // the main item they belong to is skipped
+        else
+          local.usages.push_back(usage);
       } else if (tag == 0x1) {
         local.usageMin = usage;
         local.haveMin = true;
@@ -254,14 +261,19 @@ bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescri
       }
       // Designators, strings and delimiters do not matter for decoding.
     } else {
-      error = at(itemStart, "reserved item type");
-      return false;
+      noteSkipped(out, itemStart, "reserved item type skipped");
     }
   }
   if (!openCollections.empty()) {
     error = "HID report descriptor: " + std::to_string(openCollections.size()) + " collection(s) not closed at the end";
     return false;
   }
+  // Fields kept before a report's bad item go too.
+  out.fields.erase(std::remove_if(out.fields.begin(), out.fields.end(),
+                                  [&](const HidField& field) {
+                                    return droppedReports.count({static_cast<int>(field.kind), field.reportId}) > 0;
+                                  }),
+                   out.fields.end());
   return true;
 }
 

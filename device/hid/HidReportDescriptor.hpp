@@ -51,14 +51,23 @@ struct HidReportDescriptor {
   std::vector<HidField> fields;
   std::vector<HidCollection> collections;
   bool usesReportIds = false;
+  // Main items accepted but not kept, each with its byte offset and why: reserved main tags
+  // and item types, and the items of a report with an item beyond our bounds (that report's
+  // fields are all dropped, so it is never half decoded). The first kMaxSkipNotes are named.
+  static constexpr size_t kMaxSkipNotes = 8;
+  std::vector<std::string> skipNotes;
+  size_t skippedItems = 0;
 
   // Size in bytes of the input report with this ID as sent, the ID byte included.
   size_t inputReportBytes(uint8_t reportId) const;
 };
 
-// Parses `size` bytes. On malformed input (truncated item, unbalanced collections or
-// push/pop, unknown main or global item, absurd sizes) returns false with a message naming
-// the byte offset; never reads past the end.
+// Parses `size` bytes. A descriptor whose structure is broken (truncated item, unbalanced
+// collections or push/pop, report ID 0, unknown global item, longer than 65535 bytes) is
+// refused: false with a message naming the byte offset. Main items a mouse does not need are
+// skipped, not refused (a vendor report with an odd item must not stop the mouse beside it;
+// Linux's parser also passes over reserved main items): see skipNotes. Never reads past the
+// end; bounded memory.
 bool parseHidReportDescriptor(const uint8_t* bytes, size_t size, HidReportDescriptor& out, std::string& error);
 
 // The little-endian bit field [bitOffset, bitOffset + bitSize) of `data` (bitSize 1..32),

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/files/TextFileReader.hpp"
 #include "core/spec/SettingBounds.hpp"
@@ -102,6 +103,7 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
     return false;
   HidMouseDecoder decoder;
   if (!decoder.build(descriptor, error)) return false;
+  size_t saturated = 0;
   for (const HidRecordedEvent& event : recording.events) {
     HidMouseDelta delta;
     if (!decoder.decode(event.bytes.data(), event.bytes.size(), delta)) {
@@ -114,7 +116,17 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
     timed.report.dxCounts = delta.dxCounts;
     timed.report.dyCounts = delta.dyCounts;
     timed.report.buttons = delta.buttons;
+    if (delta.saturated) {
+      timed.report.flags |= kSaturated;
+      ++saturated;
+    }
     out.push_back(timed);
+  }
+  if (saturated > 0 && warning) {
+    if (!warning->empty()) *warning += "; ";
+    *warning += std::to_string(saturated) + " of " + std::to_string(out.size()) +
+                " reports at their field's limit (flagged saturated: the mouse moved at least that far, the "
+                "excess is lost; a higher report rate or a lower resolution keeps it)";
   }
   return true;
 }

@@ -55,10 +55,11 @@ class ReplayBackend : public MouseBackend {
 
 // The reports of a file, kf-session or hid-recorder (told apart by their first line).
 // `spec` becomes the session file's header spec for kf-session files and stays as given
-// for hid-recorder files. `skippedEvents` counts hid events that are not mouse reports.
+// for hid-recorder files. `skippedEvents` counts hid events that are not mouse reports; a hid
+// report with a delta at its field's logical limit carries kSaturated.
 // Missing, unreadable, empty, special (FIFO, device) files and directories are refused before
 // reading, each with its own message. `warning` receives what was loaded despite a problem
-// (a last line cut mid-way).
+// (a last line cut mid-way, saturated reports).
 bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<TimedReport>& out, std::string& error,
                        size_t* skippedEvents = nullptr, std::string* warning = nullptr);
 
