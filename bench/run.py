@@ -8,7 +8,8 @@ must hold python/ (scripts/env.sh sets it).
     scripts/bench.sh                              # scripts/setup.sh (install, build), then this
     /usr/bin/python3 bench/run.py                 # everything (about 7 minutes on 2 cores, build excluded)
     /usr/bin/python3 bench/run.py --only timing   # one part (repeatable): build, log, timing, spatial,
-                                                  # loudness, drift, reconstruction, e2e, rtload, scale
+                                                  # loudness, drift, reconstruction, report_rate, e2e,
+                                                  # rtload, scale
 
 Parts:
   log       bench/log_choice.cpp: the logarithm of equation (2), std::log10 against faster ones
@@ -21,6 +22,10 @@ Parts:
             `no drift: 10^9 samples ...` of build/tests/dsp_tests (the core alone, 10^9 samples)
   reconstruction  build/bench/kf_reconstruction_bench: FrictionMouseIn's modes (hold, linear,
             predictive) against the simulated puck's true trajectory: lag, RMS error, CPU
+  report_rate  build/bench/kf_report_rate_bench: the synthetic recordings of tests/data/hid (125 Hz
+            8-bit, 1 kHz 12-bit, 8 kHz 16-bit, one known trajectory) replayed through FrictionMouseIn's
+            modes against that trajectory (position error, lag, saturated reports), and the
+            simulated mouse at 125 Hz .. 8 kHz
   e2e       realtime: scsynth on `jackd -d dummy` (48 kHz, period 64), a FrictionPilot on
             FrictionDevice.sim for 10 s (three times), then kfStatus: loop period, report-to-UGen
             and force-to-magnet latencies

@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import goals, realtime, spatial, timing
+from . import goals, realtime, report_rate, spatial, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -153,6 +153,12 @@ def reconstruction_section(rc, build_dir):
                   status="MET" if all(c["met"] for c in checks) else "NOT MET")
 
 
+def report_rate_section(rr, build_dir):
+    return render("report_rate", cmd=CMD, exe=f"{build_dir}/bench/kf_report_rate_bench",
+                  rate_khz=rr["sampleRateHz"] // 1000, block=rr["blockSize"], spec_rate_hz=rr["specRateHz"],
+                  recordings=report_rate.recordings_table(rr, table), simulated=report_rate.simulated_table(rr, table))
+
+
 def e2e_section(e2e):
     runs = e2e["runs"]
     rows = [(i + 1, key, f"{r[key]['p50_ms']:.3f}", f"{r[key]['p99_ms']:.3f}", f"{r[key]['max_ms']:.3f}", r[key]["n"])
@@ -229,6 +235,7 @@ def write(results, path, build_dir="build"):
                       ("drift", lambda: drift_section(get("drift"))),
                       ("drift_test", lambda: drift_test_section(get("drift_test"))),
                       ("reconstruction", lambda: reconstruction_section(get("reconstruction"), build_dir)),
+                      ("report_rate", lambda: report_rate_section(get("report_rate"), build_dir)),
                       ("e2e", lambda: e2e_section(get("e2e"))),
                       ("rtload", lambda: rtload_section(get("rtload"))),
                       ("scale", lambda: scale_section(get("scale"))),

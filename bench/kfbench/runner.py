@@ -7,8 +7,8 @@ import time
 
 from kfharness import nrt
 
-from . import build, drift, goals, loudness, native, plots, provenance, realtime, report, rtload, scores, spatial, \
-    timing
+from . import build, drift, goals, loudness, native, plots, provenance, realtime, report, report_rate, rtload, scores, \
+    spatial, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import summary_lines
 
@@ -94,6 +94,10 @@ def run_parts(bench, args, parts):
         log("reconstruction bench (3 runs)")
         results["reconstruction"] = native.run_reconstruction(bench)
         _print({"reconstruction": results["reconstruction"]})
+    if "report_rate" in parts:
+        log("report-rate bench: the synthetic recordings and the simulated mouse, 125 Hz .. 8 kHz")
+        results["report_rate"] = report_rate.run(bench)
+        _print({"report_rate": results["report_rate"]})
     if ("e2e" in parts or "rtload" in parts or "scale" in parts) and not (bench.extension / "plugins").exists():
         raise SystemExit(f"no extension folder at {bench.extension}: run scripts/setup.sh (or --only build)")
     if "e2e" in parts:
