@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "SyntheticRecordings.hpp"
+#include "hid/HidMouseDecoder.hpp"
+#include "hid/HidReportDescriptor.hpp"
+#include "recordings/HidRecorderFile.hpp"
 #include "recordings/ReplayBackend.hpp"
 
 using namespace kf;
@@ -27,6 +30,33 @@ SyntheticTrajectory loadTruth() {
   return truth;
 }
 }  // namespace
+
+TEST_CASE("synthetic recordings' descriptors: the mouse report found beside vendor, feature and consumer reports",
+          "[hid][recordings]") {
+  // (mouse report ID, input report bytes, reports of other kinds or IDs the descriptor declares)
+  const struct {
+    uint8_t mouseId;
+    size_t bytes, otherFields;
+  } expected[] = {{0, 4, 0}, {2, 8, 5}, {1, 8, 3}};
+  for (size_t i = 0; i < kf::test::syntheticMice().size(); ++i) {
+    const SyntheticMouse& mouse = kf::test::syntheticMice()[i];
+    INFO(mouse.file);
+    HidRecording recording;
+    std::string error;
+    REQUIRE(readHidRecorderFile(dataPath(mouse.file), recording, error));
+    HidReportDescriptor descriptor;
+    REQUIRE(parseHidReportDescriptor(recording.descriptor.data(), recording.descriptor.size(), descriptor, error));
+    CHECK(descriptor.skippedItems == 0);
+    CHECK(descriptor.inputReportBytes(expected[i].mouseId) == expected[i].bytes);
+    size_t other = 0;
+    for (const HidField& field : descriptor.fields)
+      other += field.reportId != expected[i].mouseId || field.kind != HidField::Kind::kInput;
+    CHECK(other == expected[i].otherFields);
+    HidMouseDecoder decoder;
+    REQUIRE(decoder.build(descriptor, error));
+    CHECK(decoder.mouseReportIds() == std::vector<uint8_t>{expected[i].mouseId});
+  }
+}
 
 TEST_CASE("synthetic recordings: the replayed position follows the trajectory; saturation is flagged",
           "[hid][recordings]") {
