@@ -58,7 +58,7 @@ TEST_CASE("synthetic recordings' descriptors: the mouse report found beside vend
   }
 }
 
-TEST_CASE("synthetic recordings: the replayed position follows the trajectory; saturation is flagged",
+TEST_CASE("synthetic recordings: the replayed position follows the trajectory, saturation flagged where it lost",
           "[hid][recordings]") {
   const SyntheticTrajectory truth = loadTruth();
   for (const SyntheticMouse& mouse : kf::test::syntheticMice()) {
