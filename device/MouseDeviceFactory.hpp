@@ -17,8 +17,18 @@ enum class MouseBackendKind { kHidapi, kEvdev };
 // "hidapi" or "evdev" (anything else: false).
 bool mouseBackendKindFromName(const std::string& name, MouseBackendKind& out);
 
+// The backend a mouse opens with unless asked: evdev on Linux. It opens every mouse the udev
+// rule grants, wireless receivers' among them: the kernel (hid-logitech-dj, hid-generic) gives
+// each paired mouse an event node of its own, while its hidraw node sits on the receiver's
+// vendor interface with the paired keyboards', which the rule does not grant. hidapi elsewhere.
+#ifdef __linux__
+constexpr MouseBackendKind kDefaultMouseBackend = MouseBackendKind::kEvdev;
+#else
+constexpr MouseBackendKind kDefaultMouseBackend = MouseBackendKind::kHidapi;
+#endif
+
 struct MouseOpenOptions {
-  MouseBackendKind kind = MouseBackendKind::kHidapi;
+  MouseBackendKind kind = kDefaultMouseBackend;
   std::string which;  // MouseSelect's selector ("" the first mouse)
   bool grab = false;  // evdev: keep the desktop cursor still
 };

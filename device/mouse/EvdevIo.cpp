@@ -4,8 +4,11 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "mouse/MouseIo.hpp"
+#include "mouse/MouseSelect.hpp"
+#include "mouse/SysfsPath.hpp"
 
 #ifdef __linux__
 #include <dirent.h>
@@ -34,14 +37,31 @@ uint16_t readHex(const std::string& path) {
   return static_cast<uint16_t>(std::strtoul(readLine(path).c_str(), nullptr, 16));
 }
 
-// sysfs capability bitmaps: hex words, most significant first; bit 0 of the last word is code 0.
-bool hasRelXY(const std::string& bitmap) {
-  std::istringstream words(bitmap);
-  std::string word, last;
-  while (words >> word) last = word;
-  if (last.empty()) return false;
-  const unsigned long bits = std::strtoul(last.c_str(), nullptr, 16);
-  return (bits & (1ul << REL_X)) && (bits & (1ul << REL_Y));
+// A sysfs capability bitmap ("capabilities/rel", ".../key"): hex words of the kernel's long,
+// most significant first; bit 0 of the last word is code 0. As udev's input_id reads it.
+std::vector<unsigned long> readBitmap(const std::string& text) {
+  std::istringstream words(text);
+  std::vector<unsigned long> bits;
+  std::string word;
+  while (words >> word) bits.insert(bits.begin(), std::strtoul(word.c_str(), nullptr, 16));
+  return bits;
+}
+
+bool hasBit(const std::vector<unsigned long>& bits, int code) {
+  constexpr int kBitsPerWord = 8 * sizeof(unsigned long);
+  const size_t word = static_cast<size_t>(code / kBitsPerWord);
+  return word < bits.size() && (bits[word] >> (code % kBitsPerWord) & 1ul);
+}
+
+// Keys a keyboard has (udev's ID_INPUT_KEY: codes below BTN_MISC, and KEY_OK up to the
+// trigger-happy buttons), not a mouse's buttons (BTN_MISC .. BTN_GEAR_UP). A node with both is
+// never listed: reading it would read what is typed.
+bool reportsKeys(const std::vector<unsigned long>& keys) {
+  for (int code = KEY_ESC; code < BTN_MISC; ++code)
+    if (hasBit(keys, code)) return true;
+  for (int code = KEY_OK; code < BTN_TRIGGER_HAPPY; ++code)
+    if (hasBit(keys, code)) return true;
+  return false;
 }
 
 class RealEvdevHandle : public EvdevHandle {
@@ -70,6 +90,15 @@ class RealEvdevHandle : public EvdevHandle {
     if (::ioctl(fd_, EVIOCGID, &ids) < 0) return false;
     vendorId = ids.vendor;
     productId = ids.product;
+    return true;
+  }
+  bool buttonsDown(uint32_t& buttons) override {
+    constexpr size_t kBitsPerWord = 8 * sizeof(unsigned long);
+    unsigned long keys[(KEY_MAX + kBitsPerWord) / kBitsPerWord] = {};
+    if (::ioctl(fd_, EVIOCGKEY(sizeof(keys)), keys) < 0) return false;
+    buttons = 0;
+    for (int code = BTN_LEFT; code <= BTN_TASK; ++code)
+      if (keys[code / kBitsPerWord] >> (code % kBitsPerWord) & 1ul) buttons |= 1u << (code - BTN_LEFT);
     return true;
   }
   int read(EvdevEvent* out, int capacity, int timeoutMs, int* errnoOut) override {
@@ -115,16 +144,22 @@ class RealEvdevApi : public EvdevApi {
       const std::string node = entry->d_name;
       if (node.rfind("event", 0) != 0) continue;
       const std::string sys = "/sys/class/input/" + node + "/device/";
-      if (!hasRelXY(readLine(sys + "capabilities/rel"))) continue;
+      const std::vector<unsigned long> rel = readBitmap(readLine(sys + "capabilities/rel"));
+      if (!hasBit(rel, REL_X) || !hasBit(rel, REL_Y)) continue;
+      if (reportsKeys(readBitmap(readLine(sys + "capabilities/key")))) continue;
       MouseInfo info;
       info.path = "/dev/input/" + node;
       info.product = readLine(sys + "name");
       info.vendorId = readHex(sys + "id/vendor");
       info.productId = readHex(sys + "id/product");
       info.serial = readLine(sys + "uniq");
+      const uint16_t bus = readHex(sys + "id/bustype");
+      info.external = bus == BUS_USB || bus == BUS_BLUETOOTH;  // a receiver's paired mouse is BUS_USB
+      info.busPath = stableBusPath(resolveSysfs("/sys/class/input/" + node + "/device"));
       out.push_back(std::move(info));
     }
     ::closedir(dir);
+    orderMice(out);
     return true;
   }
 

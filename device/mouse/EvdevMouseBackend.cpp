@@ -74,7 +74,18 @@ void EvdevMouseBackend::take(const EvdevEvent& event) {
     return;
   }
   if (dropping_) {
-    if (event.type == kEvSyn && event.code == kSynReport) dropping_ = false;
+    if (event.type == kEvSyn && event.code == kSynReport) {
+      dropping_ = false;
+      // A press or release may have been among the dropped events: the kernel's key state
+      // (EVIOCGKEY) says which buttons are down now (Documentation/input/event-codes.rst,
+      // SYN_DROPPED: re-read the state after the next SYN_REPORT). A change goes out at once.
+      uint32_t down = buttons_;
+      if (handle_->buttonsDown(down) && down != buttons_) {
+        buttons_ = down;
+        packetHasData_ = true;
+        emitPacket(event.timeS);
+      }
+    }
     return;
   }
   if (event.type == kEvRel && (event.code == kRelX || event.code == kRelY)) {
@@ -86,20 +97,24 @@ void EvdevMouseBackend::take(const EvdevEvent& event) {
     buttons_ = event.value ? buttons_ | bit : buttons_ & ~bit;
     packetHasData_ = true;
   } else if (event.type == kEvSyn && event.code == kSynReport) {
-    if (packetHasData_) {
-      MouseReport report;
-      report.deviceTimeS = (kernelTimestamps_ ? event.timeS : monotonicNowS()) - originS();
-      report.dxCounts = dx_;
-      report.dyCounts = dy_;
-      report.buttons = buttons_;
-      if (packetSaturated_) report.flags |= kSaturated;
-      if (afterLoss_) report.flags |= kAfterLoss;
-      afterLoss_ = false;
-      emit(report);
-    }
-    dx_ = dy_ = 0;
-    packetHasData_ = packetSaturated_ = false;
+    emitPacket(event.timeS);
   }
+}
+
+void EvdevMouseBackend::emitPacket(double kernelTimeS) {
+  if (packetHasData_) {
+    MouseReport report;
+    report.deviceTimeS = (kernelTimestamps_ ? kernelTimeS : monotonicNowS()) - originS();
+    report.dxCounts = dx_;
+    report.dyCounts = dy_;
+    report.buttons = buttons_;
+    if (packetSaturated_) report.flags |= kSaturated;
+    if (afterLoss_) report.flags |= kAfterLoss;
+    afterLoss_ = false;
+    emit(report);
+  }
+  dx_ = dy_ = 0;
+  packetHasData_ = packetSaturated_ = false;
 }
 
 int EvdevMouseBackend::readSome(int timeoutMs) {

@@ -2,7 +2,8 @@
 // timestamps (EVIOCSCLOCKID to CLOCK_MONOTONIC), taken when the USB report came in, so the
 // reader thread's wake-up jitter does not reach them; EVIOCGRAB on request keeps the desktop
 // cursor still. A full kernel queue shows as SYN_DROPPED: the events up to the next
-// SYN_REPORT are dropped, a loss is counted and the next report flagged.
+// SYN_REPORT are dropped, a loss is counted and the next report flagged; the buttons are then
+// read back from the kernel (EVIOCGKEY), since a press or release may have been dropped.
 #pragma once
 
 #include <atomic>
@@ -34,6 +35,7 @@ class EvdevMouseBackend : public RealMouseBackend {
   EvdevMouseBackend(std::shared_ptr<EvdevApi> api, bool grab) : api_(std::move(api)), grab_(grab) {}
   bool openInfo(const MouseInfo& info, std::string& error, OpenFailure& why) override;
   void take(const EvdevEvent& event);
+  void emitPacket(double kernelTimeS);  // the packet assembled so far, if it has anything
 
   std::shared_ptr<EvdevApi> api_;
   std::unique_ptr<EvdevHandle> handle_;

@@ -1,6 +1,7 @@
 // The real HidApi: hidapi over hidraw. Report descriptors: hid_get_report_descriptor where
 // hidapi has it (0.14+); on Linux with older hidapi (Debian's 0.13) from sysfs, or the hidraw
-// node's HIDIOCGRDESC ioctl when sysfs is not there.
+// node's HIDIOCGRDESC ioctl when sysfs is not there. Enumeration reads the descriptor from
+// sysfs too (anyone may), to put the interfaces whose reports carry X and Y first.
 #include <hidapi/hidapi.h>
 
 #include <cerrno>
@@ -10,7 +11,10 @@
 #include <iterator>
 #include <mutex>
 
+#include "hid/HidReportDescriptor.hpp"
 #include "mouse/MouseIo.hpp"
+#include "mouse/MouseSelect.hpp"
+#include "mouse/SysfsPath.hpp"
 
 #ifdef __linux__
 #include <fcntl.h>
@@ -41,17 +45,37 @@ OpenFailure classifyOpenFailure(const std::string& path) {
   return OpenFailure::kOther;
 }
 
-#if HID_API_VERSION < HID_API_MAKE_VERSION(0, 14, 0)
 #ifdef __linux__
+std::string hidrawNode(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
+
 // /dev/hidrawN -> /sys/class/hidraw/hidrawN/device/report_descriptor (readable by anyone).
 bool readSysfsDescriptor(const std::string& path, std::vector<uint8_t>& out) {
-  const std::string node = path.substr(path.find_last_of('/') + 1);
-  std::ifstream in("/sys/class/hidraw/" + node + "/device/report_descriptor", std::ios::binary);
+  std::ifstream in("/sys/class/hidraw/" + hidrawNode(path) + "/device/report_descriptor", std::ios::binary);
   if (!in) return false;
   out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   return !out.empty();
 }
 
+// Whether the node's reports carry relative X and Y: true when its descriptor cannot be read
+// or parsed (unknown is not held against it).
+bool reportsXY(const std::string& path) {
+  std::vector<uint8_t> bytes;
+  HidReportDescriptor descriptor;
+  std::string error;
+  if (!readSysfsDescriptor(path, bytes) || !parseHidReportDescriptor(bytes.data(), bytes.size(), descriptor, error))
+    return true;
+  bool x = false, y = false;
+  for (const HidField& field : descriptor.fields) {
+    if (field.kind != HidField::Kind::kInput || !field.isVariable() || !field.isRelative()) continue;
+    for (uint32_t i = 0; i < field.count; ++i) {
+      x = x || field.usageOfElement(i) == hidUsage(kHidPageGenericDesktop, 0x30);
+      y = y || field.usageOfElement(i) == hidUsage(kHidPageGenericDesktop, 0x31);
+    }
+  }
+  return x && y;
+}
+
+#if HID_API_VERSION < HID_API_MAKE_VERSION(0, 14, 0)
 bool readIoctlDescriptor(const std::string& path, std::vector<uint8_t>& out, std::string& error) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
@@ -112,6 +136,7 @@ class RealHidApi : public HidApi {
  public:
   bool enumerateMice(std::vector<MouseInfo>& out, std::string& error) override {
     out.clear();
+    std::lock_guard<std::mutex> lock(globalState_);
     if (!init(error)) return false;
     hid_device_info* list = hid_enumerate(0, 0);
     for (hid_device_info* d = list; d != nullptr; d = d->next) {
@@ -126,14 +151,21 @@ class RealHidApi : public HidApi {
       info.interfaceNumber = d->interface_number;
       info.usagePage = d->usage_page;
       info.usage = d->usage;
+      info.external = d->bus_type == HID_API_BUS_USB || d->bus_type == HID_API_BUS_BLUETOOTH;
+#ifdef __linux__
+      info.busPath = stableBusPath(resolveSysfs("/sys/class/hidraw/" + hidrawNode(info.path) + "/device"));
+      info.hasXY = reportsXY(info.path);
+#endif
       out.push_back(std::move(info));
     }
     hid_free_enumeration(list);
+    orderMice(out);
     return true;
   }
 
   std::unique_ptr<HidHandle> openPath(const std::string& path, std::string& error, OpenFailure& why) override {
     why = OpenFailure::kNone;
+    std::lock_guard<std::mutex> lock(globalState_);
     if (!init(error)) {
       why = OpenFailure::kOther;
       return nullptr;
@@ -141,6 +173,8 @@ class RealHidApi : public HidApi {
     hid_device* device = hid_open_path(path.c_str());
     if (device == nullptr) {
       why = classifyOpenFailure(path);
+      // hid_error(NULL) is hidapi's one global string, replaced by every failing call: read
+      // under the lock, before another thread's open or enumeration frees it.
       error = why == OpenFailure::kPermission ? permissionFix(path) : path + ": " + narrow(hid_error(nullptr));
       return nullptr;
     }
@@ -148,6 +182,12 @@ class RealHidApi : public HidApi {
   }
 
  private:
+  // hidapi keeps global state (the init flag, the global error string that hid_enumerate and
+  // hid_open_path replace and free) with no lock of its own: the reader threads' re-opens and
+  // the commands' listing and opening take turns here. Reads, closes and a device's own error
+  // string touch only that device and its reader thread.
+  std::mutex globalState_;
+
   bool init(std::string& error) {
     std::call_once(initOnce_, [this] { initOk_ = hid_init() == 0; });
     if (!initOk_) error = "hid_init failed: " + narrow(hid_error(nullptr));

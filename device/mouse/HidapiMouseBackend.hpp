@@ -1,7 +1,9 @@
 // HidapiMouseBackend: any USB/Bluetooth HID mouse through hidapi. Reports are decoded through
 // the device's own report descriptor (never the boot layout) and stamped on arrival with the
-// monotonic clock. The kernel keeps at most 64 reports per hidraw reader and drops new ones
-// when full, so a read that finds a full queue counts a loss and flags the next report.
+// monotonic clock. The kernel keeps at most 63 reports per hidraw reader and drops new ones
+// when full, so a read that finds a full queue counts a loss and flags the next report. hidraw
+// says nothing when it drops: a full queue may also be 63 reports that all fit, so the count
+// is an estimate (kfStatus says so).
 #pragma once
 
 #include <memory>
@@ -14,7 +16,9 @@ namespace kf {
 
 class HidapiMouseBackend : public RealMouseBackend {
  public:
-  static constexpr int kKernelQueueReports = 64;  // hidraw's HIDRAW_BUFFER_SIZE
+  // linux/drivers/hid/hidraw.c keeps a ring of HIDRAW_BUFFER_SIZE (64) slots per reader and
+  // drops a report when the slot after the head is the tail: one slot stays empty, 63 hold.
+  static constexpr int kKernelQueueReports = 63;
 
   // Enumerates, selects (MouseSelect's `which`), opens, reads the descriptor, starts the
   // reader (scheduled as `thread` asks). Null with a message (and why) on failure.
@@ -23,6 +27,7 @@ class HidapiMouseBackend : public RealMouseBackend {
                                                   const ThreadRequest& thread = {});
   ~HidapiMouseBackend() override { stop(); }
   std::string kindName() const override { return "hidapi"; }
+  bool lossesEstimated() const override { return true; }
 
  protected:
   int readSome(int timeoutMs) override;

@@ -15,13 +15,21 @@ namespace kf {
 // Why an open failed, so the caller can tell the user what to do.
 enum class OpenFailure { kNone, kPermission, kNotFound, kOther };
 
-// One mouse a backend could open (usage page 1, usage 2 for hidapi; REL_X and REL_Y for evdev).
+// One mouse a backend could open (usage page 1, usage 2 for hidapi; REL_X and REL_Y and no
+// keyboard keys for evdev).
 struct MouseInfo {
   std::string path;  // hidapi path (/dev/hidrawN on Linux) or /dev/input/eventN
   uint16_t vendorId = 0, productId = 0;
   std::string serial, manufacturer, product;
   int interfaceNumber = -1;
   uint16_t usagePage = 0, usage = 0;
+  // Where it is plugged in: its sysfs device path without the numbers the kernel hands out
+  // anew at each plug-in (HID instance, input number), e.g. "pci0000:00/0000:00:14.0/usb1/1-2/
+  // 1-2:1.0/0003:046D:C077". The same mouse in the same port (and interface, and for a
+  // receiver the same paired device) has the same busPath after a replug. Empty: unknown.
+  std::string busPath;
+  bool external = true;  // USB or Bluetooth; false: built in (a trackpoint or touchpad: PS/2, I2C, SMBus)
+  bool hasXY = true;     // its reports carry relative X and Y (hidapi: from the report descriptor)
 };
 
 // --- hidapi -------------------------------------------------------------------------------
@@ -39,14 +47,16 @@ class HidHandle {
 class HidApi {
  public:
   virtual ~HidApi() = default;
-  // Mice only (usage page 1, usage 2). False with a message when enumeration itself failed;
-  // finding none is true with an empty list.
+  // Mice only (usage page 1, usage 2), in orderMice's order. False with a message when
+  // enumeration itself failed; finding none is true with an empty list.
   virtual bool enumerateMice(std::vector<MouseInfo>& out, std::string& error) = 0;
   // Null with a message and a reason on failure.
   virtual std::unique_ptr<HidHandle> openPath(const std::string& path, std::string& error, OpenFailure& why) = 0;
 };
 
-// hidapi (hidraw backend on Linux). hid_init once per process, on first use.
+// hidapi (hidraw backend on Linux). hid_init once per process, on first use. Its calls that
+// touch hidapi's global state (hid_init, hid_enumerate, hid_open_path and the global error
+// string) are serialised by one mutex: the reader threads re-open while commands list and open.
 std::shared_ptr<HidApi> realHidApi();
 
 // --- evdev --------------------------------------------------------------------------------
@@ -65,6 +75,8 @@ class EvdevHandle {
   virtual bool grab(bool on, std::string& error) = 0;            // EVIOCGRAB
   virtual std::string name() = 0;                                // EVIOCGNAME
   virtual bool id(uint16_t& vendorId, uint16_t& productId) = 0;  // EVIOCGID
+  // EVIOCGKEY: which of BTN_LEFT .. BTN_TASK are down now (bit i = button i + 1); false on error.
+  virtual bool buttonsDown(uint32_t& buttons) = 0;
   // Waits up to timeoutMs for events and reads whole input_events: how many (> 0), 0 on
   // timeout, -1 with *errnoOut set (ENODEV: unplugged).
   virtual int read(EvdevEvent* out, int capacity, int timeoutMs, int* errnoOut) = 0;
@@ -73,7 +85,8 @@ class EvdevHandle {
 class EvdevApi {
  public:
   virtual ~EvdevApi() = default;
-  // Nodes whose capabilities have REL_X and REL_Y (from sysfs: needs no permission).
+  // Nodes whose capabilities have REL_X and REL_Y and no keyboard keys (from sysfs: needs no
+  // permission), in orderMice's order.
   virtual bool enumerateMice(std::vector<MouseInfo>& out, std::string& error) = 0;
   virtual std::unique_ptr<EvdevHandle> open(const std::string& path, std::string& error, OpenFailure& why) = 0;
 };

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <initializer_list>
 #include <locale>
 #include <sstream>
 
@@ -26,6 +27,17 @@ bool parsePositive(const std::string& text, double& out) {
   return true;
 }
 
+// One of two whole numbers ("0"/"1", "-1"/"1").
+template <typename T>
+bool parseChoice(const std::string& text, std::initializer_list<int> allowed, T& out) {
+  for (int choice : allowed)
+    if (text == std::to_string(choice)) {
+      out = static_cast<T>(choice);
+      return true;
+    }
+  return false;
+}
+
 bool parseHexId(const std::string& text, uint16_t& out) {
   char* end = nullptr;
   const unsigned long value = std::strtoul(text.c_str(), &end, 16);
@@ -46,9 +58,13 @@ double countMmFromCpi(double cpi) { return std::isfinite(cpi) && cpi > 0.0 ? 25.
 double MouseProfile::countMm() const { return std::isfinite(countMmX) ? countMmX : countMmFromCpi(cpi); }
 
 bool MouseProfile::applyTo(DeviceSpec& spec) const {
+  spec.swapXY = swapXY ? 1.0 : 0.0;
+  spec.signX = signX;
+  spec.signY = signY;
   const double mm = countMm();
   if (!std::isfinite(mm)) return false;
   spec.countMm = mm;
+  spec.countMmY = std::isfinite(countMmY) ? countMmY : 0.0;  // 0: as x (cpi is the same on both)
   if (std::isfinite(updateRateHz)) spec.updateRateHz = updateRateHz;
   return true;
 }
@@ -74,6 +90,7 @@ bool writeMouseProfile(const std::string& path, const MouseProfile& p, std::stri
   number("countMmX", p.countMmX);
   number("countMmY", p.countMmY);
   number("updateRateHz", p.updateRateHz);
+  out << "swapXY = " << (p.swapXY ? 1 : 0) << "\nsignX = " << p.signX << "\nsignY = " << p.signY << "\n";
   if (!out) error = "cannot write " + path;
   return static_cast<bool>(out);
 }
@@ -117,6 +134,12 @@ bool readMouseProfile(const std::string& path, MouseProfile& out, std::string& e
       ok = parsePositive(value, out.countMmY);
     else if (key == "updateRateHz")
       ok = parsePositive(value, out.updateRateHz);
+    else if (key == "swapXY")
+      ok = parseChoice(value, {0, 1}, out.swapXY);
+    else if (key == "signX")
+      ok = parseChoice(value, {-1, 1}, out.signX);
+    else if (key == "signY")
+      ok = parseChoice(value, {-1, 1}, out.signY);
     if (!ok) return fail(key + " = '" + value + "' is not a valid value");
   }
   return true;

@@ -1,6 +1,7 @@
 // MouseProfile: what one mouse on one surface needs to report millimetres — the count size of
-// each axis, measured from a stroke of known length, or the maker's CPI as a starting value —
-// kept per device in a small "key = value" text file:
+// each axis, measured from a stroke of known length, or the maker's CPI as a starting value,
+// and how the mouse sits in the puck (swap and signs of its axes) — kept per device in a small
+// "key = value" text file (docs/mouse-profile-format.md):
 //
 //   # kf-mouse-profile 1
 //   name = Genius Gila Gaming Mouse
@@ -11,6 +12,9 @@
 //   cpi = 1200
 //   countMmX = 0.02108
 //   countMmY = 0.02131
+//   swapXY = 0
+//   signX = 1
+//   signY = -1
 //   updateRateHz = 500
 //
 // Unknown keys are kept out of the way (ignored), so newer files still load.
@@ -35,13 +39,18 @@ struct MouseProfile {
   std::string name, serial, surface;
   uint16_t vendorId = 0, productId = 0;
   double cpi = kUnset;
+  // Along the surface's x and y (after the swap): what a stroke along each measures.
   double countMmX = kUnset, countMmY = kUnset;
   double updateRateHz = kUnset;
+  // The surface's axes from the mouse's: swapXY 1 exchanges x and y, then signX, signY -1
+  // reverse one (DeviceSpec::countsToMm).
+  bool swapXY = false;
+  int signX = 1, signY = 1;
 
   // countMmX if measured, else from cpi; NaN if neither.
   double countMm() const;
-  // Sets the spec's countMm (and updateRateHz) from what the profile has; false when it has
-  // no count size.
+  // Sets the spec's countMm, countMmY (and updateRateHz) and its axes from what the profile
+  // has; false (the axes still set) when it has no count size.
   bool applyTo(DeviceSpec& spec) const;
 };
 

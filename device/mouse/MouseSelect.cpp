@@ -1,8 +1,10 @@
 #include "mouse/MouseSelect.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <tuple>
 
 namespace kf {
 
@@ -33,7 +35,16 @@ std::string listOf(const std::vector<MouseInfo>& mice) {
 
 }  // namespace
 
-bool selectMouse(const std::vector<MouseInfo>& mice, const std::string& which, MouseInfo& out, std::string& error) {
+void orderMice(std::vector<MouseInfo>& mice) {
+  auto key = [](const MouseInfo& m) {
+    // An unknown bus path sorts after every known one.
+    return std::make_tuple(!m.external, !m.hasXY, m.busPath.empty(), m.busPath, m.interfaceNumber, m.path);
+  };
+  std::stable_sort(mice.begin(), mice.end(), [&](const MouseInfo& a, const MouseInfo& b) { return key(a) < key(b); });
+}
+
+bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInfo& out, std::string& error) {
+  orderMice(mice);
   if (which.empty() || which == "first") {
     if (mice.empty()) {
       error = "no mouse found: plug one in (and see the udev rule if it is there but not listed)";
@@ -57,23 +68,27 @@ bool selectMouse(const std::vector<MouseInfo>& mice, const std::string& which, M
         out = info;
         return true;
       }
-    out = MouseInfo{};
-    out.path = which;
-    return true;
-  }
-  const size_t colon = which.find(':');
-  const size_t second = colon == std::string::npos ? std::string::npos : which.find(':', colon + 1);
-  uint16_t vendorId = 0, productId = 0;
-  if (colon == std::string::npos || !parseHexId(which.substr(0, colon), vendorId) ||
-      !parseHexId(which.substr(colon + 1, second == std::string::npos ? std::string::npos : second - colon - 1),
-                  productId)) {
-    error =
-        "cannot read the mouse selector '" + which + "': give an index, a device path, or VVVV:PPPP[:serial] in hex";
+    // Not a mouse this backend lists: not there, or a keyboard's node, which is never opened.
+    error = which + " is not a mouse this backend lists; there are:" + listOf(mice);
     return false;
   }
-  const std::string serial = second == std::string::npos ? std::string() : which.substr(second + 1);
+  const size_t at = which.find('@');
+  const std::string port = at == std::string::npos ? std::string() : which.substr(at + 1);
+  const std::string ids = which.substr(0, at);
+  const size_t colon = ids.find(':');
+  const size_t second = colon == std::string::npos ? std::string::npos : ids.find(':', colon + 1);
+  uint16_t vendorId = 0, productId = 0;
+  if (colon == std::string::npos || !parseHexId(ids.substr(0, colon), vendorId) ||
+      !parseHexId(ids.substr(colon + 1, second == std::string::npos ? std::string::npos : second - colon - 1),
+                  productId)) {
+    error = "cannot read the mouse selector '" + which +
+            "': give an index, a device path, or VVVV:PPPP[:serial] or VVVV:PPPP@port in hex";
+    return false;
+  }
+  const std::string serial = second == std::string::npos ? std::string() : ids.substr(second + 1);
   for (const MouseInfo& info : mice)
-    if (info.vendorId == vendorId && info.productId == productId && (serial.empty() || info.serial == serial)) {
+    if (info.vendorId == vendorId && info.productId == productId && (serial.empty() || info.serial == serial) &&
+        (port.empty() || info.busPath == port)) {
       out = info;
       return true;
     }
@@ -85,6 +100,8 @@ std::string reselector(const MouseInfo& info) {
   if (info.vendorId == 0 && info.productId == 0) return info.path;
   char ids[16];
   std::snprintf(ids, sizeof(ids), "%04x:%04x", info.vendorId, info.productId);
+  // Two mice of one make (the same ids, often no serial) are told apart by their port.
+  if (!info.busPath.empty()) return std::string(ids) + "@" + info.busPath;
   return info.serial.empty() ? std::string(ids) : std::string(ids) + ":" + info.serial;
 }
 
@@ -95,6 +112,9 @@ std::string describeMouse(int index, const MouseInfo& info) {
   out += info.manufacturer.empty() ? info.product : info.manufacturer + " " + info.product;
   if (!info.serial.empty()) out += " (serial " + info.serial + ")";
   if (info.interfaceNumber >= 0) out += " interface " + std::to_string(info.interfaceNumber);
+  if (!info.external) out += " (built in)";
+  if (!info.hasXY) out += " (no X/Y in its reports)";
+  if (!info.busPath.empty()) out += " at " + info.busPath;
   return out;
 }
 

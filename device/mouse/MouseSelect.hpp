@@ -1,4 +1,5 @@
-// MouseSelect: which of the enumerated mice a user means.
+// MouseSelect: which of the enumerated mice a user means, in an order that does not change
+// from one enumeration to the next.
 #pragma once
 
 #include <string>
@@ -8,13 +9,23 @@
 
 namespace kf {
 
-// which: "" or "first" the first mouse; "N" (digits) the N-th (from 0) of the list; a path
-// ("/dev/hidraw3", "/dev/input/event5"); or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). A
-// path that is not in the list is still used (hidraw nodes of composite devices). False with
-// a message that lists what there is.
-bool selectMouse(const std::vector<MouseInfo>& mice, const std::string& which, MouseInfo& out, std::string& error);
+// The order mice are listed and "first" is taken in: external mice (USB, Bluetooth) before
+// built-in ones (a trackpoint or touchpad is never the first while a USB mouse is plugged in),
+// then interfaces whose reports carry X and Y before others (a vendor or keyboard interface
+// that also declares a mouse collection), then by bus path (the port), interface and node path.
+// Enumeration order (readdir, udev) is not stable; this is.
+void orderMice(std::vector<MouseInfo>& mice);
 
-// A selector that finds the same mouse again after a replug (its path may change).
+// which: "" or "first" the first mouse (orderMice's order); "N" (digits) the N-th (from 0) of
+// that order; a path listed ("/dev/hidraw3", "/dev/input/event5": a node that is not a listed
+// mouse, a keyboard's, is refused); "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids); or
+// "VVVV:PPPP@busPath": that device in that port and interface (what reselector gives). False
+// with a message that lists what there is.
+bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInfo& out, std::string& error);
+
+// A selector that finds the same mouse again after a replug (its node path may change): the
+// same ids in the same port and interface when the bus path is known, else the same ids (and
+// serial).
 std::string reselector(const MouseInfo& info);
 
 // "0: /dev/hidraw3 046d:c077 Logitech USB Optical Mouse (serial ..., interface 0)"

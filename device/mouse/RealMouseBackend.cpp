@@ -1,5 +1,8 @@
 #include "mouse/RealMouseBackend.hpp"
 
+#include <pthread.h>
+
+#include <csignal>
 #include <cstdio>
 
 #include "mouse/MouseSelect.hpp"
@@ -12,7 +15,7 @@ RealMouseBackend::~RealMouseBackend() { stop(); }
 
 bool RealMouseBackend::openSelected(const std::vector<MouseInfo>& mice, const std::string& which, std::string& error,
                                     OpenFailure* why, const ThreadRequest& thread) {
-  OpenFailure failure = OpenFailure::kOther;
+  OpenFailure failure = OpenFailure::kNotFound;  // no such mouse, unless the open says otherwise
   MouseInfo info;
   const bool opened = selectMouse(mice, which, info, error) && openInfo(info, error, failure);
   if (why) *why = opened ? OpenFailure::kNone : failure;
@@ -24,7 +27,17 @@ bool RealMouseBackend::openSelected(const std::vector<MouseInfo>& mice, const st
 void RealMouseBackend::startReader() {
   if (thread_.joinable()) return;
   state_.store(static_cast<int>(MouseState::kRunning), std::memory_order_release);
+  // The reader is born with every asynchronous signal blocked (a thread inherits its creator's
+  // mask), so no signal meant for the process (SIGINT, SIGCHLD, a profiler's SIGPROF) is ever
+  // handled on it: hid_read_timeout would return -1 from poll's EINTR, which reads as an
+  // unplug. The faults a thread causes itself stay unblocked, so a crash still reaches the
+  // exit handlers (host/ExitSafety) that drive the magnet off.
+  sigset_t blocked, previous;
+  sigfillset(&blocked);
+  for (int fault : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS}) sigdelset(&blocked, fault);
+  pthread_sigmask(SIG_BLOCK, &blocked, &previous);
   thread_ = std::thread([this] { threadMain(); });
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
 }
 
 void RealMouseBackend::stop() {
@@ -80,6 +93,7 @@ MouseCounters RealMouseBackend::counters() const {
   MouseCounters c;
   c.reports = reports_.load(std::memory_order_relaxed);
   c.lossEvents = lossEvents_.load(std::memory_order_relaxed);
+  c.lossesEstimated = lossesEstimated();
   c.saturated = saturated_.load(std::memory_order_relaxed);
   c.malformed = malformed_.load(std::memory_order_relaxed);
   c.queueOverflows = queue_.overflows();
@@ -118,13 +132,14 @@ std::string RealMouseBackend::describe() const {
                                                           : "stopped";
   char line[512];
   std::snprintf(line, sizeof(line),
-                "%s mouse %s (%04x:%04x %s): %s, reports %llu, measured rate %.1f Hz, losses %llu, "
+                "%s mouse %s (%04x:%04x %s): %s, reports %llu, measured rate %.1f Hz, losses %llu%s, "
                 "saturated %llu, malformed %llu, overflows %llu, unplugs %llu, re-opens %llu",
                 kindName().c_str(), mouse.path.c_str(), mouse.vendorId, mouse.productId, mouse.product.c_str(), state,
                 static_cast<unsigned long long>(c.reports), c.measuredRateHz,
-                static_cast<unsigned long long>(c.lossEvents), static_cast<unsigned long long>(c.saturated),
-                static_cast<unsigned long long>(c.malformed), static_cast<unsigned long long>(c.queueOverflows),
-                static_cast<unsigned long long>(c.unplugs), static_cast<unsigned long long>(c.reopens));
+                static_cast<unsigned long long>(c.lossEvents), c.lossesEstimated ? " (estimated: full queues)" : "",
+                static_cast<unsigned long long>(c.saturated), static_cast<unsigned long long>(c.malformed),
+                static_cast<unsigned long long>(c.queueOverflows), static_cast<unsigned long long>(c.unplugs),
+                static_cast<unsigned long long>(c.reopens));
   std::string out = line;
   const std::string error = lastError();
   if (!error.empty()) out += "; last error: " + error;

@@ -24,11 +24,12 @@ namespace kf {
 enum class MouseState : int { kRunning = 0, kUnplugged = 1, kStopped = 2 };
 
 struct MouseCounters {
-  uint64_t reports = 0;         // mouse reports passed on
-  uint64_t lossEvents = 0;      // times reports were lost (SYN_DROPPED, a full kernel queue)
-  uint64_t saturated = 0;       // reports with a delta at its field's limit (excess lost)
-  uint64_t malformed = 0;       // reads that were not a whole mouse report (short, other ID)
-  uint64_t queueOverflows = 0;  // reports the device thread did not take in time
+  uint64_t reports = 0;          // mouse reports passed on
+  uint64_t lossEvents = 0;       // times reports were lost (SYN_DROPPED, a full kernel queue)
+  bool lossesEstimated = false;  // hidraw: a full queue is taken for a loss (it may not be one)
+  uint64_t saturated = 0;        // reports with a delta at its field's limit (excess lost)
+  uint64_t malformed = 0;        // reads that were not a whole mouse report (short, other ID)
+  uint64_t queueOverflows = 0;   // reports the device thread did not take in time
   uint64_t unplugs = 0;
   uint64_t reopens = 0;
   double measuredRateHz = 0.0;  // 0 until enough reports (ReportRateEstimator)
@@ -67,6 +68,8 @@ class RealMouseBackend : public MouseBackend {
   std::string statusLine() const override { return describe(); }
   ThreadScheduling readerScheduling() const override { return readerScheduling_.load(); }
   virtual std::string kindName() const = 0;
+  // True when the kernel does not say it dropped reports and lossEvents is inferred.
+  virtual bool lossesEstimated() const { return false; }
   // The mouse open now (it may change at a re-open). Any non-realtime thread.
   MouseInfo info() const;
 

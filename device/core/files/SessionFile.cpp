@@ -33,6 +33,10 @@ const SpecField kSpecFields[] = {
     {"maxForceSlewNPerS", [](const DeviceSpec& s) { return s.maxForceSlewNPerS; }},
     {"watchdogS", [](const DeviceSpec& s) { return s.watchdogS; }},
     {"magnetLagS", [](const DeviceSpec& s) { return s.magnetLagS; }},
+    {"countMmY", [](const DeviceSpec& s) { return s.countMmY; }},  // the reports' counts are the mouse's
+    {"swapXY", [](const DeviceSpec& s) { return s.swapXY; }},
+    {"signX", [](const DeviceSpec& s) { return s.signX; }},
+    {"signY", [](const DeviceSpec& s) { return s.signY; }},
 };
 
 // strtod, unlike istream, reads back the "nan" and "inf" a requested force may hold.

@@ -26,6 +26,10 @@ constexpr Field kFields[] = {
     {"maxDriveLevel", &DeviceSpec::maxDriveLevel},
     {"heatTimeConstantS", &DeviceSpec::heatTimeConstantS},
     {"heatRatedDuty", &DeviceSpec::heatRatedDuty},
+    {"countMmY", &DeviceSpec::countMmY},
+    {"swapXY", &DeviceSpec::swapXY},
+    {"signX", &DeviceSpec::signX},
+    {"signY", &DeviceSpec::signY},
 };
 
 bool fail(std::string* error, std::string message) {
@@ -56,6 +60,8 @@ bool DeviceSpec::isValid(std::string* error) const {
   if (std::string message = checkSetting("maxCountsPerReport", maxCountsPerReport); !message.empty())
     return fail(error, message);
   if (minForceN > maxForceN) return fail(error, "minForceN is above maxForceN");
+  if (signX == 0.0 || signY == 0.0) return fail(error, "signX and signY are 1 or -1");
+  if (countMmY != 0.0 && countMmY < 1e-4) return fail(error, "countMmY is 0 (as countMm) or 0.0001..10 mm");
   // The watchdog must not trip between two frames that arrive on time.
   if (watchdogS < 2.0 * forceFramePeriodS) return fail(error, "watchdogS is shorter than two force frames");
   return true;

@@ -2,6 +2,7 @@
 // shared by the device thread, the simulator, record/replay and the UGens.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -28,12 +29,26 @@ struct DeviceSpec {
   double maxDriveLevel = paper::device::maxDriveLevel;
   double heatTimeConstantS = paper::device::heatTimeConstantS;
   double heatRatedDuty = paper::device::heatRatedDuty;
+  // The surface's axes from the mouse's (a mouse profile sets them): swapXY 1 takes the
+  // surface's x from the mouse's y and its y from the mouse's x; signX, signY -1 reverse an
+  // axis (after the swap); countMm and countMmY are the count sizes along the surface's x and
+  // y (countMmY 0: the same as x). Applied where counts become millimetres (countsToMm).
+  double countMmY = 0.0;
+  double swapXY = 0.0;
+  double signX = 1.0;
+  double signY = 1.0;
 
   // maxCounts * countMm * updateRate: 334 mm/s for the paper profile.
   double maxSpeedMmPerS() const { return maxCountsPerReport * countMm * updateRateHz; }
   // Audio is delayed by this much so sound and touch arrive together (paper, section 3).
   double audioDelayS() const { return tactileLatencyS - audioLatencyS; }
   double updatePeriodS() const { return 1.0 / updateRateHz; }
+  // The mouse's counts (x and y as it reports them) as millimetres along the surface's x and y.
+  void countsToMm(int64_t mouseXCounts, int64_t mouseYCounts, double& xMm, double& yMm) const {
+    const bool swap = swapXY != 0.0;
+    xMm = signX * countMm * static_cast<double>(swap ? mouseYCounts : mouseXCounts);
+    yMm = signY * (countMmY > 0.0 ? countMmY : countMm) * static_cast<double>(swap ? mouseXCounts : mouseYCounts);
+  }
 
   // Sets the field named `key` (the member name above) to `value`. Returns false, and
   // changes nothing, for an unknown key or a value outside the field's bounds

@@ -26,6 +26,10 @@ constexpr SettingBounds kBounds[] = {
     {"maxDriveLevel", 1e-3, 1.0, false, "of full-scale drive"},
     {"heatTimeConstantS", 0.01, 1e5, false, "s"},
     {"heatRatedDuty", 1e-3, 1.0, false, "of full-scale drive squared"},
+    {"countMmY", 0.0, 10.0, false, "mm"},  // 0: as countMm; else as countMm's bounds (DeviceSpec::isValid)
+    {"swapXY", 0.0, 1.0, true, ""},
+    {"signX", -1.0, 1.0, true, ""},  // -1 or 1 (DeviceSpec::isValid refuses 0)
+    {"signY", -1.0, 1.0, true, ""},
     // DeviceOptions: the device's threads, -1 auto, 0 normal scheduling, 1..98 SCHED_FIFO
     {"threadPriority", -1.0, 98.0, true, ""},
     // ReplayOptions

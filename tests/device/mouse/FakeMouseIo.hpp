@@ -2,14 +2,17 @@
 // real time, as the kernel would hand it to a reader, and fail as the real calls do:
 //  - reports become due at plug-in (the first open) + leadS + (recorded time - startS) +
 //    injected jitter, on the monotonic clock; a read blocks until one is due or its timeout passes (then 0);
-//  - the kernel's per-reader queue is bounded: hidraw keeps 64 reports and drops new ones
-//    when full; evdev keeps 64 events and, on overflow, throws the queue away and leaves
-//    SYN_DROPPED plus the newest event (drivers/input/evdev.c); a stall of the reader
+//  - the kernel's per-reader queue is bounded: hidraw's ring of 64 slots holds 63 reports and
+//    drops new ones when full (drivers/hid/hidraw.c); evdev keeps 64 events and, on overflow,
+//    throws the queue away and leaves SYN_DROPPED plus the newest event (drivers/input/evdev.c),
+//    and EVIOCGKEY answers the buttons down now; a stall of the reader
 //    (stallAtS / stallForS) lets it fill;
 //  - short reads: hid reports cut to a few bytes (shortReportEvery); evdev reads that return
 //    at most maxEventsPerRead events, splitting packets between reads;
 //  - unplug at unplugAtS: hid reads return -1, evdev reads -1 with ENODEV, and the device is
-//    gone from enumeration until replugAtS;
+//    gone from enumeration until replugAtS (then, hidapi, at replugPath if one is given);
+//  - other devices listed with it (`others`: a twin of the same make in another port, a
+//    built-in trackpoint), which cannot be opened;
 //  - EACCES: open fails with the permission message and OpenFailure::kPermission.
 // evdev events are derived from the reports: REL_X, REL_Y (when non-zero), BTN_* changes,
 // SYN_REPORT, all stamped with the report's due time in whole microseconds (as input_event).
@@ -49,6 +52,9 @@ struct FakeMouseScript {
   size_t kernelQueue = 64;
   bool denyAccess = false;  // EACCES on open
   std::string path = "/dev/hidraw7";
+  std::string replugPath;  // hidapi: its node after the replug ("" the same)
+  std::string busPath = "pci0000:00/0000:00:14.0/usb1/1-2/1-2:1.0/0003:0458:0138";
+  std::vector<MouseInfo> others;
 };
 
 // The timeline both fakes share: what is due when, from one plug-in time.
@@ -79,15 +85,22 @@ class FakeTimeline {
     const double waitS = sinceS - nowSincePlugS();
     if (waitS > 0) std::this_thread::sleep_for(std::chrono::duration<double>(waitS));
   }
-  // What enumeration lists while the mouse is plugged in.
+  // The hidraw node now: a replug may give the mouse another.
+  std::string hidPath() const {
+    const bool replugged = nowSincePlugS() >= script_.replugAtS && !script_.replugPath.empty();
+    return replugged ? script_.replugPath : script_.path;
+  }
+  // What enumeration lists: the others first (enumeration order is not the one to choose by),
+  // then the mouse while it is plugged in.
   bool enumerate(const std::string& path, std::vector<MouseInfo>& out) const {
-    out.clear();
+    out = script_.others;
     if (!present(nowSincePlugS())) return true;
     MouseInfo info;
     info.path = path;
     info.vendorId = static_cast<uint16_t>(script_.recording.vendorId);
     info.productId = static_cast<uint16_t>(script_.recording.productId);
     info.product = script_.recording.name;
+    info.busPath = script_.busPath;
     out.push_back(info);
     return true;
   }
@@ -196,7 +209,7 @@ class FakeHidHandle : public HidHandle {
   void refill(double nowS) {
     const FakeMouseScript& s = reader_.timeline().script();
     reader_.due(nowS, [&](const FakeTimeline::Due& due) {
-      if (queue_.size() >= s.kernelQueue) {  // hidraw: full, the new report is dropped
+      if (queue_.size() + 1 >= s.kernelQueue) {  // hidraw: the slot after the head is the tail, dropped
         ++drops_;
         return;
       }
@@ -218,12 +231,12 @@ class FakeHidApi : public HidApi {
  public:
   explicit FakeHidApi(FakeMouseScript script) : timeline(std::make_shared<FakeTimeline>(std::move(script))) {}
   bool enumerateMice(std::vector<MouseInfo>& out, std::string&) override {
-    timeline->enumerate(timeline->script().path, out);
+    timeline->enumerate(timeline->hidPath(), out);
     for (MouseInfo& info : out) info.interfaceNumber = 0, info.usagePage = 1, info.usage = 2;
     return true;
   }
   std::unique_ptr<HidHandle> openPath(const std::string& path, std::string& error, OpenFailure& why) override {
-    if (!timeline->open(path, timeline->script().path, error, why)) return nullptr;
+    if (!timeline->open(path, timeline->hidPath(), error, why)) return nullptr;
     return std::make_unique<FakeHidHandle>(timeline);
   }
   std::shared_ptr<FakeTimeline> timeline;
@@ -243,6 +256,12 @@ class FakeEvdevHandle : public EvdevHandle {
     return true;
   }
   std::string name() override { return reader_.timeline().script().recording.name; }
+  bool buttonsDown(uint32_t& buttons) override {  // the kernel's state: the latest report's
+    buttons = buttons_;
+    ++keyStateReads;
+    return true;
+  }
+  int keyStateReads = 0;
   bool id(uint16_t& vendorId, uint16_t& productId) override {
     vendorId = static_cast<uint16_t>(reader_.timeline().script().recording.vendorId);
     productId = static_cast<uint16_t>(reader_.timeline().script().recording.productId);

@@ -242,7 +242,7 @@ TEST_CASE("hidapi backend: a full kernel queue is counted as a loss and flags th
   script.startS = 6.0;
   script.endS = 7.0;
   script.kernelQueue = 64;  // the kernel's own: this test is about loss
-  script.stallAtS = 0.72;   // the reader is held 300 ms: ~110 reports come, 64 fit
+  script.stallAtS = 0.72;   // the reader is held 300 ms: ~110 reports come, 63 fit
   script.stallForS = 0.3;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
@@ -362,6 +362,7 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   MouseOpenOptions options;
+  options.kind = MouseBackendKind::kHidapi;
   options.which = "0458:0138";
   auto device = openMouseDevice(options, DeviceSpec{}, error, nullptr, api);
   REQUIRE(device);
@@ -380,30 +381,6 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   CHECK(device->mouseBackend().statusLine().find("hidapi mouse /dev/hidraw7") != std::string::npos);
 }
 
-TEST_CASE("mouse selectors: first, index, path, VID:PID(:serial), and clear errors", "[mouse]") {
-  std::vector<MouseInfo> mice(2);
-  mice[0].path = "/dev/hidraw1", mice[0].vendorId = 0x046d, mice[0].productId = 0xc077;
-  mice[1].path = "/dev/hidraw4", mice[1].vendorId = 0x0458, mice[1].productId = 0x0138, mice[1].serial = "A1";
-  MouseInfo out;
-  std::string error;
-  REQUIRE(selectMouse(mice, "", out, error));
-  CHECK(out.path == "/dev/hidraw1");
-  REQUIRE(selectMouse(mice, "1", out, error));
-  CHECK(out.path == "/dev/hidraw4");
-  REQUIRE(selectMouse(mice, "458:138", out, error));
-  CHECK(out.path == "/dev/hidraw4");
-  REQUIRE(selectMouse(mice, "0458:0138:A1", out, error));
-  CHECK_FALSE(selectMouse(mice, "0458:0138:B2", out, error));
-  CHECK(error.find("/dev/hidraw4") != std::string::npos);  // lists what there is
-  CHECK_FALSE(selectMouse(mice, "2", out, error));
-  CHECK_FALSE(selectMouse(mice, "mouse", out, error));
-  REQUIRE(selectMouse(mice, "/dev/hidraw9", out, error));  // not listed, still tried
-  CHECK(out.path == "/dev/hidraw9");
-  CHECK_FALSE(selectMouse({}, "", out, error));
-  CHECK(error.find("no mouse found") != std::string::npos);
-  CHECK(reselector(mice[1]) == "0458:0138:A1");
-}
-
 TEST_CASE("the real hidapi and evdev enumerate this machine and cope with finding no mouse", "[mouse][real]") {
   for (MouseBackendKind kind : {MouseBackendKind::kHidapi, MouseBackendKind::kEvdev}) {
     std::vector<std::string> lines;
@@ -419,7 +396,7 @@ TEST_CASE("the real hidapi and evdev enumerate this machine and cope with findin
     }
     WARN((kind == MouseBackendKind::kHidapi ? "hidapi" : "evdev") << " finds " << lines.size() << " mice");
   }
-  // A node that is not there: not found, named.
+  // A node that is not there (not listed): not found, named.
   std::string error;
   OpenFailure why = OpenFailure::kNone;
   MouseOpenOptions options;
@@ -437,7 +414,9 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   std::string error;
   DeviceSpec spec;
   spec.countMm = 0.0212;
-  auto device = openMouseDevice(MouseOpenOptions{}, spec, error, nullptr, api);
+  MouseOpenOptions options;
+  options.kind = MouseBackendKind::kHidapi;
+  auto device = openMouseDevice(options, spec, error, nullptr, api);
   REQUIRE(device);
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
   REQUIRE(device->startRecording(path, error));
