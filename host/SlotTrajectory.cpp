@@ -16,7 +16,7 @@ void addEntries(TrajectoryReconstructor& trajectory, const PositionEntry* entrie
 }
 
 void SlotTrajectory::reset(const DeviceSpec& spec) {
-  countMm_ = spec.countMm;
+  axes_ = spec;
   updateRateHz_ = spec.updateRateHz;
   valid_ = false;
   lastBlock_ = -1;
@@ -77,8 +77,9 @@ void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* repor
     else if (continuous)
       timeS = clock_.map(r.deviceTimeS, clock.startS);
     // From absolute counts: reports lost on the way (a full queue) still count.
-    add(PositionEntry{timeS, countsToMm(r.xCounts - xCounts_), countsToMm(r.yCounts - yCounts_), r.flags, false,
-                      r.deviceTimeS});
+    double dxMm = 0.0, dyMm = 0.0;
+    axes_.countsToMm(r.xCounts - xCounts_, r.yCounts - yCounts_, dxMm, dyMm);
+    add(PositionEntry{timeS, dxMm, dyMm, r.flags, false, r.deviceTimeS});
     xCounts_ = r.xCounts;
     yCounts_ = r.yCounts;
   }

@@ -75,17 +75,22 @@ class SlotTrajectory {
 
   // The position of the latest report (mm, re-basing applied) and its speed (the report's
   // displacement over one update interval), for status and sclang.
-  double reportedXMm() const { return countsToMm(xCounts_) + offsetXMm_; }
-  double reportedYMm() const { return countsToMm(yCounts_) + offsetYMm_; }
+  double reportedXMm() const { return mm(xCounts_, yCounts_, true) + offsetXMm_; }
+  double reportedYMm() const { return mm(xCounts_, yCounts_, false) + offsetYMm_; }
   int64_t lastBlock() const { return lastBlock_; }
   // Reports handed to takeBlock since reset (a backlog beyond the buffer counts as one).
   int64_t reportsTaken() const { return reportsTaken_; }
 
  private:
   static int modeIndex(TrajectoryMode mode) { return static_cast<int>(mode); }
-  double countsToMm(int64_t counts) const { return static_cast<double>(counts) * countMm_; }
+  // The mouse's counts on the surface's x (or y): count sizes, swap and signs of the spec.
+  double mm(int64_t xCounts, int64_t yCounts, bool x) const {
+    double xMm = 0.0, yMm = 0.0;
+    axes_.countsToMm(xCounts, yCounts, xMm, yMm);
+    return x ? xMm : yMm;
+  }
 
-  double countMm_ = 0.021;
+  DeviceSpec axes_;  // its countMm, countMmY, swapXY, signX, signY
   double updateRateHz_ = 125.0;
   bool valid_ = false;  // a block was taken since reset
   int64_t lastBlock_ = -1;

@@ -201,3 +201,25 @@ TEST_CASE("realtime: one clock mapping for the slot, so readers agree under arri
     }
   }
 }
+
+TEST_CASE("the slot turns the mouse's counts into the surface's mm with the spec's sizes, swap and signs") {
+  // A mouse turned a quarter in the puck (mouse +y is surface +x, mouse +x is surface -y),
+  // with different count sizes along the surface's two axes (a mouse profile's).
+  kf::DeviceSpec spec;
+  spec.countMm = 0.02;
+  spec.countMmY = 0.03;
+  spec.swapXY = 1;
+  spec.signY = -1;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  MouseReport reports[2];
+  reports[0].deviceTimeS = 0.0005, reports[0].xCounts = 100, reports[0].yCounts = 50;
+  reports[1].deviceTimeS = 0.0010, reports[1].xCounts = 110, reports[1].yCounts = 40;
+  slot.takeBlock(clockOf(0), reports, 0, true, 0.0);  // the first look: starts at 0
+  slot.takeBlock(clockOf(1), reports, 2, true, 0.0);
+  CHECK(slot.reportedXMm() == Approx(40 * 0.02));
+  CHECK(slot.reportedYMm() == Approx(-110 * 0.03));
+  REQUIRE(slot.numEntries() == 2);
+  CHECK(slot.entries()[1].dxMm == Approx(-10 * 0.02));  // the step of the second report
+  CHECK(slot.entries()[1].dyMm == Approx(-10 * 0.03));
+}
