@@ -3,10 +3,10 @@
 + FrictionDevice {
 
 	// which: nil (the first mouse), an index of listMice, a device path ("/dev/hidraw3",
-	// "/dev/input/event5") or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). backend: \hidapi or
-	// \evdev. profile: an Event of settings (e.g. (countMm: 0.0212)) or the path of a mouse
+	// "/dev/input/event5") or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). backend: \evdev (nil on
+	// Linux: it opens wireless receivers' mice too) or \hidapi (nil elsewhere). profile: an Event of settings (e.g. (countMm: 0.0212)) or the path of a mouse
 	// profile file (writeMouseProfile). grab: evdev only, keeps the desktop cursor still.
-	*mouse { |server, index = 0, which, backend = \hidapi, profile, grab = false|
+	*mouse { |server, index = 0, which, backend, profile, grab = false|
 		^this.new.prInitMouse(server, index, which, backend, profile, grab).prOpen
 	}
 
@@ -65,7 +65,8 @@
 		var file = File(path.standardizePath, "w");
 		if(file.isOpen.not) { Error("FrictionDevice.writeMouseProfile: cannot write %".format(path)).throw };
 		file.write("# kf-mouse-profile 1\n");
-		[\name, \vendorId, \productId, \serial, \surface, \cpi, \countMmX, \countMmY, \updateRateHz].do { |key|
+		[\name, \vendorId, \productId, \serial, \surface, \cpi, \countMmX, \countMmY, \updateRateHz, \swapXY, \signX,
+			\signY].do { |key|
 			profile[key] !? { |value| file.write("% = %\n".format(key, value)) }
 		};
 		file.close;
@@ -83,8 +84,10 @@
 				if(equals.isNil) { Error("%:%: not 'key = value'".format(path, i + 1)).throw };
 				key = line.keep(equals).stripWhiteSpace.asSymbol;
 				value = line.drop(equals + 1).stripWhiteSpace;
-				profile[key] = if([\cpi, \countMmX, \countMmY, \updateRateHz].includes(key)) {
+				profile[key] = case { [\cpi, \countMmX, \countMmY, \updateRateHz].includes(key) } {
 					value.asFloat
+				} { [\swapXY, \signX, \signY].includes(key) } {
+					value.asInteger
 				} { value };
 			}
 		};
@@ -102,7 +105,7 @@
 
 	prInitMouse { |argServer, argIndex, which, backend, profile, grab|
 		var settings, profilePath;
-		backend = backend ? \hidapi;
+		backend = backend ?? { if(thisProcess.platform.name == \linux) { \evdev } { \hidapi } };
 		if([\hidapi, \evdev].includes(backend.asSymbol).not) {
 			Error("FrictionDevice.mouse: backend must be \\hidapi or \\evdev, got %".format(backend)).throw
 		};

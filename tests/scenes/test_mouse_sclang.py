@@ -23,8 +23,8 @@ def test_mouse_messages_and_specs():
     assert "KF-MSG [ /cmd, kfOpenMouse, 2, 0458:0138, evdev, , grab, 1, countMm, 0.02 ]" in out
     assert "KF-MOUSEMSG true" in out
     assert "KF-SPEC 0.02 317.5" in out  # 0.02 mm x 127 counts x 125 Hz
-    assert "KF-FIRST [ /cmd, kfOpenMouse, 0, , hidapi,  ]" in out
-    assert "KF-INDEX [ /cmd, kfOpenMouse, 1, 3, hidapi,  ]" in out
+    assert "KF-FIRST [ /cmd, kfOpenMouse, 0, , evdev,  ]" in out  # Linux: evdev unless asked
+    assert "KF-INDEX [ /cmd, kfOpenMouse, 1, 3, evdev,  ]" in out
     assert "KF-REOPEN [ /cmd, kfReopenMouse, 2 ]" in out
     assert "KF-LIST [ /cmd, kfListMice, hidapi, /tmp/x ]" in out
     assert "KF-RECORD [ /cmd, kfRecord, 2, /tmp/m.txt ]" in out
