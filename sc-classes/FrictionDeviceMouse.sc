@@ -4,8 +4,9 @@
 
 	// which: nil (the first mouse), an index of listMice, a device path ("/dev/hidraw3",
 	// "/dev/input/event5") or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). backend: \evdev (nil on
-	// Linux: it opens wireless receivers' mice too) or \hidapi (nil elsewhere). profile: an Event of settings (e.g. (countMm: 0.0212)) or the path of a mouse
-	// profile file (writeMouseProfile). grab: evdev only, keeps the desktop cursor still.
+	// Linux: it opens wireless receivers' mice too) or \hidapi (nil elsewhere). profile: an Event
+	// of settings (e.g. (countMm: 0.0212)) or the path of a mouse profile file (writeMouseProfile).
+	// grab: evdev only, keeps the desktop cursor still.
 	*mouse { |server, index = 0, which, backend, profile, grab = false|
 		^this.new.prInitMouse(server, index, which, backend, profile, grab).prOpen
 	}
