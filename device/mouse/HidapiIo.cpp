@@ -11,7 +11,7 @@
 #include <iterator>
 #include <mutex>
 
-#include "hid/HidReportDescriptor.hpp"
+#include "mouse/DescriptorKind.hpp"
 #include "mouse/MouseIo.hpp"
 #include "mouse/MouseSelect.hpp"
 #include "mouse/SysfsPath.hpp"
@@ -54,25 +54,6 @@ bool readSysfsDescriptor(const std::string& path, std::vector<uint8_t>& out) {
   if (!in) return false;
   out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   return !out.empty();
-}
-
-// Whether the node's reports carry relative X and Y: true when its descriptor cannot be read
-// or parsed (unknown is not held against it).
-bool reportsXY(const std::string& path) {
-  std::vector<uint8_t> bytes;
-  HidReportDescriptor descriptor;
-  std::string error;
-  if (!readSysfsDescriptor(path, bytes) || !parseHidReportDescriptor(bytes.data(), bytes.size(), descriptor, error))
-    return true;
-  bool x = false, y = false;
-  for (const HidField& field : descriptor.fields) {
-    if (field.kind != HidField::Kind::kInput || !field.isVariable() || !field.isRelative()) continue;
-    for (uint32_t i = 0; i < field.count; ++i) {
-      x = x || field.usageOfElement(i) == hidUsage(kHidPageGenericDesktop, 0x30);
-      y = y || field.usageOfElement(i) == hidUsage(kHidPageGenericDesktop, 0x31);
-    }
-  }
-  return x && y;
 }
 
 #if HID_API_VERSION < HID_API_MAKE_VERSION(0, 14, 0)
@@ -154,7 +135,11 @@ class RealHidApi : public HidApi {
       info.external = d->bus_type == HID_API_BUS_USB || d->bus_type == HID_API_BUS_BLUETOOTH;
 #ifdef __linux__
       info.busPath = stableBusPath(resolveSysfs("/sys/class/hidraw/" + hidrawNode(info.path) + "/device"));
-      info.hasXY = reportsXY(info.path);
+      std::vector<uint8_t> descriptor;
+      const DescriptorKind kind =
+          readSysfsDescriptor(info.path, descriptor) ? descriptorKind(descriptor) : DescriptorKind{};
+      info.hasXY = !kind.parsed || kind.hasXY;  // unknown is not held against it
+      info.alsoKeyboard = kind.hasKeyboard;
 #endif
       out.push_back(std::move(info));
     }

@@ -28,8 +28,9 @@ struct MouseInfo {
   // 1-2:1.0/0003:046D:C077". The same mouse in the same port (and interface, and for a
   // receiver the same paired device) has the same busPath after a replug. Empty: unknown.
   std::string busPath;
-  bool external = true;  // USB or Bluetooth; false: built in (a trackpoint or touchpad: PS/2, I2C, SMBus)
-  bool hasXY = true;     // its reports carry relative X and Y (hidapi: from the report descriptor)
+  bool external = true;       // USB or Bluetooth; false: built in (a trackpoint or touchpad: PS/2, I2C, SMBus)
+  bool hasXY = true;          // its reports carry relative X and Y (hidapi: from the report descriptor)
+  bool alsoKeyboard = false;  // hidapi: the node is a keyboard's too (evdev lists no such node)
 };
 
 // --- hidapi -------------------------------------------------------------------------------

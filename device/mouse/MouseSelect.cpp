@@ -38,7 +38,8 @@ std::string listOf(const std::vector<MouseInfo>& mice) {
 void orderMice(std::vector<MouseInfo>& mice) {
   auto key = [](const MouseInfo& m) {
     // An unknown bus path sorts after every known one.
-    return std::make_tuple(!m.external, !m.hasXY, m.busPath.empty(), m.busPath, m.interfaceNumber, m.path);
+    return std::make_tuple(!m.external, !m.hasXY, m.alsoKeyboard, m.busPath.empty(), m.busPath, m.interfaceNumber,
+                           m.path);
   };
   std::stable_sort(mice.begin(), mice.end(), [&](const MouseInfo& a, const MouseInfo& b) { return key(a) < key(b); });
 }
@@ -114,6 +115,7 @@ std::string describeMouse(int index, const MouseInfo& info) {
   if (info.interfaceNumber >= 0) out += " interface " + std::to_string(info.interfaceNumber);
   if (!info.external) out += " (built in)";
   if (!info.hasXY) out += " (no X/Y in its reports)";
+  if (info.alsoKeyboard) out += " (also a keyboard)";
   if (!info.busPath.empty()) out += " at " + info.busPath;
   return out;
 }

@@ -11,8 +11,9 @@ namespace kf {
 
 // The order mice are listed and "first" is taken in: external mice (USB, Bluetooth) before
 // built-in ones (a trackpoint or touchpad is never the first while a USB mouse is plugged in),
-// then interfaces whose reports carry X and Y before others (a vendor or keyboard interface
-// that also declares a mouse collection), then by bus path (the port), interface and node path.
+// then interfaces whose reports carry X and Y before others (a vendor interface that also
+// declares a mouse collection), then those that are no keyboard's before a keyboard's with a
+// mouse collection, then by bus path (the port), interface and node path.
 // Enumeration order (readdir, udev) is not stable; this is.
 void orderMice(std::vector<MouseInfo>& mice);
 

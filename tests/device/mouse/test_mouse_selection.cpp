@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "FakeMouseIo.hpp"
+#include "mouse/DescriptorKind.hpp"
 #include "mouse/HidapiMouseBackend.hpp"
 #include "mouse/MouseSelect.hpp"
 #include "mouse/SysfsPath.hpp"
@@ -34,6 +35,12 @@ std::vector<MouseInfo> laptop() {
       mouse("/dev/hidraw4", 0x1532, 0x0084, "pci0000:00/0000:00:14.0/usb1/1-3/1-3:1.0/0003:1532:0084", 0),
       mouse("/dev/hidraw2", 0x046d, 0xc077, "pci0000:00/0000:00:14.0/usb1/1-2/1-2:1.0/0003:046D:C077", 0),
       mouse("/dev/input/event6", 0x0002, 0x000a, "platform/i8042/serio1/serio2/input", -1, false)};
+}
+
+MouseInfo mouse_(const std::string& path, const std::string& busPath, bool alsoKeyboard) {
+  MouseInfo m;
+  m.path = path, m.busPath = busPath, m.alsoKeyboard = alsoKeyboard;
+  return m;
 }
 
 std::vector<std::string> pathsInOrder(std::vector<MouseInfo> mice) {
@@ -148,4 +155,39 @@ TEST_CASE("a re-open after a replug finds the mouse in its own port, not its twi
   CHECK(backend->state() == MouseState::kRunning);
   CHECK(backend->info().path == "/dev/hidraw8");
   CHECK(backend->info().busPath == script.busPath);
+}
+
+TEST_CASE("a hidraw node's descriptor says whether it carries X/Y and whether it is a keyboard's too",
+          "[mouse][select]") {
+  HidRecording genius;
+  std::string error;
+  REQUIRE(readHidRecorderFile(KF_HID_RECORDING, genius, error));
+  const DescriptorKind mouse = descriptorKind(genius.descriptor);
+  CHECK(mouse.parsed);
+  CHECK(mouse.hasXY);
+
+  // A keyboard with a pointing stick on one interface: report 1 a boot keyboard's modifiers,
+  // report 2 a mouse's three buttons and int8 X, Y (HID 1.11, appendix B and E).
+  const std::vector<uint8_t> keyboardAndMouse = {
+      0x05, 0x01, 0x09, 0x06, 0xA1, 0x01, 0x85, 0x01, 0x05, 0x07, 0x19, 0xE0, 0x29, 0xE7, 0x15, 0x00,
+      0x25, 0x01, 0x75, 0x01, 0x95, 0x08, 0x81, 0x02, 0xC0, 0x05, 0x01, 0x09, 0x02, 0xA1, 0x01, 0x85,
+      0x02, 0x09, 0x01, 0xA1, 0x00, 0x05, 0x09, 0x19, 0x01, 0x29, 0x03, 0x15, 0x00, 0x25, 0x01, 0x95,
+      0x03, 0x75, 0x01, 0x81, 0x02, 0x95, 0x01, 0x75, 0x05, 0x81, 0x03, 0x05, 0x01, 0x09, 0x30, 0x09,
+      0x31, 0x15, 0x81, 0x25, 0x7F, 0x75, 0x08, 0x95, 0x02, 0x81, 0x06, 0xC0, 0xC0};
+  const DescriptorKind both = descriptorKind(keyboardAndMouse);
+  REQUIRE(both.parsed);
+  CHECK(both.hasXY);
+  CHECK(both.hasKeyboard);
+  CHECK_FALSE(mouse.hasKeyboard);
+  // The keyboard part alone: a keyboard, no X/Y.
+  const DescriptorKind keyboard = descriptorKind({keyboardAndMouse.begin(), keyboardAndMouse.begin() + 25});
+  CHECK(keyboard.hasKeyboard);
+  CHECK_FALSE(keyboard.hasXY);
+  CHECK_FALSE(descriptorKind({0x05, 0x01, 0xA1}).parsed);  // truncated: unknown
+
+  // In the order: a keyboard's node with a mouse collection after a mouse's own.
+  std::vector<MouseInfo> mice = {mouse_("/dev/hidraw1", "usb1/1-1/1-1:1.0", true),
+                                 mouse_("/dev/hidraw6", "usb1/1-4/1-4:1.0", false)};
+  orderMice(mice);
+  CHECK(mice.front().path == "/dev/hidraw6");
 }
