@@ -133,17 +133,19 @@ class RealEvdevHandle : public EvdevHandle {
 
 class RealEvdevApi : public EvdevApi {
  public:
+  explicit RealEvdevApi(std::string sysClassInput) : classDir_(std::move(sysClassInput)) {}
+
   bool enumerateMice(std::vector<MouseInfo>& out, std::string& error) override {
     out.clear();
-    DIR* dir = ::opendir("/sys/class/input");
+    DIR* dir = ::opendir(classDir_.c_str());
     if (dir == nullptr) {
-      error = std::string("/sys/class/input: ") + std::strerror(errno);
+      error = classDir_ + ": " + std::strerror(errno);
       return errno == ENOENT;  // no input subsystem: no mice, not an error
     }
     while (const dirent* entry = ::readdir(dir)) {
       const std::string node = entry->d_name;
       if (node.rfind("event", 0) != 0) continue;
-      const std::string sys = "/sys/class/input/" + node + "/device/";
+      const std::string sys = classDir_ + "/" + node + "/device/";
       const std::vector<unsigned long> rel = readBitmap(readLine(sys + "capabilities/rel"));
       if (!hasBit(rel, REL_X) || !hasBit(rel, REL_Y)) continue;
       if (reportsKeys(readBitmap(readLine(sys + "capabilities/key")))) continue;
@@ -155,7 +157,7 @@ class RealEvdevApi : public EvdevApi {
       info.serial = readLine(sys + "uniq");
       const uint16_t bus = readHex(sys + "id/bustype");
       info.external = bus == BUS_USB || bus == BUS_BLUETOOTH;  // a receiver's paired mouse is BUS_USB
-      info.busPath = stableBusPath(resolveSysfs("/sys/class/input/" + node + "/device"));
+      info.busPath = stableBusPath(resolveSysfs(classDir_ + "/" + node + "/device"));
       out.push_back(std::move(info));
     }
     ::closedir(dir);
@@ -176,13 +178,20 @@ class RealEvdevApi : public EvdevApi {
     why = OpenFailure::kNone;
     return std::make_unique<RealEvdevHandle>(fd);
   }
+
+ private:
+  std::string classDir_;  // /sys/class/input
 };
 
 }  // namespace
 
 std::shared_ptr<EvdevApi> realEvdevApi() {
-  static std::shared_ptr<EvdevApi> api = std::make_shared<RealEvdevApi>();
+  static std::shared_ptr<EvdevApi> api = std::make_shared<RealEvdevApi>("/sys/class/input");
   return api;
+}
+
+std::shared_ptr<EvdevApi> evdevApiReadingSysfsAt(const std::string& sysClassInput) {
+  return std::make_shared<RealEvdevApi>(sysClassInput);
 }
 
 #else
@@ -206,6 +215,8 @@ std::shared_ptr<EvdevApi> realEvdevApi() {
   static std::shared_ptr<EvdevApi> api = std::make_shared<NoEvdevApi>();
   return api;
 }
+
+std::shared_ptr<EvdevApi> evdevApiReadingSysfsAt(const std::string&) { return realEvdevApi(); }
 
 #endif
 

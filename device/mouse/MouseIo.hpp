@@ -94,6 +94,9 @@ class EvdevApi {
 
 // Linux evdev; on other systems enumerates nothing and fails to open.
 std::shared_ptr<EvdevApi> realEvdevApi();
+// The same, enumerating a copy of /sys/class/input elsewhere (tests build one with the nodes
+// of devices this machine does not have).
+std::shared_ptr<EvdevApi> evdevApiReadingSysfsAt(const std::string& sysClassInput);
 
 // The message for a node the user may not open: names it and the fix (the udev rule).
 std::string permissionFix(const std::string& path);

@@ -34,7 +34,7 @@ bool isHidDeviceName(const std::string& part) {
 std::string stableBusPath(const std::string& sysfsPath) {
   std::string path = sysfsPath;
   const std::string devices = "/sys/devices/";
-  if (path.rfind(devices, 0) == 0) path = path.substr(devices.size());
+  if (const size_t at = path.find(devices); at != std::string::npos) path = path.substr(at + devices.size());
   std::istringstream parts(path);
   std::string part, out;
   while (std::getline(parts, part, '/')) {
