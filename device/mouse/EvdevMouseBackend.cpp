@@ -50,6 +50,8 @@ bool EvdevMouseBackend::openInfo(const MouseInfo& info, std::string& error, Open
   handle_ = std::move(handle);
   dx_ = dy_ = 0;
   packetHasData_ = packetSaturated_ = dropping_ = false;
+  buttons_ = 0;
+  handle_->buttonsDown(buttons_);  // held through a replug, or down at the open: the kernel knows
   return true;
 }
 

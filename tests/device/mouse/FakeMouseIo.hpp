@@ -47,7 +47,7 @@ struct FakeMouseScript {
   double stallAtS = 1e9, stallForS = 0;  // since plug-in: the reader is held this long
   int shortReportEvery = 0;              // hid: every n-th report arrives cut to 3 bytes
   int maxEventsPerRead = 64;             // evdev
-  // The kernel's queue per reader: hidraw 64 reports, evdev 64 events for a mouse. Tests not
+  // The kernel's ring per reader: hidraw 64 slots (63 reports), evdev 64 events for a mouse. Tests not
   // about loss raise it, so that their reader, descheduled on a loaded machine, loses nothing.
   size_t kernelQueue = 64;
   bool denyAccess = false;  // EACCES on open
