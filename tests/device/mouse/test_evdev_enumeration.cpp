@@ -82,8 +82,8 @@ TEST_CASE("evdev enumeration lists mice only, never a node that reports keys, US
             {KEY_ESC, KEY_A, KEY_Z, KEY_ENTER});
   sysfs.add("event6", "platform/i8042/serio1/serio2", 6, BUS_I8042, 0x0002, 0x000a, "TPPS/2 IBM TrackPoint",
             {REL_X, REL_Y}, {BTN_LEFT, BTN_RIGHT, BTN_MIDDLE});
-  sysfs.add("event5", "pci0000:00/0000:00:15.0/i2c_designware.0/i2c-0/i2c-ELAN0001:00/0018:04F3:3140.0001", 5,
-            BUS_I2C, 0x04f3, 0x3140, "ELAN0001:00 04F3:3140 Mouse", {REL_X, REL_Y}, {BTN_LEFT, BTN_RIGHT});
+  sysfs.add("event5", "pci0000:00/0000:00:15.0/i2c_designware.0/i2c-0/i2c-ELAN0001:00/0018:04F3:3140.0001", 5, BUS_I2C,
+            0x04f3, 0x3140, "ELAN0001:00 04F3:3140 Mouse", {REL_X, REL_Y}, {BTN_LEFT, BTN_RIGHT});
   sysfs.add("event20", receiver + "/0003:046D:4082.0004", 20, BUS_USB, 0x046d, 0x4082, "Logitech M705",
             {REL_X, REL_Y, REL_WHEEL, REL_HWHEEL}, {BTN_LEFT, BTN_RIGHT, BTN_MIDDLE, BTN_SIDE, BTN_EXTRA});
   sysfs.add("event21", receiver + "/0003:046D:4023.0005", 21, BUS_USB, 0x046d, 0x4023, "Logitech K400", {REL_X, REL_Y},
