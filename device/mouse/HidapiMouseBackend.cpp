@@ -46,7 +46,7 @@ bool HidapiMouseBackend::reopenHandle(std::string& error) {
   std::vector<MouseInfo> mice;
   MouseInfo info;
   OpenFailure why = OpenFailure::kNone;
-  if (!api_->enumerateMice(mice, error) || !selectMouse(mice, reselector(current_), info, error)) return false;
+  if (!api_->enumerateMice(mice, error) || !findMouseAgain(mice, current_, info, error)) return false;
   if (!openInfo(info, error, why)) return false;
   afterLoss_ = true;  // whatever moved while it was away is lost
   return true;

@@ -97,6 +97,32 @@ bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInf
   return false;
 }
 
+bool findMouseAgain(std::vector<MouseInfo> mice, const MouseInfo& previous, MouseInfo& out, std::string& error) {
+  orderMice(mice);
+  std::vector<const MouseInfo*> sameMake;
+  for (const MouseInfo& m : mice) {
+    const bool same = previous.vendorId == 0 && previous.productId == 0
+                          ? m.path == previous.path  // no ids known: its node
+                          : m.vendorId == previous.vendorId && m.productId == previous.productId &&
+                                m.serial == previous.serial && m.interfaceNumber == previous.interfaceNumber;
+    if (!same) continue;
+    if (!previous.busPath.empty() && m.busPath == previous.busPath) {
+      out = m;
+      return true;
+    }
+    sameMake.push_back(&m);
+  }
+  if (sameMake.size() == 1) {
+    out = *sameMake.front();
+    return true;
+  }
+  error = sameMake.empty()
+              ? "no mouse " + reselector(previous) + " is plugged in; there are:" + listOf(mice)
+              : std::to_string(sameMake.size()) + " mice like " + reselector(previous) +
+                    " are plugged in, none in its port: plug it back where it was; there are:" + listOf(mice);
+  return false;
+}
+
 std::string reselector(const MouseInfo& info) {
   if (info.vendorId == 0 && info.productId == 0) return info.path;
   char ids[16];

@@ -24,9 +24,15 @@ void orderMice(std::vector<MouseInfo>& mice);
 // with a message that lists what there is.
 bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInfo& out, std::string& error);
 
-// A selector that finds the same mouse again after a replug (its node path may change): the
-// same ids in the same port and interface when the bus path is known, else the same ids (and
-// serial).
+// The mouse `previous` after a replug (its node path may change): the one with its ids in its
+// port and interface; else, when its port is unknown or it came back elsewhere (another port, a
+// Bluetooth reconnection), the one mouse with its ids, serial and interface. Never one of
+// several of its make: a twin in another port is not it. False with a message that lists what
+// there is.
+bool findMouseAgain(std::vector<MouseInfo> mice, const MouseInfo& previous, MouseInfo& out, std::string& error);
+
+// The selector of this mouse in this port ("VVVV:PPPP@busPath"; without a known port the ids
+// and serial): what a re-open looks for, in words.
 std::string reselector(const MouseInfo& info);
 
 // "0: /dev/hidraw3 046d:c077 Logitech USB Optical Mouse (serial ..., interface 0)"

@@ -191,3 +191,28 @@ TEST_CASE("a hidraw node's descriptor says whether it carries X/Y and whether it
   orderMice(mice);
   CHECK(mice.front().path == "/dev/hidraw6");
 }
+
+TEST_CASE("finding a mouse again: its port first; elsewhere only when it is the one of its make", "[mouse][select]") {
+  const MouseInfo ours = mouse("/dev/hidraw7", 0x0458, 0x0138, "usb1/1-2/1-2:1.0/0003:0458:0138", 0);
+  const MouseInfo twin = mouse("/dev/hidraw2", 0x0458, 0x0138, "usb1/1-1/1-1:1.0/0003:0458:0138", 0);
+  const MouseInfo other = mouse("/dev/hidraw3", 0x046d, 0xc077, "usb1/1-3/1-3:1.0/0003:046D:C077", 0);
+  MouseInfo back = ours, out;
+  back.path = "/dev/hidraw9";  // a new node in the same port
+  std::string error;
+  REQUIRE(findMouseAgain({twin, other, back}, ours, out, error));
+  CHECK(out.path == "/dev/hidraw9");
+
+  // Back in another port (or a Bluetooth mouse reconnected: a new hci handle in its path).
+  MouseInfo moved = ours;
+  moved.path = "/dev/hidraw4", moved.busPath = "usb1/1-4/1-4:1.0/0003:0458:0138";
+  REQUIRE(findMouseAgain({other, moved}, ours, out, error));
+  CHECK(out.path == "/dev/hidraw4");
+  // ... but with its twin plugged in too, neither is taken for it.
+  CHECK_FALSE(findMouseAgain({twin, other, moved}, ours, out, error));
+  CHECK(error.find("none in its port") != std::string::npos);
+  // Another interface of the same mouse is not it.
+  MouseInfo vendorInterface = moved;
+  vendorInterface.interfaceNumber = 1;
+  CHECK_FALSE(findMouseAgain({other, vendorInterface}, ours, out, error));
+  CHECK(error.find("no mouse 0458:0138@usb1/1-2/1-2:1.0/0003:0458:0138 is plugged in") != std::string::npos);
+}
