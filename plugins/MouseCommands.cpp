@@ -91,8 +91,9 @@ bool openStage(World* world, void* raw) {  // NRT
     return false;
   }
   kf::MouseOpenOptions options;
-  const char* backend = data->args.backend[0] != '\0' ? data->args.backend : "hidapi";
-  if (!kf::mouseBackendKindFromName(backend, options.kind)) {
+  // An empty backend keeps options.kind at kDefaultMouseBackend (evdev on Linux).
+  const char* backend = data->args.backend;
+  if (backend[0] != '\0' && !kf::mouseBackendKindFromName(backend, options.kind)) {
     failWith(data, "kfOpenMouse: unknown backend '%s' (hidapi or evdev)", backend);
     return false;
   }

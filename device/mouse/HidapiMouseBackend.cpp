@@ -27,14 +27,6 @@ bool HidapiMouseBackend::openInfo(const MouseInfo& info, std::string& error, Ope
     why = OpenFailure::kOther;
     return false;
   }
-  constexpr HidUsage kX = hidUsage(kHidPageGenericDesktop, 0x30), kY = hidUsage(kHidPageGenericDesktop, 0x31);
-  for (const HidField& field : descriptor.fields) {
-    if (field.kind != HidField::Kind::kInput || !field.isVariable() || !field.isRelative()) continue;
-    for (uint32_t i = 0; i < field.count; ++i) {
-      if (field.usageOfElement(i) == kX) xMin_ = field.logicalMin, xMax_ = field.logicalMax;
-      if (field.usageOfElement(i) == kY) yMin_ = field.logicalMin, yMax_ = field.logicalMax;
-    }
-  }
   handle_ = std::move(handle);
   decoder_ = std::move(decoder);
   current_ = info;
@@ -63,9 +55,8 @@ void HidapiMouseBackend::take(const uint8_t* bytes, int size, double arrivalS) {
   report.dxCounts = delta.dxCounts;
   report.dyCounts = delta.dyCounts;
   report.buttons = delta.buttons;
-  const bool saturated = (xMax_ > xMin_ && (delta.dxCounts <= xMin_ || delta.dxCounts >= xMax_)) ||
-                         (yMax_ > yMin_ && (delta.dyCounts <= yMin_ || delta.dyCounts >= yMax_));
-  if (saturated) report.flags |= kSaturated;
+  // The decoder knows each axis' logical limits (and clamps to them, as the kernel does).
+  if (delta.saturated) report.flags |= kSaturated;
   if (afterLoss_) report.flags |= kAfterLoss;
   afterLoss_ = false;
   emit(report);

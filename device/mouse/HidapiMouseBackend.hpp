@@ -42,7 +42,6 @@ class HidapiMouseBackend : public RealMouseBackend {
   std::shared_ptr<HidApi> api_;
   std::unique_ptr<HidHandle> handle_;
   HidMouseDecoder decoder_;
-  int64_t xMin_ = 0, xMax_ = 0, yMin_ = 0, yMax_ = 0;  // logical limits: a delta there saturated
   bool afterLoss_ = false;
   MouseInfo current_;  // the reader thread's (and open's) own
 };
