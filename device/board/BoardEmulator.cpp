@@ -38,7 +38,7 @@ void BoardEmulator::advance(double nowS) {
     const double fireS = lastValidS_ + kBoardWatchdogS;
     heatTo(fireS);
     watchdogPending_ = false;
-    if (drive_ != 0) errors_ |= kErrWatchdog;
+    if (state_ == BoardState::kArmed) errors_ |= kErrWatchdog;  // it only runs while armed
     setDrive(0, fireS, "watchdog");
   }
   heatTo(nowS);
@@ -61,8 +61,9 @@ void BoardEmulator::receiveSetPoint(const uint8_t* data, size_t size, double now
   lastSequence_ = setPoint.sequence;
   haveSequence_ = true;
   ++validFrames_;
+  // The watchdog runs while armed only: a disarmed board's target is 0 already (PROTOCOL.md 6).
   lastValidS_ = nowS;
-  watchdogPending_ = true;
+  watchdogPending_ = state_ == BoardState::kArmed;
   const bool mayDrive = state_ == BoardState::kArmed && !(errors_ & kErrOverTemperature);
   setDrive(mayDrive ? setPoint.drive : 0, nowS, "set-point");
 }
@@ -91,6 +92,7 @@ usb::Result BoardEmulator::control(uint8_t requestType, uint8_t request, uint16_
     case Request::kGetVersion: {
       if (!in || length < kVersionSize) return usb::Result::kPipe;
       VersionReply version;
+      version.protocolMajor = protocolMajor_;
       version.firmwareMajor = 1;
       version.flags = 1;  // measures the current
       version.fullScaleCurrentMa = 1500;
@@ -101,29 +103,49 @@ usb::Result BoardEmulator::control(uint8_t requestType, uint8_t request, uint16_
     case Request::kArm:
       if (in || value != kArmKey || refuseArm_ || state_ == BoardState::kFault || (errors_ & kErrOverTemperature))
         return usb::Result::kPipe;
+      if (state_ == BoardState::kArmed) return usb::Result::kOk;  // ARM while armed: changes nothing
       state_ = BoardState::kArmed;
       haveSequence_ = false;  // the first frame after arming is taken whatever its sequence
+      lastValidS_ = nowS;     // the watchdog starts with ARM
+      watchdogPending_ = true;
       return usb::Result::kOk;
     case Request::kDisarm:
       if (in) return usb::Result::kPipe;
       state_ = BoardState::kDisarmed;
       setDrive(0, nowS, "disarm");
       return usb::Result::kOk;
-    case Request::kClearErrors:
-      if (in) return usb::Result::kPipe;
-      errors_ &= kErrOverTemperature;  // the live flag stays
-      if (state_ == BoardState::kFault) state_ = BoardState::kDisarmed;
+    case Request::kClearErrors: {
+      if (!in || length < kClearReplySize) return usb::Result::kPipe;
+      ClearReply reply;
+      reply.before = errors_;
+      // Latched flags go; a live condition that persists stays, and so does its fault.
+      errors_ &= kErrOverTemperature | kErrSupply;
+      if (overCurrentPresent_) errors_ |= kErrOverCurrent;
+      if (state_ == BoardState::kFault && !overCurrentPresent_) state_ = BoardState::kDisarmed;
+      reply.remaining = errors_;
+      encodeClearReply(reply, data);
+      if (transferred != nullptr) *transferred = kClearReplySize;
       return usb::Result::kOk;
+    }
   }
   return usb::Result::kPipe;
 }
 
-void BoardEmulator::usbReset(double nowS) {
+void BoardEmulator::usbReset(double nowS, const char* why) {
   advance(nowS);
   state_ = BoardState::kDisarmed;
   errors_ |= kErrUsbReset;
   watchdogPending_ = false;
-  setDrive(0, nowS, "usb reset");
+  setDrive(0, nowS, why);
+}
+
+void BoardEmulator::overCurrent(double nowS, bool persists) {
+  advance(nowS);
+  state_ = BoardState::kFault;
+  errors_ |= kErrOverCurrent;
+  overCurrentPresent_ = persists;
+  watchdogPending_ = false;
+  setDrive(0, nowS, "over current");
 }
 
 void BoardEmulator::powerLoss(double nowS) {
@@ -137,7 +159,8 @@ void BoardEmulator::powerOn(double nowS) {
   advance(nowS);
   state_ = BoardState::kDisarmed;
   haveSequence_ = false;
-  errors_ = 0;
+  errors_ = kErrUsbReset;  // enumerated afresh: reported once, until the host's CLEAR_ERRORS
+  overCurrentPresent_ = false;
   validFrames_ = rejectedFrames_ = 0;
   watchdogPending_ = false;
 }

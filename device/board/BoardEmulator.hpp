@@ -1,7 +1,9 @@
 // BoardEmulator: the friction board of device/board/PROTOCOL.md as a state machine on explicit
-// times — set-point validation, sequence rules, arming, the 20 ms watchdog, USB reset /
-// suspend / power loss, a coil heat and temperature model — with a timeline of the coil
-// current for tests ("when did the magnet go off"). Not thread-safe: EmulatedUsb locks it.
+// times — set-point validation, sequence rules, arming (and ARM while armed), the 20 ms
+// watchdog (idle while disarmed), USB reset / suspend / power loss, CLEAR_ERRORS, an
+// over-current fault, a coil heat and temperature model — with a timeline of the coil current
+// for tests ("when did the magnet go off"). It does not model the current loop or its PWM:
+// its current is the target at once. Not thread-safe: EmulatedUsb locks it.
 #pragma once
 
 #include <cstdint>
@@ -30,13 +32,18 @@ class BoardEmulator {
   // A vendor request on EP 0. kPipe (STALL) for unknown ones and refused ARMs.
   usb::Result control(uint8_t requestType, uint8_t request, uint16_t value, uint8_t* data, uint16_t length,
                       int* transferred, double nowS);
-  void usbReset(double nowS);   // bus reset or suspend: off, disarmed
-  void powerLoss(double nowS);  // unplugged: everything off and forgotten
-  void powerOn(double nowS);    // plugged in again: a fresh, disarmed board
+  void usbReset(double nowS, const char* why = "usb reset");  // bus reset or suspend: off, disarmed
+  void powerLoss(double nowS);                                // unplugged: everything off and forgotten
+  void powerOn(double nowS);                                  // plugged in again: a fresh, disarmed board
 
   // Failure modes: ARM is refused (a fault the board keeps, no coil supply).
   void setRefuseArm(bool refuse) { refuseArm_ = refuse; }
+  // The loop cannot hold the current (a shorted coil): fault, current off. `persists`: the
+  // condition stays, so CLEAR_ERRORS leaves the board in fault until setOverCurrent(false).
+  void overCurrent(double nowS, bool persists);
+  void setOverCurrent(bool present) { overCurrentPresent_ = present; }
   void setAmbientC(double ambientC) { ambientC_ = ambientC; }
+  void setProtocolMajor(uint8_t major) { protocolMajor_ = major; }
 
   uint16_t drive() const { return drive_; }
   BoardState state() const { return state_; }
@@ -59,10 +66,12 @@ class BoardEmulator {
   bool haveSequence_ = false;
   double lastValidS_ = -1.0;
   bool watchdogPending_ = false;
-  uint16_t errors_ = 0;
+  uint16_t errors_ = kErrUsbReset;  // a board starts enumerated: reported until CLEAR_ERRORS
   uint64_t validFrames_ = 0;
   uint64_t rejectedFrames_ = 0;
   bool refuseArm_ = false;
+  bool overCurrentPresent_ = false;
+  uint8_t protocolMajor_ = kProtocolMajor;
   double ambientC_ = 25.0;
   double heat_ = 0.0;  // mean (drive / full)^2, time constant 5 s
   double temperatureC_ = 25.0;

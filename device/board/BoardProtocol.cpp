@@ -92,4 +92,16 @@ bool decodeVersion(const uint8_t* data, size_t size, VersionReply& out) {
   return true;
 }
 
+void encodeClearReply(const ClearReply& reply, uint8_t* out) {
+  put16(out, reply.before);
+  put16(out + 2, reply.remaining);
+}
+
+bool decodeClearReply(const uint8_t* data, size_t size, ClearReply& out) {
+  if (size != kClearReplySize) return false;
+  out.before = get16(data);
+  out.remaining = get16(data + 2);
+  return true;
+}
+
 }  // namespace kf::board

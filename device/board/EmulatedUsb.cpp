@@ -23,14 +23,36 @@ double EmulatedUsb::nowS() const { return steadyS() - originS_; }
 class EmulatedPort : public usb::Port {
  public:
   explicit EmulatedPort(std::shared_ptr<EmulatedUsb> bus) : bus_(std::move(bus)) {}
-  ~EmulatedPort() override { close(); }
+  ~EmulatedPort() override {
+    close();
+    // What this port left in flight can never be delivered to it now.
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    auto& pending = bus_->pending_;
+    pending.erase(std::remove_if(pending.begin(), pending.end(),
+                                 [this](const EmulatedUsb::Pending& p) { return p.owner == this; }),
+                  pending.end());
+  }
 
   usb::Result init() override { return usb::Result::kOk; }
   void exit() override {}
 
   usb::Result open(const usb::DeviceIds& ids) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
-    if (!bus_->plugged_ || ids.vendorId != kVendorId || ids.productId != kProductId ||
+    skipped_.clear();
+    if (ids.vendorId != kVendorId || ids.productId != kProductId) return usb::Result::kNotFound;
+    // The strangers come first on this bus; like LibusbPort, only their descriptors are read.
+    int address = 1;
+    for (const usb::InterfaceIdentity& stranger : bus_->strangers_) {
+      const std::string mismatch = usb::interfaceMismatch(&stranger, ids.iface);
+      if (mismatch.empty()) {
+        ++bus_->strangerTouches_;  // taken for a board: it would be opened and claimed
+        continue;
+      }
+      skipped_ +=
+          (skipped_.empty() ? "" : "; ") + std::string("bus 1 device ") + std::to_string(address++) + ": " + mismatch;
+    }
+    const usb::InterfaceIdentity board{kInterfaceNumber, kInterfaceClass, kInterfaceSubclass, kInterfaceProtocol};
+    if (!bus_->plugged_ || !usb::interfaceMismatch(&board, ids.iface).empty() ||
         (!ids.serial.empty() && ids.serial != bus_->serial_))
       return usb::Result::kNotFound;
     if (bus_->denyAccess_) return usb::Result::kAccess;
@@ -39,6 +61,7 @@ class EmulatedPort : public usb::Port {
     return usb::Result::kOk;
   }
 
+  std::string skipped() const override { return skipped_; }
   std::string openSerial() const override { return bus_->serial_; }
 
   usb::Result claimInterface(int number) override {
@@ -56,7 +79,10 @@ class EmulatedPort : public usb::Port {
 
   void close() override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
-    if (generation_ != 0) --bus_->openHandles_;
+    if (generation_ != 0) {
+      --bus_->openHandles_;
+      bus_->closesInFlight_ += ownInFlight(-1);
+    }
     generation_ = 0;
   }
 
@@ -71,6 +97,7 @@ class EmulatedPort : public usb::Port {
   usb::Result clearHalt(uint8_t endpoint) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
     if (!alive()) return usb::Result::kNoDevice;
+    if (ownInFlight(endpoint) > 0) ++bus_->haltsInFlight_;
     if (endpoint == kSetPointEndpoint) bus_->outHalted_ = false;
     ++bus_->clearHalts_;
     return usb::Result::kOk;
@@ -79,8 +106,13 @@ class EmulatedPort : public usb::Port {
   usb::Result submit(usb::Transfer& transfer) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
     if (!alive()) return usb::Result::kNoDevice;
+    for (const EmulatedUsb::Pending& p : bus_->pending_)
+      if (p.transfer == &transfer) {
+        ++bus_->resubmitsInFlight_;  // libusb: LIBUSB_ERROR_BUSY, and the host lost track of it
+        return usb::Result::kBusy;
+      }
     const double nowS = bus_->nowS();
-    EmulatedUsb::Pending pending{&transfer, nowS, generation_, false, false, false};
+    EmulatedUsb::Pending pending{this, &transfer, nowS, generation_, false, false, false};
     if (transfer.endpoint == kSetPointEndpoint) {
       if (bus_->timeOutOut_ > 0) {
         --bus_->timeOutOut_;
@@ -115,6 +147,7 @@ class EmulatedPort : public usb::Port {
     for (EmulatedUsb::Pending& pending : bus_->pending_)
       if (pending.transfer == &transfer) {
         pending.cancelled = true;
+        pending.dueS = std::min(pending.dueS, bus_->nowS());
         bus_->changed_.notify_all();
         return usb::Result::kOk;
       }
@@ -132,8 +165,8 @@ class EmulatedPort : public usb::Port {
       double nextDueS = 0.0;
       double earliestS = deadlineS;
       for (auto it = bus_->pending_.begin(); it != bus_->pending_.end(); ++it) {
-        const bool dead = it->generation != bus_->generation_ || !bus_->plugged_;
-        const double dueS = (it->cancelled || dead) ? nowS : it->dueS;
+        if (it->owner != this) continue;  // another host's transfer: its own thread runs it
+        const double dueS = it->dueS + bus_->callbackDelayS_;
         if (dueS <= nowS && (next == bus_->pending_.end() || dueS < nextDueS)) {
           next = it;
           nextDueS = dueS;
@@ -155,6 +188,14 @@ class EmulatedPort : public usb::Port {
 
  private:
   bool alive() const { return generation_ != 0 && generation_ == bus_->generation_ && bus_->plugged_; }
+
+  // Under the lock: this port's transfers whose callbacks have not run (endpoint -1: any).
+  int ownInFlight(int endpoint) const {
+    int count = 0;
+    for (const EmulatedUsb::Pending& p : bus_->pending_)
+      if (p.owner == this && (endpoint < 0 || p.transfer->endpoint == endpoint)) ++count;
+    return count;
+  }
 
   // Under the lock: what the transfer did.
   void complete(const EmulatedUsb::Pending& pending, double nowS) {
@@ -186,6 +227,7 @@ class EmulatedPort : public usb::Port {
 
   std::shared_ptr<EmulatedUsb> bus_;
   int generation_ = 0;  // of the plug-in it was opened on; 0: not open
+  std::string skipped_;
 };
 
 std::unique_ptr<usb::Port> EmulatedUsb::makePort() { return std::make_unique<EmulatedPort>(shared_from_this()); }
@@ -193,7 +235,9 @@ std::unique_ptr<usb::Port> EmulatedUsb::makePort() { return std::make_unique<Emu
 void EmulatedUsb::unplug() {
   std::lock_guard<std::mutex> lock(mutex_);
   plugged_ = false;
-  board_.powerLoss(nowS());
+  const double now = nowS();
+  board_.powerLoss(now);
+  for (Pending& pending : pending_) pending.dueS = std::min(pending.dueS, now);  // they end: no device
   changed_.notify_all();
 }
 
@@ -205,6 +249,52 @@ void EmulatedUsb::replug() {
   outHalted_ = false;
   board_.powerOn(nowS());
   changed_.notify_all();
+}
+
+void EmulatedUsb::busReset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.usbReset(nowS(), "usb reset");
+}
+void EmulatedUsb::suspend() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.usbReset(nowS(), "suspend");
+}
+void EmulatedUsb::overCurrent(bool persists) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.overCurrent(nowS(), persists);
+}
+void EmulatedUsb::setOverCurrent(bool present) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.setOverCurrent(present);
+}
+void EmulatedUsb::setProtocolMajor(uint8_t major) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.setProtocolMajor(major);
+}
+void EmulatedUsb::delayCallbacks(double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  callbackDelayS_ = seconds;
+  changed_.notify_all();
+}
+void EmulatedUsb::addStranger(usb::InterfaceIdentity iface) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  strangers_.push_back(iface);
+}
+int EmulatedUsb::strangerTouches() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return strangerTouches_;
+}
+int EmulatedUsb::closesInFlight() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return closesInFlight_;
+}
+int EmulatedUsb::resubmitsInFlight() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return resubmitsInFlight_;
+}
+int EmulatedUsb::haltsInFlight() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return haltsInFlight_;
 }
 
 void EmulatedUsb::setDenyAccess(bool deny) {

@@ -2,7 +2,10 @@
 // usb::Port like the real one, on the steady clock: interrupt endpoints serve one transfer
 // per 1 ms frame each, control requests at once. It fails as USB fails, on request: transfers
 // that time out, partial transfers, a stalled endpoint, unplugging (transfers in flight end
-// with kNoDevice) and plugging back in, permission denied at open, a board that never arms.
+// with kNoDevice) and plugging back in, permission denied at open, a board that never arms,
+// a bus reset or suspend, an over-current fault, a board of another protocol version, a
+// stranger sharing the test IDs, callbacks that arrive late. It checks the host keeps libusb's
+// transfer life cycle (UsbPort.hpp): each breach is counted (lifeCycleBreaches()).
 #pragma once
 
 #include <condition_variable>
@@ -29,10 +32,21 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void replug();
   void setDenyAccess(bool deny);
   void setRefuseArm(bool refuse);
-  void timeOutNextOut(int count);  // these OUT transfers are never taken: kTimedOut
-  void partialNextOut(int count);  // only 4 of 8 bytes arrive (the board rejects them)
-  void partialNextIn(int count);   // short status transfers
-  void stallOut();                 // EP 0x01 halts until the host clears it
+  void timeOutNextOut(int count);   // these OUT transfers are never taken: kTimedOut
+  void partialNextOut(int count);   // only 4 of 8 bytes arrive (the board rejects them)
+  void partialNextIn(int count);    // short status transfers
+  void stallOut();                  // EP 0x01 halts until the host clears it
+  void busReset();                  // the board is reset by the bus (disarmed, USB_RESET)
+  void suspend();                   // the bus went idle: the same for the board
+  void overCurrent(bool persists);  // the board trips to fault; `persists`: CLEAR_ERRORS cannot clear it
+  void setOverCurrent(bool present);
+  void setProtocolMajor(uint8_t major);
+  // Every transfer's callback (completed, cancelled, unplugged) comes this much later than due:
+  // a host that frees or closes before its callbacks ran is caught.
+  void delayCallbacks(double seconds);
+  // A device with the board's IDs but another interface, listed before the board.
+  void addStranger(usb::InterfaceIdentity iface);
+  int strangerTouches();  // opens, claims, control requests on strangers: must stay 0
 
   // What the board did (copies, under the lock).
   std::vector<BoardEmulator::Change> timeline();
@@ -45,12 +59,18 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   int interfaceReleases();
   int clearHalts();
   bool isOpen();  // a host holds it open
+  // Breaches of the transfer life cycle: a handle closed, a transfer resubmitted, or a halt
+  // cleared on its endpoint, while a transfer's callback had not run.
+  int closesInFlight();
+  int resubmitsInFlight();
+  int haltsInFlight();
 
  private:
   friend class EmulatedPort;
   struct Pending {
+    const void* owner;  // the port that submitted it
     usb::Transfer* transfer;
-    double dueS;
+    double dueS;     // when it completes (cancel and unplug bring it forward); +callbackDelayS_
     int generation;  // of the plug-in it was submitted on
     bool cancelled;
     bool timeOut;
@@ -72,6 +92,10 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   double nextOutS_ = 0.0, nextInS_ = 0.0;  // the next free frame of each endpoint
   std::vector<Pending> pending_;
   int claims_ = 0, releases_ = 0, clearHalts_ = 0, openHandles_ = 0;
+  double callbackDelayS_ = 0.0;
+  std::vector<usb::InterfaceIdentity> strangers_;
+  int strangerTouches_ = 0;
+  int closesInFlight_ = 0, resubmitsInFlight_ = 0, haltsInFlight_ = 0;
 };
 
 }  // namespace kf::board

@@ -2,7 +2,11 @@
 // on the caller's thread.
 #include <libusb.h>
 
+#include <atomic>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -25,7 +29,7 @@ const char* describe(Result result) {
     case Result::kNotFound:
       return "not found";
     case Result::kBusy:
-      return "busy (another program has claimed the board)";
+      return "busy (another program or a kernel driver holds the interface; it is not detached)";
     case Result::kTimeout:
       return "timed out";
     case Result::kPipe:
@@ -54,6 +58,23 @@ const char* describe(TransferStatus status) {
       return "overflow";
   }
   return "?";
+}
+
+std::string interfaceMismatch(const InterfaceIdentity* found, const InterfaceIdentity& wanted) {
+  char text[160];
+  if (found == nullptr) {
+    std::snprintf(text, sizeof text, "has no interface %d: not a friction board, not touched", wanted.number);
+    return text;
+  }
+  if (found->interfaceClass == wanted.interfaceClass && found->subclass == wanted.subclass &&
+      found->protocol == wanted.protocol)
+    return "";
+  std::snprintf(text, sizeof text,
+                "interface %d is class 0x%02x subclass 0x%02x protocol 0x%02x, not the board's 0x%02x/0x%02x/0x%02x: "
+                "not a friction board, not touched",
+                wanted.number, found->interfaceClass, found->subclass, found->protocol, wanted.interfaceClass,
+                wanted.subclass, wanted.protocol);
+  return text;
 }
 
 namespace {
@@ -101,6 +122,25 @@ TransferStatus statusOf(libusb_transfer_status status) {
   }
 }
 
+// The identity of interface `number` (alternate setting 0) of the active configuration, read
+// from the cached descriptors without opening the device (Linux: sysfs).
+bool readInterface(libusb_device* device, int number, InterfaceIdentity& out) {
+  libusb_config_descriptor* config = nullptr;
+  if (libusb_get_active_config_descriptor(device, &config) != 0 || config == nullptr) return false;
+  bool found = false;
+  for (int i = 0; i < config->bNumInterfaces && !found; ++i) {
+    const libusb_interface& iface = config->interface[i];
+    if (iface.num_altsetting < 1 || iface.altsetting[0].bInterfaceNumber != number) continue;
+    const libusb_interface_descriptor& alt = iface.altsetting[0];
+    out = {number, alt.bInterfaceClass, alt.bInterfaceSubClass, alt.bInterfaceProtocol};
+    found = true;
+  }
+  libusb_free_config_descriptor(config);
+  return found;
+}
+
+constexpr double kCallbackWaitS = 10.0;  // past this a transfer that never returns is leaked
+
 class LibusbPort : public Port {
  public:
   ~LibusbPort() override {
@@ -114,7 +154,8 @@ class LibusbPort : public Port {
   }
 
   void exit() override {
-    if (context_ == nullptr) return;
+    // A context with a leaked transfer stays: libusb_exit would free what is still in flight.
+    if (context_ == nullptr || leaked_) return;
     libusb_exit(context_);
     context_ = nullptr;
   }
@@ -122,6 +163,7 @@ class LibusbPort : public Port {
   Result open(const DeviceIds& ids) override {
     if (context_ == nullptr) return Result::kInvalid;
     close();
+    skipped_.clear();
     libusb_device** list = nullptr;
     const ssize_t count = libusb_get_device_list(context_, &list);
     if (count < 0) return resultOf(static_cast<int>(count));
@@ -130,6 +172,17 @@ class LibusbPort : public Port {
       libusb_device_descriptor descriptor;
       if (libusb_get_device_descriptor(list[i], &descriptor) != 0) continue;
       if (descriptor.idVendor != ids.vendorId || descriptor.idProduct != ids.productId) continue;
+      // Ours only if the interface is: a stranger with the same (shared test) IDs is not opened.
+      InterfaceIdentity found;
+      const bool present = readInterface(list[i], ids.iface.number, found);
+      const std::string mismatch = interfaceMismatch(present ? &found : nullptr, ids.iface);
+      if (!mismatch.empty()) {
+        char where[64];
+        std::snprintf(where, sizeof where, "bus %d device %d", libusb_get_bus_number(list[i]),
+                      libusb_get_device_address(list[i]));
+        skipped_ += (skipped_.empty() ? "" : "; ") + std::string(where) + ": " + mismatch;
+        continue;
+      }
       libusb_device_handle* handle = nullptr;
       const int opened = libusb_open(list[i], &handle);
       if (opened != 0) {
@@ -152,11 +205,14 @@ class LibusbPort : public Port {
     return result;
   }
 
+  std::string skipped() const override { return skipped_; }
   std::string openSerial() const override { return serial_; }
 
   Result claimInterface(int number) override {
     if (handle_ == nullptr) return Result::kInvalid;
-    libusb_set_auto_detach_kernel_driver(handle_, 1);  // no kernel driver binds a vendor interface; harmless
+    // No kernel driver binds a vendor interface: one that is bound means the interface is not
+    // what we think, and it is left alone (no libusb_detach_kernel_driver, no auto-detach).
+    if (libusb_kernel_driver_active(handle_, number) == 1) return Result::kBusy;
     return resultOf(libusb_claim_interface(handle_, number));
   }
 
@@ -165,14 +221,31 @@ class LibusbPort : public Port {
   }
 
   void close() override {
+    if (leaked_) return;
+    // Cancel what is still in flight and wait for each callback before anything is freed.
+    bool inFlight = cancelInFlight();
+    if (inFlight && context_ != nullptr) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kCallbackWaitS);
+      while ((inFlight = anyInFlight()) && std::chrono::steady_clock::now() < deadline) {
+        timeval timeout{0, 10000};
+        libusb_handle_events_timeout_completed(context_, &timeout, nullptr);
+      }
+    }
+    if (inFlight) {
+      // Freeing now would let libusb write into freed memory: leak the transfers, the handle
+      // and the context instead, and say so.
+      std::fprintf(stderr, "KineticFriction: a USB transfer never came back; its handle is leaked\n");
+      leaked_ = true;
+      return;
+    }
     if (handle_ != nullptr) {
       libusb_close(handle_);
       handle_ = nullptr;
     }
     std::lock_guard<std::mutex> lock(transfersMutex_);
-    for (libusb_transfer* transfer : transfers_) {
-      if (transfer->user_data != nullptr) static_cast<Transfer*>(transfer->user_data)->impl = nullptr;
-      libusb_free_transfer(transfer);
+    for (const std::unique_ptr<Owned>& owned : transfers_) {
+      owned->transfer->impl = nullptr;
+      libusb_free_transfer(owned->raw);
     }
     transfers_.clear();
   }
@@ -187,29 +260,33 @@ class LibusbPort : public Port {
 
   Result clearHalt(uint8_t endpoint) override {
     if (handle_ == nullptr) return Result::kNoDevice;
+    if (endpointBusy(endpoint)) return Result::kBusy;  // the caller's bug: cancel and wait first
     return resultOf(libusb_clear_halt(handle_, endpoint));
   }
 
   Result submit(Transfer& transfer) override {
     if (handle_ == nullptr) return Result::kNoDevice;
-    auto* raw = static_cast<libusb_transfer*>(transfer.impl);
-    if (raw == nullptr) {
-      raw = libusb_alloc_transfer(0);
+    auto* owned = static_cast<Owned*>(transfer.impl);
+    std::lock_guard<std::mutex> lock(transfersMutex_);
+    if (owned == nullptr) {
+      libusb_transfer* raw = libusb_alloc_transfer(0);
       if (raw == nullptr) return Result::kOther;
-      raw->user_data = &transfer;
-      std::lock_guard<std::mutex> lock(transfersMutex_);
-      transfers_.push_back(raw);
-      transfer.impl = raw;
+      transfers_.push_back(std::unique_ptr<Owned>(new Owned{raw, &transfer, false}));
+      owned = transfers_.back().get();
+      transfer.impl = owned;
     }
-    libusb_fill_interrupt_transfer(raw, handle_, transfer.endpoint, transfer.buffer, transfer.length, &onDone,
-                                   &transfer, transfer.timeoutMs);
-    return resultOf(libusb_submit_transfer(raw));
+    if (owned->inFlight) return Result::kBusy;  // its callback has not run: not ours to refill
+    libusb_fill_interrupt_transfer(owned->raw, handle_, transfer.endpoint, transfer.buffer, transfer.length, &onDone,
+                                   owned, transfer.timeoutMs);
+    const Result result = resultOf(libusb_submit_transfer(owned->raw));
+    owned->inFlight = result == Result::kOk;
+    return result;
   }
 
   Result cancel(Transfer& transfer) override {
-    auto* raw = static_cast<libusb_transfer*>(transfer.impl);
-    if (raw == nullptr) return Result::kNotFound;
-    return resultOf(libusb_cancel_transfer(raw));
+    auto* owned = static_cast<Owned*>(transfer.impl);
+    if (owned == nullptr) return Result::kNotFound;
+    return resultOf(libusb_cancel_transfer(owned->raw));
   }
 
   Result handleEvents(int timeoutMs) override {
@@ -219,18 +296,53 @@ class LibusbPort : public Port {
   }
 
  private:
+  struct Owned {
+    libusb_transfer* raw;
+    Transfer* transfer;
+    std::atomic<bool> inFlight;  // submitted, its callback not yet run
+  };
+
   static void LIBUSB_CALL onDone(libusb_transfer* raw) {
-    auto& transfer = *static_cast<Transfer*>(raw->user_data);
+    auto* owned = static_cast<Owned*>(raw->user_data);
+    Transfer& transfer = *owned->transfer;
     transfer.status = statusOf(raw->status);
     transfer.actualLength = raw->actual_length;
+    owned->inFlight = false;  // the callback may resubmit it
     if (transfer.callback != nullptr) transfer.callback(transfer);
+  }
+
+  bool anyInFlight() {
+    std::lock_guard<std::mutex> lock(transfersMutex_);
+    for (const std::unique_ptr<Owned>& owned : transfers_)
+      if (owned->inFlight) return true;
+    return false;
+  }
+
+  bool endpointBusy(uint8_t endpoint) {
+    std::lock_guard<std::mutex> lock(transfersMutex_);
+    for (const std::unique_ptr<Owned>& owned : transfers_)
+      if (owned->inFlight && owned->transfer->endpoint == endpoint) return true;
+    return false;
+  }
+
+  bool cancelInFlight() {
+    std::lock_guard<std::mutex> lock(transfersMutex_);
+    bool any = false;
+    for (const std::unique_ptr<Owned>& owned : transfers_)
+      if (owned->inFlight) {
+        libusb_cancel_transfer(owned->raw);
+        any = true;
+      }
+    return any;
   }
 
   libusb_context* context_ = nullptr;
   libusb_device_handle* handle_ = nullptr;
   std::string serial_;
+  std::string skipped_;
+  bool leaked_ = false;
   std::mutex transfersMutex_;
-  std::vector<libusb_transfer*> transfers_;
+  std::vector<std::unique_ptr<Owned>> transfers_;
 };
 
 }  // namespace

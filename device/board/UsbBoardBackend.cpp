@@ -12,6 +12,10 @@ namespace {
 constexpr uint8_t kVendorOut = 0x41;  // vendor, interface, host to device
 constexpr uint8_t kVendorIn = 0xC1;
 constexpr unsigned kControlTimeoutMs = 200;
+// How long to wait for a callback after cancelling before the transfer is given up as leaked.
+// libusb calls back every cancelled transfer (LIBUSB_TRANSFER_CANCELLED, or its real end if it
+// had finished first), so this is only a bound on a broken stack, not on a slow transfer.
+constexpr double kCallbackWaitS = 10.0;
 
 double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
@@ -52,6 +56,8 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
   usb::Result result = port_->open(options_.ids);
   if (result == usb::Result::kNotFound) {
     error = "no friction board found (" + idsText(options_.ids) + "); is it plugged in?";
+    const std::string skipped = port_->skipped();
+    if (!skipped.empty()) error += " Devices with these IDs that are not a board were left alone: " + skipped;
     return false;
   }
   if (result != usb::Result::kOk) {
@@ -73,17 +79,40 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     error = std::string("the board did not answer GET_VERSION: ") + usb::describe(result);
   } else if (version.protocolMajor != board::kProtocolMajor) {
     error = "the board speaks protocol " + std::to_string(version.protocolMajor) + "." +
-            std::to_string(version.protocolMinor) + ", this host " + std::to_string(board::kProtocolMajor) + ".x";
+            std::to_string(version.protocolMinor) + ", this host " + std::to_string(board::kProtocolMajor) +
+            ".x: update the board's firmware (or KineticFriction) so that both speak " +
+            std::to_string(board::kProtocolMajor) + ".x";
   } else {
-    std::lock_guard<PiMutex> lock(telemetryMutex_);
-    telemetry_.version = version;
-    telemetry_.serial = port_->openSerial();
-    telemetry_.haveStatus = false;
-    return true;
+    {
+      std::lock_guard<PiMutex> lock(telemetryMutex_);
+      telemetry_.version = version;
+      telemetry_.serial = port_->openSerial();
+      telemetry_.haveStatus = false;
+    }
+    // The enumeration's reset (and any fault left from before) is read and cleared here, so
+    // the status frames show only what happens from now on.
+    board::ClearReply cleared;
+    if (clearErrorsLocked(cleared, error)) return true;
   }
   port_->releaseInterface(board::kInterfaceNumber);
   port_->close();
   return false;
+}
+
+bool UsbBoardBackend::clearErrorsLocked(board::ClearReply& reply, std::string& error) {
+  uint8_t data[board::kClearReplySize] = {};
+  int moved = 0;
+  const usb::Result result =
+      port_->control(kVendorIn, static_cast<uint8_t>(board::Request::kClearErrors), 0, board::kInterfaceNumber, data,
+                     board::kClearReplySize, kControlTimeoutMs, &moved);
+  if (result != usb::Result::kOk || !board::decodeClearReply(data, static_cast<size_t>(moved), reply)) {
+    error = std::string("the board did not answer CLEAR_ERRORS: ") + usb::describe(result);
+    return false;
+  }
+  std::lock_guard<PiMutex> lock(telemetryMutex_);
+  telemetry_.lastClear = reply;
+  if (reply.before & board::kErrUsbReset) ++telemetry_.boardResets;
+  return true;
 }
 
 bool UsbBoardBackend::open(std::string& error) {
@@ -119,6 +148,29 @@ bool UsbBoardBackend::arm(std::string& error) {
     error = "the friction board is not connected";
     return false;
   }
+  {
+    // ARM while armed changes nothing, on the board (PROTOCOL.md 5) and here: no restart.
+    std::lock_guard<PiMutex> telemetryLock(telemetryMutex_);
+    if (armed_.load() && telemetry_.haveStatus && telemetry_.status.state == board::BoardState::kArmed) return true;
+  }
+  board::ClearReply cleared;
+  if (!clearErrorsLocked(cleared, error)) return false;
+  if (cleared.remaining & board::kErrOverCurrent) {
+    error =
+        "the board is in fault: over current, and it persists (a shorted or miswired coil?); switch the coil "
+        "supply off, fix it, then arm again";
+    return false;
+  }
+  if (cleared.remaining & board::kErrOverTemperature) {
+    error = "the board is too hot (over temperature); let it cool, then arm again";
+    return false;
+  }
+  if (cleared.remaining & board::kErrSupply) {
+    error = "the board's coil supply is off or too low; switch it on, then arm again";
+    return false;
+  }
+  // From off: set-points carry 0 until the device has restarted its slew limiter.
+  latestDrive_.store(kRestartPending, std::memory_order_relaxed);
   const usb::Result result = port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kArm), board::kArmKey,
                                             board::kInterfaceNumber, nullptr, 0, kControlTimeoutMs, nullptr);
   if (result == usb::Result::kPipe) {
@@ -154,10 +206,22 @@ void UsbBoardBackend::commandForce(double timeS, float forceN) {
 
 void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
   const double level = std::isfinite(driveLevel) ? std::clamp(static_cast<double>(driveLevel), 0.0, 1.0) : 0.0;
-  latestDrive_.store(static_cast<uint16_t>(std::lround(level * board::kDriveFull)), std::memory_order_relaxed);
+  const auto drive = static_cast<uint32_t>(std::lround(level * board::kDriveFull));
+  // A compare-exchange: a frame computed before ARM's restart never overwrites it.
+  uint32_t current = latestDrive_.load(std::memory_order_relaxed);
+  do {
+    if (current & kRestartPending) return;
+  } while (!latestDrive_.compare_exchange_weak(current, drive, std::memory_order_relaxed));
 }
 
-void UsbBoardBackend::driveOff() { latestDrive_.store(0, std::memory_order_relaxed); }
+void UsbBoardBackend::driveOff() { latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed); }
+
+bool UsbBoardBackend::takeRestartFromOff() {
+  uint32_t current = latestDrive_.load(std::memory_order_relaxed);
+  while (current & kRestartPending)
+    if (latestDrive_.compare_exchange_weak(current, 0, std::memory_order_relaxed)) return true;
+  return false;
+}
 
 BoardTelemetry UsbBoardBackend::telemetry() const {
   std::lock_guard<PiMutex> lock(telemetryMutex_);
@@ -179,7 +243,7 @@ void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
 
 void UsbBoardBackend::submitSetPoint(int slot) {
   usb::Transfer& transfer = outTransfers_[slot];
-  const uint16_t drive = armed_.load(std::memory_order_relaxed) ? latestDrive_.load(std::memory_order_relaxed) : 0;
+  const uint16_t drive = armed_.load(std::memory_order_relaxed) ? latestDrive() : 0;
   board::encodeSetPoint({++sequence_, drive}, transfer.buffer);
   const usb::Result result = port_->submit(transfer);
   if (result == usb::Result::kOk) {
@@ -206,9 +270,9 @@ void UsbBoardBackend::submitStatus() {
 void UsbBoardBackend::submitIdle() {
   if (stopping_.load() || unplugged_ || !connected_.load()) return;
   const int inFlight = std::clamp(options_.transfersInFlight, 1, kMaxInFlight);
-  for (int slot = 0; slot < inFlight && !stallPending_ && !unplugged_; ++slot)
+  for (int slot = 0; slot < inFlight && !haltOut_ && !unplugged_; ++slot)
     if (!outBusy_[slot]) submitSetPoint(slot);
-  if (!statusBusy_ && !unplugged_) submitStatus();
+  if (!statusBusy_ && !haltIn_ && !unplugged_) submitStatus();
 }
 
 void UsbBoardBackend::markUnplugged() {
@@ -246,8 +310,8 @@ void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
         break;
       case usb::TransferStatus::kStall:
         ++telemetry_.stalls;
-        stallPending_ = true;
-        return;  // resubmitted once the halt is cleared
+        haltOut_ = true;
+        return;  // resubmitted once every OUT transfer is back and the halt is cleared
       case usb::TransferStatus::kNoDevice:
         break;
       case usb::TransferStatus::kCancelled:
@@ -261,7 +325,7 @@ void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
     markUnplugged();
     return;
   }
-  if (!stopping_.load() && !unplugged_ && !stallPending_) submitSetPoint(slot);
+  if (!stopping_.load() && !unplugged_ && !haltOut_) submitSetPoint(slot);
 }
 
 void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
@@ -273,7 +337,7 @@ void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
   if (transfer.status == usb::TransferStatus::kCancelled) return;
   if (transfer.status == usb::TransferStatus::kStall) {
     // A halted status endpoint is cleared in the loop like the set-point one.
-    stallPending_ = true;
+    haltIn_ = true;
     std::lock_guard<PiMutex> lock(telemetryMutex_);
     ++telemetry_.stalls;
     return;
@@ -302,9 +366,27 @@ bool UsbBoardBackend::anyOutInFlight() const {
 
 bool UsbBoardBackend::anyInFlight() const { return statusBusy_ || anyOutInFlight(); }
 
-void UsbBoardBackend::waitForTransfers(double timeoutS) {
-  const double deadlineS = steadyS() + timeoutS;
-  while (anyInFlight() && steadyS() < deadlineS) port_->handleEvents(5);
+bool UsbBoardBackend::waitForTransfers() {
+  // No shorter bound: a transfer's callback may come as late as its timeout, or later under
+  // load, and until it ran libusb owns the transfer (UsbPort.hpp).
+  const double deadlineS = steadyS() + kCallbackWaitS;
+  while (anyInFlight()) {
+    if (steadyS() > deadlineS) {
+      std::lock_guard<PiMutex> lock(telemetryMutex_);
+      telemetry_.transfersLeaked = true;
+      telemetry_.lastError = "a USB transfer never came back; it was not freed";
+      return false;
+    }
+    port_->handleEvents(5);
+  }
+  return true;
+}
+
+void UsbBoardBackend::cancelAll() {
+  for (int slot = 0; slot < kMaxInFlight; ++slot)
+    if (outBusy_[slot]) port_->cancel(outTransfers_[slot]);
+  if (statusBusy_) port_->cancel(statusTransfer_);
+  if (zeroBusy_) port_->cancel(zeroTransfer_);
 }
 
 void UsbBoardBackend::dropHandle() {
@@ -322,18 +404,20 @@ void UsbBoardBackend::run() {
     if (connected_.load()) {
       port_->handleEvents(5);
       if (unplugged_) {
-        waitForTransfers(0.5);  // they come back with kNoDevice
+        cancelAll();
+        waitForTransfers();  // they come back with kNoDevice: only then is the handle dropped
         dropHandle();
-        for (bool& busy : outBusy_) busy = false;
-        statusBusy_ = zeroBusy_ = false;  // whatever did not come back is gone with the handle
         nextReopenS_ = steadyS() + options_.reopenPeriodS;
         continue;
       }
-      if (stallPending_ && !anyOutInFlight()) {
-        const usb::Result cleared = port_->clearHalt(board::kSetPointEndpoint);
-        port_->clearHalt(board::kStatusEndpoint);
-        if (cleared == usb::Result::kNoDevice) markUnplugged();
-        stallPending_ = false;
+      // A halt is cleared only on an endpoint with nothing in flight (libusb_clear_halt).
+      if (haltOut_ && !anyOutInFlight()) {
+        if (port_->clearHalt(board::kSetPointEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        haltOut_ = false;
+      }
+      if (haltIn_ && !statusBusy_) {
+        if (port_->clearHalt(board::kStatusEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        haltIn_ = false;
       }
       submitIdle();
     } else {
@@ -349,7 +433,7 @@ void UsbBoardBackend::run() {
         // Found again: a fresh board, disarmed until armed again.
         armed_.store(false);
         unplugged_ = false;
-        stallPending_ = false;
+        haltOut_ = haltIn_ = false;
         lastOutDoneS_ = -1.0;
         connected_.store(true);
         std::lock_guard<PiMutex> telemetryLock(telemetryMutex_);
@@ -366,22 +450,24 @@ void UsbBoardBackend::run() {
 void UsbBoardBackend::shutdownLink() {
   if (connected_.load() && !unplugged_) {
     // Cancel what is queued and wait for every callback, so no transfer is left in flight.
-    for (int slot = 0; slot < kMaxInFlight; ++slot)
-      if (outBusy_[slot]) port_->cancel(outTransfers_[slot]);
-    if (statusBusy_) port_->cancel(statusTransfer_);
-    waitForTransfers(0.5);
+    cancelAll();
+    waitForTransfers();
     // The last set-point: drive 0. Then DISARM, release, close.
     board::encodeSetPoint({++sequence_, 0}, zeroTransfer_.buffer);
     if (port_->submit(zeroTransfer_) == usb::Result::kOk) {
       zeroBusy_ = true;
-      waitForTransfers(0.1);
+      const double giveUpS = steadyS() + 0.1;  // a board that takes nothing: DISARM does it
+      while (zeroBusy_ && steadyS() < giveUpS) port_->handleEvents(5);
+      cancelAll();
+      waitForTransfers();
     }
     armed_.store(false);
     std::lock_guard<std::mutex> lock(portMutex_);
     port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0, board::kInterfaceNumber, nullptr, 0,
                    kControlTimeoutMs, nullptr);
   } else if (connected_.load()) {
-    waitForTransfers(0.5);
+    cancelAll();
+    waitForTransfers();
   }
   if (connected_.load()) dropHandle();
   std::lock_guard<std::mutex> lock(portMutex_);

@@ -2,11 +2,15 @@
 // usb::Port (libusb, or the emulator in tests). One event thread of its own keeps a few
 // set-point OUT transfers in flight, each filled with the latest drive level when it is
 // (re)submitted, and one status IN transfer. Partial, stalled and timed-out transfers are
-// counted and retried (a stall after clearing the halt); kNoDevice is an unplug: the handle
-// is dropped and the board looked for again, and a board found again stays disarmed until
-// armed again. close(): cancel, wait for the callbacks, one set-point of drive 0, DISARM,
-// release, close. commandDrive/driveOff are lock-free (the device thread, or the audio thread
-// in lockstep); open, close, arm and disarm run on a non-realtime thread.
+// counted and retried (a stalled endpoint once its transfers are back and its halt cleared);
+// kNoDevice is an unplug: every callback is waited for, the handle dropped and the board looked
+// for again, and a board found again stays disarmed until armed again. A transfer is reused or
+// freed only after its callback ran. open and arm send CLEAR_ERRORS (a reset is reported once,
+// a fault that persists refuses the ARM); ARM starts the drive from off, so the device's slew
+// limiter brings it up (takeRestartFromOff). close(): cancel, wait for the callbacks, one
+// set-point of drive 0, DISARM, release, close. commandDrive/driveOff are lock-free (the
+// device thread, or the audio thread in lockstep); open, close, arm and disarm run on a
+// non-realtime thread.
 #pragma once
 
 #include <atomic>
@@ -26,7 +30,11 @@
 namespace kf {
 
 struct BoardOptions {
-  usb::DeviceIds ids{board::kVendorId, board::kProductId, ""};
+  usb::DeviceIds ids{
+      board::kVendorId,
+      board::kProductId,
+      "",
+      {board::kInterfaceNumber, board::kInterfaceClass, board::kInterfaceSubclass, board::kInterfaceProtocol}};
   int transfersInFlight = 2;  // set-points queued on EP 0x01 (1..4): each ~1 ms of latency
   unsigned transferTimeoutMs = 20;
   double reopenPeriodS = 0.25;   // after an unplug, how often to look for the board
@@ -56,6 +64,9 @@ struct BoardTelemetry {
   uint64_t badStatus = 0;  // short or damaged status frames
   uint64_t unplugs = 0;
   uint64_t reopens = 0;
+  uint64_t boardResets = 0;      // power-on, bus resets, suspends the board reported (CLEAR_ERRORS)
+  board::ClearReply lastClear;   // the last CLEAR_ERRORS answer
+  bool transfersLeaked = false;  // a callback never came back: its transfer was never freed
 };
 
 class UsbBoardBackend : public ForceBackend {
@@ -76,19 +87,25 @@ class UsbBoardBackend : public ForceBackend {
   void commandForce(double timeS, float forceN) override;
   void commandDrive(double timeS, float forceN, float driveLevel) override;
   void driveOff() override;
+  bool takeRestartFromOff() override;
 
   BoardTelemetry telemetry() const;
   ThreadScheduling threadScheduling() const { return threadScheduling_.load(); }
-  uint16_t latestDrive() const { return latestDrive_.load(std::memory_order_relaxed); }
+  uint16_t latestDrive() const { return static_cast<uint16_t>(latestDrive_.load(std::memory_order_relaxed) & 0xFFFFu); }
 
  private:
   static constexpr int kMaxInFlight = 4;
+  // In latestDrive_ above the 16 drive bits: ARM happened and the device has not yet reset its
+  // slew limiter; until it has, frames store drive 0 (they were computed before the reset).
+  static constexpr uint32_t kRestartPending = 1u << 16;
 
   static void onTransfer(usb::Transfer& transfer);
   void onSetPoint(usb::Transfer& transfer);
   void onStatus(usb::Transfer& transfer);
   void run();
   bool connectLocked(std::string& error);  // portMutex_ held
+  // CLEAR_ERRORS, portMutex_ held: what was set and what persists, counted in the telemetry.
+  bool clearErrorsLocked(board::ClearReply& reply, std::string& error);
   void submitSetPoint(int slot);
   void submitStatus();
   void submitIdle();
@@ -96,7 +113,10 @@ class UsbBoardBackend : public ForceBackend {
   void dropHandle();
   bool anyInFlight() const;
   bool anyOutInFlight() const;
-  void waitForTransfers(double timeoutS);
+  // Runs events until every callback ran (however long their timeouts); false (and the
+  // transfers leaked, never freed) if one has not come back after kCallbackWaitS.
+  bool waitForTransfers();
+  void cancelAll();
   void shutdownLink();
   void setError(const std::string& error);
 
@@ -113,11 +133,12 @@ class UsbBoardBackend : public ForceBackend {
   bool zeroBusy_ = false;
   uint16_t sequence_ = 0;
   double lastOutDoneS_ = -1.0;
-  bool stallPending_ = false;
+  bool haltOut_ = false;  // EP 0x01 stalled: cleared once no OUT transfer is in flight
+  bool haltIn_ = false;   // EP 0x81 likewise
   bool unplugged_ = false;
   double nextReopenS_ = 0.0;
 
-  std::atomic<uint16_t> latestDrive_{0};
+  std::atomic<uint32_t> latestDrive_{0};  // drive bits, and kRestartPending
   std::atomic<bool> armed_{false};
   std::atomic<bool> connected_{false};
   std::atomic<bool> stopping_{false};

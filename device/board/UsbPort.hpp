@@ -3,6 +3,10 @@
 // context, open by IDs and serial, claim/release, synchronous control requests, asynchronous
 // interrupt transfers (submit, cancel, callbacks run by handleEvents), clear halt, close.
 // Thread rules are libusb's: handleEvents on one thread; control, submit and cancel from any.
+// Life cycle (libusb's API docs, "asynchronous I/O"): a submitted transfer is the library's
+// until its callback ran — cancel only asks for that callback, so its storage is not reused or
+// freed before; clearHalt only on an endpoint with no transfer in flight ("cancel all pending
+// transfers before attempting to clear the halt condition", libusb_clear_halt).
 #pragma once
 
 #include <cstdint>
@@ -35,10 +39,26 @@ struct Transfer {
   void* impl = nullptr;  // the port's own (libusb_transfer*)
 };
 
+// The interface a device must have to be ours: checked from its descriptors before it is
+// opened, so a stranger that shares the IDs (test IDs are shared) is never opened, claimed or
+// detached from its kernel driver.
+struct InterfaceIdentity {
+  int number = 0;
+  uint8_t interfaceClass = 0;
+  uint8_t subclass = 0;
+  uint8_t protocol = 0;
+};
+
+// What keeps a device from being ours: "" when interface `found` is `wanted`; else e.g.
+// "interface 0 is class 0x03 subclass 0x01 protocol 0x02, not the board's 0xff/0x4b/0x01".
+// found == nullptr: the device has no such interface.
+std::string interfaceMismatch(const InterfaceIdentity* found, const InterfaceIdentity& wanted);
+
 struct DeviceIds {
   uint16_t vendorId = 0;
   uint16_t productId = 0;
   std::string serial;  // empty: the first device with the IDs
+  InterfaceIdentity iface;
 };
 
 class Port {
@@ -46,12 +66,18 @@ class Port {
   virtual ~Port() = default;
   virtual Result init() = 0;  // an own context, not libusb's default one
   virtual void exit() = 0;
-  // Opens the device with these IDs (and serial). kNotFound when none matches.
+  // Opens the device with these IDs (and serial) whose interface ids.iface.number has the
+  // class, subclass and protocol of ids.iface. kNotFound when none matches; skipped() then
+  // names the devices that had the IDs but not the interface (left untouched).
   virtual Result open(const DeviceIds& ids) = 0;
+  virtual std::string skipped() const = 0;
   virtual std::string openSerial() const = 0;  // of the open device
+  // Never detaches a kernel driver: kBusy when one (or another program) holds the interface.
   virtual Result claimInterface(int number) = 0;
   virtual void releaseInterface(int number) = 0;
-  virtual void close() = 0;  // every transfer must be back first
+  // Every transfer must be back first (its callback ran); one that is not is cancelled and
+  // waited for, and if it never comes back it is leaked with its handle, never freed.
+  virtual void close() = 0;
   // Synchronous control request; *transferred gets the data bytes moved.
   virtual Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data,
                          uint16_t length, unsigned timeoutMs, int* transferred) = 0;

@@ -114,6 +114,7 @@ void Device::pump(double nowS, double scheduledS) {
 }
 
 void Device::applyFrameLocked(const ForceFrame& frame, double commandS, double nowS) {
+  if (board_ && board_->takeRestartFromOff()) safety_.resetToOff();  // armed: up from the minimum
   const float commandedN = safety_.applyFrame(frame, nowS);
   if (!lockstep_) telemetry_.forceLatency.record(nowS - frame.endedHostS);
   force_->commandDrive(commandS, commandedN, safety_.driveLevel());

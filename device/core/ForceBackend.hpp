@@ -22,6 +22,10 @@ class ForceBackend {
   // driveOff() only stores values; a backend that talks to hardware through a library must
   // override it (e.g. a write(2) of a prepared off command on its open descriptor).
   virtual void driveOffFromSignal() noexcept { driveOff(); }
+  // True once after the magnet was switched on from off by the backend's own request (a board
+  // armed): the device then restarts its slew limiter from minForceN before the next frame, so
+  // the force rises from the minimum at the slew limit instead of jumping to the last request.
+  virtual bool takeRestartFromOff() { return false; }
 };
 
 // The force side of a device without a magnet (replay, a mouse alone): counts what it is told.

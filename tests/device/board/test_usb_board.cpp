@@ -36,6 +36,14 @@ std::unique_ptr<UsbBoardBackend> openBoard(const std::shared_ptr<EmulatedUsb>& b
   return backend;
 }
 
+// Arms a board driven without a Device, playing the device's part: ARM restarts the force from
+// off, and the device acknowledges that (takeRestartFromOff) before its next frame.
+bool armAlone(UsbBoardBackend& backend, std::string& error) {
+  if (!backend.arm(error)) return false;
+  backend.takeRestartFromOff();
+  return true;
+}
+
 }  // namespace
 
 TEST_CASE("board emulator: the watchdog turns the current off 20 ms after the last valid frame", "[board]") {
@@ -96,7 +104,9 @@ TEST_CASE("board driver: set-points reach the board at 1 kHz once armed", "[boar
   CHECK(bus->drive() == 0);  // not armed: drive 0 goes out
   CHECK(bus->validFrames() > 10);
   std::string error;
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
+  CHECK(bus->drive() == 0);                // ARM starts from off: the drive commanded before it is not sent
+  backend->commandDrive(0.0, 0.8f, 0.5f);  // the first frame after ARM
   CHECK(waitFor([&] { return bus->drive() == 32768; }));
   const uint64_t before = bus->validFrames();
   const auto start = std::chrono::steady_clock::now();
@@ -124,7 +134,7 @@ TEST_CASE("board driver: close sends drive 0, disarms, releases and closes", "[b
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);
   std::string error;
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
   backend->commandDrive(0.0, 1.4f, 1.0f);
   REQUIRE(waitFor([&] { return bus->drive() == kDriveFull; }));
   const double closeS = bus->nowS();
@@ -148,7 +158,7 @@ TEST_CASE("board driver: timeouts, partial transfers and a stall are counted and
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);
   std::string error;
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
   backend->commandDrive(0.0, 1.0f, 0.25f);
   REQUIRE(waitFor([&] { return bus->drive() == 16384; }));
   bus->timeOutNextOut(3);
@@ -176,7 +186,7 @@ TEST_CASE("board driver: unplug mid-transfer, replug stays disarmed until armed"
   options.reopenPeriodS = 0.05;
   auto backend = openBoard(bus, options);
   std::string error;
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
   backend->commandDrive(0.0, 1.0f, 0.75f);
   REQUIRE(waitFor([&] { return bus->drive() == 49151; }));
   const double unplugS = bus->nowS();
@@ -196,7 +206,8 @@ TEST_CASE("board driver: unplug mid-transfer, replug stays disarmed until armed"
   REQUIRE(waitFor([&] { return bus->validFrames() > frames + 30; }));
   CHECK(bus->drive() == 0);
   CHECK(bus->state() == BoardState::kDisarmed);
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
+  backend->commandDrive(0.0, 1.0f, 0.75f);
   CHECK(waitFor([&] { return bus->drive() == 49151; }));
 }
 
@@ -233,7 +244,7 @@ TEST_CASE("board driver: a host that stops sending leaves it to the board's watc
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);
   std::string error;
-  REQUIRE(backend->arm(error));
+  REQUIRE(armAlone(*backend, error));
   backend->commandDrive(0.0, 1.0f, 1.0f);
   REQUIRE(waitFor([&] { return bus->drive() == kDriveFull; }));
   bus->timeOutNextOut(1000000);  // nothing gets through any more
