@@ -178,6 +178,8 @@ TEST_CASE("board driver: timeouts, partial transfers and a stall are counted and
   CHECK(t.lostTransfers >= 5);
   CHECK(t.connected);
   CHECK(bus->drive() == 16384);
+  CHECK(bus->haltsInFlight() == 0);  // each halt was cleared with nothing in flight on its endpoint
+  CHECK(bus->resubmitsInFlight() == 0);
 }
 
 TEST_CASE("board driver: unplug mid-transfer, replug stays disarmed until armed", "[board]") {

@@ -1,0 +1,199 @@
+// The board driver's life cycle against the emulated bus: the interface checked before a
+// device with the (shared test) IDs is touched, the protocol version, CLEAR_ERRORS on open and
+// before ARM, ARM through the slew limiter, and libusb's transfer rules with callbacks that
+// arrive late (EmulatedUsb counts every breach).
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <thread>
+
+#include "board/EmulatedUsb.hpp"
+#include "board/UsbBoardBackend.hpp"
+#include "core/Device.hpp"
+#include "recordings/ReplayBackend.hpp"
+
+using namespace kf;
+using namespace kf::board;
+using namespace std::chrono_literals;
+
+namespace {
+
+template <class Done>
+bool waitFor(Done done, std::chrono::milliseconds limit = 3000ms) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!done()) {
+    if (std::chrono::steady_clock::now() - start > limit) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+std::shared_ptr<UsbBoardBackend> openBoard(const std::shared_ptr<EmulatedUsb>& bus, BoardOptions options = {}) {
+  auto backend = std::make_shared<UsbBoardBackend>(bus->makePort(), options);
+  std::string error;
+  INFO(error);
+  REQUIRE(backend->open(error));
+  return backend;
+}
+
+// A device's part when the driver runs alone: ARM restarts from off, acknowledged at once.
+bool armAlone(UsbBoardBackend& backend, std::string& error) {
+  if (!backend.arm(error)) return false;
+  backend.takeRestartFromOff();
+  return true;
+}
+
+void checkNoBreach(EmulatedUsb& bus) {
+  CHECK(bus.closesInFlight() == 0);
+  CHECK(bus.resubmitsInFlight() == 0);
+  CHECK(bus.haltsInFlight() == 0);
+}
+
+}  // namespace
+
+TEST_CASE("board identity: a stranger with the test IDs is never touched", "[board]") {
+  const usb::InterfaceIdentity board{kInterfaceNumber, kInterfaceClass, kInterfaceSubclass, kInterfaceProtocol};
+  CHECK(usb::interfaceMismatch(&board, board).empty());
+  const usb::InterfaceIdentity keyboard{0, 0x03, 0x01, 0x01};
+  CHECK(usb::interfaceMismatch(&keyboard, board).find("class 0x03") != std::string::npos);
+  CHECK_FALSE(usb::interfaceMismatch(nullptr, board).empty());
+  for (const usb::InterfaceIdentity& other :
+       {usb::InterfaceIdentity{0, 0xFF, 0x00, 0x01}, usb::InterfaceIdentity{0, 0xFF, 0x4B, 0x02}})
+    CHECK_FALSE(usb::interfaceMismatch(&other, board).empty());  // subclass, protocol
+
+  auto bus = EmulatedUsb::create();
+  bus->addStranger(keyboard);
+  auto backend = openBoard(bus);  // the board after it is found, the stranger left alone
+  CHECK(backend->telemetry().serial == "KF-EMU-0001");
+  backend->close();
+  bus->unplug();  // only the stranger is left
+  UsbBoardBackend alone(bus->makePort());
+  std::string error;
+  CHECK_FALSE(alone.open(error));
+  INFO(error);
+  CHECK(error.find("no friction board found") != std::string::npos);
+  CHECK(error.find("left alone") != std::string::npos);
+  CHECK(error.find("class 0x03") != std::string::npos);
+  CHECK(bus->strangerTouches() == 0);
+}
+
+TEST_CASE("board version: a board of another protocol major is refused with what to do", "[board]") {
+  auto bus = EmulatedUsb::create();
+  bus->setProtocolMajor(1);
+  UsbBoardBackend backend(bus->makePort());
+  std::string error;
+  CHECK_FALSE(backend.open(error));
+  INFO(error);
+  CHECK(error.find("speaks protocol 1.0, this host 2.x") != std::string::npos);
+  CHECK(error.find("firmware") != std::string::npos);
+  CHECK_FALSE(bus->isOpen());
+  CHECK(bus->interfaceReleases() == 1);
+}
+
+TEST_CASE("board errors: open and arm clear them; a reset is reported once; a persisting fault refuses ARM",
+          "[board]") {
+  auto bus = EmulatedUsb::create();
+  auto backend = openBoard(bus);
+  BoardTelemetry t = backend->telemetry();
+  CHECK(t.boardResets == 1);  // the enumeration, read and acknowledged by open
+  CHECK((t.lastClear.before & kErrUsbReset) != 0);
+  REQUIRE(waitFor([&] { return backend->telemetry().haveStatus; }));
+  CHECK((backend->telemetry().status.errors & kErrUsbReset) == 0);  // not stuck
+
+  bus->busReset();  // mid-session: the board disarms and says why
+  REQUIRE(waitFor([&] {
+    const BoardTelemetry now = backend->telemetry();
+    return (now.status.errors & kErrUsbReset) != 0 && now.status.state == BoardState::kDisarmed;
+  }));
+  std::string error;
+  REQUIRE(armAlone(*backend, error));  // CLEAR_ERRORS first: the reset counted, then cleared
+  CHECK(backend->telemetry().boardResets == 2);
+  REQUIRE(waitFor([&] { return backend->telemetry().status.state == BoardState::kArmed; }));
+  CHECK((backend->telemetry().status.errors & kErrUsbReset) == 0);
+
+  bus->overCurrent(/*persists=*/true);
+  REQUIRE(waitFor([&] { return backend->telemetry().status.state == BoardState::kFault; }));
+  CHECK_FALSE(backend->arm(error));
+  CHECK(error.find("over current") != std::string::npos);
+  CHECK(error.find("persists") != std::string::npos);
+  CHECK(bus->state() == BoardState::kFault);
+  bus->setOverCurrent(false);  // fixed: no power cycle needed
+  REQUIRE(armAlone(*backend, error));
+  CHECK(bus->state() == BoardState::kArmed);
+  backend->close();
+  checkNoBreach(*bus);
+}
+
+TEST_CASE("board arm: the force starts from the minimum through the slew limiter", "[board]") {
+  DeviceSpec spec;
+  spec.maxForceSlewNPerS = 100.0;  // 0.1 N per 1 ms frame: 13 frames from min to max
+  auto bus = EmulatedUsb::create();
+  std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
+  Device device(spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
+                std::make_shared<CountingForceSink>(), /*lockstep=*/true);
+  REQUIRE(device.attachBoard(board) == nullptr);
+  device.pump(0.0);  // lockstep: frames pushed from now on are applied at once
+  double frameS = 0.0;
+  auto frame = [&](float forceN) {
+    frameS += spec.forceFramePeriodS;
+    device.pushForceFrame({frameS, forceN, frameS});
+    return board->latestDrive();
+  };
+  for (int i = 0; i < 40; ++i) frame(1.4f);  // disarmed: the request has slewed up to the top
+  REQUIRE(board->latestDrive() == kDriveFull);
+  std::string error;
+  REQUIRE(board->arm(error));
+  CHECK(board->latestDrive() == 0);
+  const uint64_t frames = bus->validFrames();
+  REQUIRE(waitFor([&] { return bus->validFrames() > frames + 5; }));
+  CHECK(bus->drive() == 0);  // no frame since ARM: the board is not driven to the old request
+  // One frame's worth of slew in drive units (linear table): 0.1 N of 1.26 N, +1 for rounding.
+  const double maxStep =
+      spec.maxForceSlewNPerS * spec.forceFramePeriodS / (spec.maxForceN - spec.minForceN) * kDriveFull + 1.0;
+  uint16_t previous = 0;
+  int steps = 0;
+  while (previous < kDriveFull && steps < 100) {
+    const uint16_t drive = frame(1.4f);
+    CHECK(drive - previous <= maxStep);
+    CHECK(drive > previous);
+    previous = drive;
+    ++steps;
+  }
+  CHECK(steps == 13);  // 1.26 N at 0.1 N a frame
+  REQUIRE(waitFor([&] { return bus->drive() == kDriveFull; }));
+  device.close();
+}
+
+TEST_CASE("board transfers: close waits for callbacks that arrive late, whatever the timeout", "[board]") {
+  auto bus = EmulatedUsb::create();
+  BoardOptions options;
+  options.transferTimeoutMs = 2000;  // set-points the board never takes stay in flight 2 s
+  auto backend = openBoard(bus, options);
+  std::string error;
+  REQUIRE(armAlone(*backend, error));
+  backend->commandDrive(0.0, 1.0f, 0.5f);
+  REQUIRE(waitFor([&] { return bus->drive() == 32768; }));
+  bus->timeOutNextOut(1000000);
+  bus->delayCallbacks(0.6);  // longer than any fixed wait the driver had
+  std::this_thread::sleep_for(10ms);
+  backend->close();
+  checkNoBreach(*bus);
+  CHECK_FALSE(bus->isOpen());
+  CHECK(bus->state() == BoardState::kDisarmed);
+  CHECK_FALSE(backend->telemetry().transfersLeaked);
+}
+
+TEST_CASE("board transfers: an unplug drops the handle only after every late callback", "[board]") {
+  auto bus = EmulatedUsb::create();
+  BoardOptions options;
+  options.reopenPeriodS = 0.05;
+  auto backend = openBoard(bus, options);
+  bus->delayCallbacks(0.6);
+  bus->unplug();
+  REQUIRE(waitFor([&] { return !backend->telemetry().connected; }));
+  bus->delayCallbacks(0.0);
+  bus->replug();
+  REQUIRE(waitFor([&] { return backend->telemetry().connected; }));
+  CHECK(backend->telemetry().reopens == 1);
+  backend->close();
+  checkNoBreach(*bus);
+}
