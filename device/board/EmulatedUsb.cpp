@@ -166,7 +166,9 @@ class EmulatedPort : public usb::Port {
       double earliestS = deadlineS;
       for (auto it = bus_->pending_.begin(); it != bus_->pending_.end(); ++it) {
         if (it->owner != this) continue;  // another host's transfer: its own thread runs it
-        const double dueS = it->dueS + bus_->callbackDelayS_;
+        const bool delayed =
+            bus_->callbackDelayEndpoint_ == 0 || bus_->callbackDelayEndpoint_ == it->transfer->endpoint;
+        const double dueS = it->dueS + (delayed ? bus_->callbackDelayS_ : 0.0);
         if (dueS <= nowS && (next == bus_->pending_.end() || dueS < nextDueS)) {
           next = it;
           nextDueS = dueS;
@@ -271,9 +273,10 @@ void EmulatedUsb::setProtocolMajor(uint8_t major) {
   std::lock_guard<std::mutex> lock(mutex_);
   board_.setProtocolMajor(major);
 }
-void EmulatedUsb::delayCallbacks(double seconds) {
+void EmulatedUsb::delayCallbacks(double seconds, uint8_t endpoint) {
   std::lock_guard<std::mutex> lock(mutex_);
   callbackDelayS_ = seconds;
+  callbackDelayEndpoint_ = endpoint;
   changed_.notify_all();
 }
 void EmulatedUsb::addStranger(usb::InterfaceIdentity iface) {

@@ -41,9 +41,10 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void overCurrent(bool persists);  // the board trips to fault; `persists`: CLEAR_ERRORS cannot clear it
   void setOverCurrent(bool present);
   void setProtocolMajor(uint8_t major);
-  // Every transfer's callback (completed, cancelled, unplugged) comes this much later than due:
-  // a host that frees or closes before its callbacks ran is caught.
-  void delayCallbacks(double seconds);
+  // Every transfer's callback (completed, cancelled, unplugged) on `endpoint` (0: on every
+  // endpoint) comes this much later than due: a host that frees or closes before its
+  // callbacks ran is caught.
+  void delayCallbacks(double seconds, uint8_t endpoint = 0);
   // A device with the board's IDs but another interface, listed before the board.
   void addStranger(usb::InterfaceIdentity iface);
   int strangerTouches();  // opens, claims, control requests on strangers: must stay 0
@@ -93,6 +94,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   std::vector<Pending> pending_;
   int claims_ = 0, releases_ = 0, clearHalts_ = 0, openHandles_ = 0;
   double callbackDelayS_ = 0.0;
+  uint8_t callbackDelayEndpoint_ = 0;
   std::vector<usb::InterfaceIdentity> strangers_;
   int strangerTouches_ = 0;
   int closesInFlight_ = 0, resubmitsInFlight_ = 0, haltsInFlight_ = 0;
