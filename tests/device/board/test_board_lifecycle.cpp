@@ -187,6 +187,7 @@ TEST_CASE("board transfers: an unplug drops the handle only after every late cal
   BoardOptions options;
   options.reopenPeriodS = 0.05;
   auto backend = openBoard(bus, options);
+  REQUIRE(waitFor([&] { return backend->telemetry().haveStatus && bus->validFrames() > 5; }));  // in flight
   // The status transfer reports the unplug at once; the set-points' callbacks come 0.6 s later.
   bus->delayCallbacks(0.6, kSetPointEndpoint);
   bus->unplug();
