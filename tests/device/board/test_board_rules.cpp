@@ -104,6 +104,12 @@ TEST_CASE("board rules: the watchdog is idle while disarmed and starts with ARM"
   CHECK(board.state() == BoardState::kArmed);  // still armed: the next set-point drives
   send(board, 2, 500, 1.03);
   CHECK(board.drive() == 500);
+  // Disarmed after a set-point: the watchdog stops with it and reports nothing.
+  clearErrors(board, 1.031);
+  REQUIRE(board.control(kOut, static_cast<uint8_t>(Request::kDisarm), 0, nullptr, 0, nullptr, 1.032) ==
+          usb::Result::kOk);
+  board.advance(1.2);
+  CHECK(board.errors() == 0);
 }
 
 TEST_CASE("board rules: suspend and bus reset turn the current off and disarm", "[board]") {
