@@ -109,8 +109,11 @@ bool openStage(World*, void* raw) {  // NRT
     failWith(data, "kfBoardOpen: %s", error.c_str());
     return false;
   }
-  // The board replaced, if any, closes here (NRT) as the last reference goes.
+  // The board replaced, if any, closes here (NRT) as the last reference goes. A new board starts
+  // with the linear table: another board's table must not drive it (kfBoardCalibrate checks).
   data->device->attachBoard(board);
+  data->device->setCalibration(
+      kf::CalibrationTable::linear(data->device->spec().minForceN, data->device->spec().maxForceN));
   const kf::BoardTelemetry t = board->telemetry();
   Print("kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA) is disarmed\n",
         data->args.index, t.serial.c_str(), emulate ? " (emulated)" : "", t.version.protocolMajor,
@@ -155,9 +158,18 @@ bool calibrateStage(World*, void* raw) {  // NRT
   const kf::DeviceSpec& spec = data->device->spec();
   kf::CalibrationTable table = kf::CalibrationTable::linear(spec.minForceN, spec.maxForceN);
   std::string error;
-  if (data->args.path[0] != '\0' && !kf::CalibrationTable::load(data->args.path, table, error)) {
-    failWith(data, "kfBoardCalibrate: %s", error.c_str());
-    return false;
+  if (data->args.path[0] != '\0') {
+    // A table drives only the board it was measured on (CalibrationTable::checkBoard).
+    const std::shared_ptr<kf::ForceBackend> holder = data->device->board();
+    const auto* board = dynamic_cast<const kf::UsbBoardBackend*>(holder.get());
+    if (!kf::CalibrationTable::load(data->args.path, table, error)) {
+      failWith(data, "kfBoardCalibrate: %s", error.c_str());
+      return false;
+    }
+    if (!table.checkBoard(board != nullptr ? board->telemetry().serial : "", error)) {
+      failWith(data, "kfBoardCalibrate: %s", error.c_str());
+      return false;
+    }
   }
   data->device->setCalibration(table);
   return true;

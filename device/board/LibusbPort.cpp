@@ -61,19 +61,18 @@ const char* describe(TransferStatus status) {
 }
 
 std::string interfaceMismatch(const InterfaceIdentity* found, const InterfaceIdentity& wanted) {
-  char text[160];
+  char text[96];
   if (found == nullptr) {
-    std::snprintf(text, sizeof text, "has no interface %d: not a friction board, not touched", wanted.number);
+    std::snprintf(text, sizeof text, "no interface %d", wanted.number);
     return text;
   }
   if (found->interfaceClass == wanted.interfaceClass && found->subclass == wanted.subclass &&
       found->protocol == wanted.protocol)
     return "";
-  std::snprintf(text, sizeof text,
-                "interface %d is class 0x%02x subclass 0x%02x protocol 0x%02x, not the board's 0x%02x/0x%02x/0x%02x: "
-                "not a friction board, not touched",
-                wanted.number, found->interfaceClass, found->subclass, found->protocol, wanted.interfaceClass,
-                wanted.subclass, wanted.protocol);
+  // class/subclass/protocol, short: it goes into a /kfFail reason of 200 characters.
+  std::snprintf(text, sizeof text, "interface %d is class %02x/%02x/%02x, not %02x/%02x/%02x", wanted.number,
+                found->interfaceClass, found->subclass, found->protocol, wanted.interfaceClass, wanted.subclass,
+                wanted.protocol);
   return text;
 }
 

@@ -57,7 +57,7 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
   if (result == usb::Result::kNotFound) {
     error = "no friction board found (" + idsText(options_.ids) + "); is it plugged in?";
     const std::string skipped = port_->skipped();
-    if (!skipped.empty()) error += " Devices with these IDs that are not a board were left alone: " + skipped;
+    if (!skipped.empty()) error += " Left alone, not a board: " + skipped;
     return false;
   }
   if (result != usb::Result::kOk) {

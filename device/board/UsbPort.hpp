@@ -50,7 +50,7 @@ struct InterfaceIdentity {
 };
 
 // What keeps a device from being ours: "" when interface `found` is `wanted`; else e.g.
-// "interface 0 is class 0x03 subclass 0x01 protocol 0x02, not the board's 0xff/0x4b/0x01".
+// "interface 0 is class 03/01/02, not ff/4b/01" (class/subclass/protocol).
 // found == nullptr: the device has no such interface.
 std::string interfaceMismatch(const InterfaceIdentity* found, const InterfaceIdentity& wanted);
 

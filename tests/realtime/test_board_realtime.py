@@ -53,7 +53,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         s.sync;
     """, jack, name="board"))
     lines = run.output.splitlines()
-    assert any(re.match(r"^kfBoardOpen 5 board KF-EMU-0001 \(emulated\) \(protocol 1\.0", l) for l in lines), \
+    assert any(re.match(r"^kfBoardOpen 5 board KF-EMU-0001 \(emulated\) \(protocol 2\.0", l) for l in lines), \
         run.output[-3000:]
     assert "kfBoardArm 5 board armed" in run.output
     assert any(l.startswith("kfBoardArm: no device is open at index 6") for l in lines)

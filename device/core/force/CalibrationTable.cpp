@@ -80,7 +80,8 @@ bool CalibrationTable::parse(const std::string& text, CalibrationTable& out, std
       continue;
     }
     if (first == "serial") {
-      fields >> serial;
+      std::string rest;
+      if (!(fields >> serial) || (fields >> rest)) return fail("expected \"serial <the board's USB serial>\"");
       continue;
     }
     CalibrationPoint point;
@@ -98,6 +99,26 @@ bool CalibrationTable::parse(const std::string& text, CalibrationTable& out, std
   if (!fromPoints(std::move(points), table, error)) return false;
   table.serial_ = serial;
   out = std::move(table);
+  return true;
+}
+
+bool CalibrationTable::checkBoard(const std::string& boardSerial, std::string& error) const {
+  // Short enough for a /kfFail reason (200 characters) with the command's name.
+  if (serial_.empty()) {
+    error = "the table names no board: if it was measured on this one, add \"serial " +
+            (boardSerial.empty() ? std::string("<serial>") : boardSerial) +
+            "\" after its header; else measure this board";
+    return false;
+  }
+  if (boardSerial.empty()) {
+    error = "the table is for board " + serial_ + " and no board is open: add the board first, then load its table";
+    return false;
+  }
+  if (boardSerial != serial_) {
+    error = "the table was measured on board " + serial_ + ", not on this one (" + boardSerial +
+            "): measure this board and load its own table";
+    return false;
+  }
   return true;
 }
 

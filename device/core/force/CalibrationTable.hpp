@@ -40,9 +40,15 @@ class CalibrationTable {
   const std::string& serial() const { return serial_; }
   void setSerial(std::string serial) { serial_ = std::move(serial); }
 
+  // May this table drive the board whose USB serial is boardSerial ("" when no board is open)?
+  // Only when it names that board: a table measured on another board is refused, and so is
+  // one that names none (it cannot be checked; docs/calibration-format.md says why). False
+  // with a message that says what to do.
+  bool checkBoard(const std::string& boardSerial, std::string& error) const;
+
  private:
   std::vector<CalibrationPoint> points_{{0.0, 0.0}, {1.0, 0.0}};
-  std::string serial_;  // of the board it was measured on; empty: any
+  std::string serial_;  // of the board it was measured on; empty: not named
 };
 
 }  // namespace kf
