@@ -89,7 +89,7 @@ TEST_CASE("board version: a board of another protocol major is refused with what
   CHECK(bus->interfaceReleases() == 1);
 }
 
-TEST_CASE("board errors: open and arm clear them; a reset is reported once; a persisting fault refuses ARM",
+TEST_CASE("board errors: open and arm clear them, a reset is reported once, a persisting fault refuses ARM",
           "[board]") {
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);

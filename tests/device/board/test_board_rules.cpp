@@ -49,7 +49,7 @@ TEST_CASE("board rules: the power-on reset is reported once, until CLEAR_ERRORS"
   CHECK((board.status(0.011).errors & kErrUsbReset) != 0);
 }
 
-TEST_CASE("board rules: an over-current trip clears without a power cycle; one that persists says so", "[board]") {
+TEST_CASE("board rules: an over-current trip clears without a power cycle, one that persists says so", "[board]") {
   BoardEmulator board(0.0);
   clearErrors(board, 0.0);
   REQUIRE(arm(board, 0.0) == usb::Result::kOk);
