@@ -1,7 +1,8 @@
 // A friction board's calibration table: measured force (N) at drive levels (0..1 of the
 // board's full-scale current), and the file the server's kfBoardCalibrate loads
 // ("kf-calibration 1", docs/calibration-format.md). The server inverts it (force -> drive);
-// driveFor does the same here, to check a table before using it.
+// driveFor does the same here, to check a table before using it. A table names the serial of
+// the board it was measured on: the server loads it onto that board only.
 FrictionCalibration {
 	var <points, <>serial, <path;
 
@@ -35,7 +36,13 @@ FrictionCalibration {
 					};
 					header = true
 				}
-				{ fields[0] == "serial" } { ser = fields[1] }
+				{ fields[0] == "serial" } {
+					if(fields.size != 2) {
+						Error("FrictionCalibration.read: %: line %: expected \"serial <the board's serial>\"".format(
+							path, i + 1)).throw
+					};
+					ser = fields[1]
+				}
 				{
 					if(fields.size != 2) {
 						Error("FrictionCalibration.read: %: line %: expected drive and force".format(path, i + 1)).throw
@@ -48,8 +55,14 @@ FrictionCalibration {
 		^this.new(pts.asArray, ser).prSetPath(path)
 	}
 
+	// The file names the board (serial): the server refuses a table without one, or another
+	// board's, so write refuses to make such a file.
 	write { |argPath|
 		var file;
+		if(serial.isNil) {
+			Error("FrictionCalibration.write: give the serial of the board it was measured on " ++
+				"(FrictionCalibration(points, serial) or .serial_; the board's status shows it)").throw
+		};
 		argPath = argPath.standardizePath;
 		file = File(argPath, "w");
 		if(file.isOpen.not) { Error("FrictionCalibration.write: cannot write %".format(argPath)).throw };
@@ -112,6 +125,10 @@ FrictionCalibration {
 		};
 		if(argSerial.notNil and: { argSerial.isString.not and: { argSerial.isKindOf(Symbol).not } }) {
 			Error("FrictionCalibration: serial must be a String or nil, got %".format(argSerial)).throw
+		};
+		if(argSerial.notNil and: { argSerial.asString.isEmpty or: { argSerial.asString.any(_.isSpace) } }) {
+			Error("FrictionCalibration: serial must be one word (the board's USB serial), got \"%\"".format(
+				argSerial)).throw
 		};
 		points = argPoints.collect { |p| p.collect(_.asFloat) };
 		serial = argSerial !? { argSerial.asString };

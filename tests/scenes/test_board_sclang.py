@@ -23,7 +23,9 @@ def test_calibration_tables_validate_round_trip_and_invert():
             {{ FrictionCalibration([[0, -1]]) }},
             {{ FrictionCalibration([[0, \\x]]) }},
             {{ FrictionCalibration.read("/nonexistent/kf.txt") }},
-            {{ FrictionCalibration.drives(1) }}
+            {{ FrictionCalibration.drives(1) }},
+            {{ FrictionCalibration([[0, 0.14], [1, 1.4]]).write("{path}.noserial") }},
+            {{ FrictionCalibration([[0, 0.14]], "KF 7") }}
         ].do {{ |f| try {{ f.value; errors.add("none") }} {{ |e| errors.add(e.errorString) }} }};
         errors.do {{ |e| ("KF-ERROR " ++ e).postln }};
     """)
@@ -33,9 +35,11 @@ def test_calibration_tables_validate_round_trip_and_invert():
     assert "KF-DRIVES [ 0.0, 0.0, 0.35, 0.5, 0.8, 0.8 ]" in out
     assert "KF-FORCES [ 0.14, 0.37, 0.95, 1.3 ]" in out
     errors = [l for l in out.splitlines() if l.startswith("KF-ERROR ")]
-    assert len(errors) == 8 and not any("none" == e.split(" ", 1)[1] for e in errors), errors
+    assert len(errors) == 10 and not any("none" == e.split(" ", 1)[1] for e in errors), errors
     assert "not monotone" in errors[1] and "does not ascend" in errors[2] and "not in 0..1" in errors[3]
     assert "no such file" in errors[6]
+    # A table names its board: no file without a serial, and a serial is one word.
+    assert "give the serial of the board" in errors[8] and "one word" in errors[9]
 
 
 def test_board_messages_for_scores():
