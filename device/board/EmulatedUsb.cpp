@@ -62,7 +62,10 @@ class EmulatedPort : public usb::Port {
   }
 
   std::string skipped() const override { return skipped_; }
-  std::string openSerial() const override { return bus_->serial_; }
+  std::string openSerial() const override {
+    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    return bus_->serial_;
+  }
 
   usb::Result claimInterface(int number) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
@@ -243,10 +246,11 @@ void EmulatedUsb::unplug() {
   changed_.notify_all();
 }
 
-void EmulatedUsb::replug() {
+void EmulatedUsb::replug(const std::string& serial) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (plugged_) return;
   plugged_ = true;
+  if (!serial.empty()) serial_ = serial;
   ++generation_;  // handles of the old plug-in stay dead
   outHalted_ = false;
   board_.powerOn(nowS());

@@ -29,7 +29,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
 
   // Failures.
   void unplug();
-  void replug();
+  void replug(const std::string& serial = "");  // serial: another board in its place
   void setDenyAccess(bool deny);
   void setRefuseArm(bool refuse);
   void timeOutNextOut(int count);   // these OUT transfers are never taken: kTimedOut
@@ -82,7 +82,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  const std::string serial_;
+  std::string serial_;
   const double originS_;
   BoardEmulator board_;
   bool plugged_ = true;

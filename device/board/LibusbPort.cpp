@@ -23,7 +23,7 @@ const char* describe(Result result) {
     case Result::kInvalid:
       return "invalid parameter";
     case Result::kAccess:
-      return "permission denied (is the udev rule of device/board/PROTOCOL.md installed?)";
+      return "permission denied (is the udev rule 70-kineticfriction.rules installed? then replug the board)";
     case Result::kNoDevice:
       return "no device (unplugged)";
     case Result::kNotFound:

@@ -28,7 +28,7 @@ std::string idsText(const usb::DeviceIds& ids) {
 }  // namespace
 
 UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions options)
-    : port_(std::move(port)), options_(options) {
+    : port_(std::move(port)), options_(options), ids_(options.ids) {
   for (usb::Transfer& transfer : outTransfers_) {
     transfer.endpoint = board::kSetPointEndpoint;
     transfer.length = board::kSetPointSize;
@@ -53,15 +53,15 @@ void UsbBoardBackend::setError(const std::string& error) {
 }
 
 bool UsbBoardBackend::connectLocked(std::string& error) {
-  usb::Result result = port_->open(options_.ids);
+  usb::Result result = port_->open(ids_);
   if (result == usb::Result::kNotFound) {
-    error = "no friction board found (" + idsText(options_.ids) + "); is it plugged in?";
+    error = "no friction board found (" + idsText(ids_) + "); is it plugged in?";
     const std::string skipped = port_->skipped();
     if (!skipped.empty()) error += " Left alone, not a board: " + skipped;
     return false;
   }
   if (result != usb::Result::kOk) {
-    error = "cannot open the friction board (" + idsText(options_.ids) + "): " + usb::describe(result);
+    error = "cannot open the friction board (" + idsText(ids_) + "): " + usb::describe(result);
     return false;
   }
   result = port_->claimInterface(board::kInterfaceNumber);
@@ -123,10 +123,12 @@ bool UsbBoardBackend::open(std::string& error) {
     error = std::string("libusb could not start: ") + usb::describe(init);
     return false;
   }
+  ids_ = options_.ids;
   if (!connectLocked(error)) {
     port_->exit();
     return false;
   }
+  ids_.serial = port_->openSerial();  // from now on this board only (a board without a serial: any)
   armed_.store(false);
   connected_.store(true);
   stopping_.store(false);

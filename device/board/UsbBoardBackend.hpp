@@ -122,6 +122,10 @@ class UsbBoardBackend : public ForceBackend {
 
   std::unique_ptr<usb::Port> port_;
   const BoardOptions options_;
+  // What connectLocked looks for: the options' IDs, and once a board was opened, its serial,
+  // so that after an unplug the same board is opened again, never another in its place (its
+  // calibration table is that board's).
+  usb::DeviceIds ids_;
   std::mutex portMutex_;  // open/claim/control/release/close between the event and NRT threads
 
   // Event thread only.

@@ -199,3 +199,21 @@ TEST_CASE("board transfers: an unplug drops the handle only after every late cal
   backend->close();
   checkNoBreach(*bus);
 }
+
+TEST_CASE("board reopen: after an unplug the same board is opened again, not another in its place", "[board]") {
+  auto bus = EmulatedUsb::create("KF-0001");
+  BoardOptions options;
+  options.reopenPeriodS = 0.02;
+  auto backend = openBoard(bus, options);  // no serial asked: the first board, KF-0001
+  bus->unplug();
+  REQUIRE(waitFor([&] { return !backend->telemetry().connected; }));
+  bus->replug("KF-0002");              // another board in its place: its table would be wrong
+  std::this_thread::sleep_for(100ms);  // five reopen periods
+  CHECK_FALSE(backend->telemetry().connected);
+  CHECK(backend->telemetry().reopens == 0);
+  bus->unplug();
+  bus->replug("KF-0001");
+  REQUIRE(waitFor([&] { return backend->telemetry().connected; }));
+  CHECK(backend->telemetry().serial == "KF-0001");
+  backend->close();
+}
