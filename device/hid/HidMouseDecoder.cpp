@@ -33,6 +33,16 @@ int32_t HidMouseDecoder::readAxis(const uint8_t* bytes, size_t size, bool have, 
   return static_cast<int32_t>(value);
 }
 
+bool HidMouseDecoder::axisRange(int64_t& xLowest, int64_t& xHighest, int64_t& yLowest, int64_t& yHighest) const {
+  for (const Layout& layout : layouts_) {
+    if (!layout.haveX || !layout.haveY) continue;
+    xLowest = layout.x.lowest, xHighest = layout.x.highest;
+    yLowest = layout.y.lowest, yHighest = layout.y.highest;
+    return true;
+  }
+  return false;
+}
+
 bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& error) {
   layouts_.clear();
   arrayUsages_.clear();

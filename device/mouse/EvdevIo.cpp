@@ -33,6 +33,11 @@ std::string readLine(const std::string& path) {
   return line;
 }
 
+std::vector<uint8_t> readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 uint16_t readHex(const std::string& path) {
   return static_cast<uint16_t>(std::strtoul(readLine(path).c_str(), nullptr, 16));
 }
@@ -158,6 +163,9 @@ class RealEvdevApi : public EvdevApi {
       const uint16_t bus = readHex(sys + "id/bustype");
       info.external = bus == BUS_USB || bus == BUS_BLUETOOTH;  // a receiver's paired mouse is BUS_USB
       info.busPath = stableBusPath(resolveSysfs(classDir_ + "/" + node + "/device"));
+      // The input device's parent is the HID device (for a USB or Bluetooth HID mouse, and a
+      // receiver's paired one: hid-logitech-dj gives it a descriptor of its own).
+      info.hidDescriptor = readBytes(sys + "device/report_descriptor");
       out.push_back(std::move(info));
     }
     ::closedir(dir);

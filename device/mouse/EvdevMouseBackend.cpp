@@ -3,6 +3,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "hid/HidMouseDecoder.hpp"
+#include "hid/HidReportDescriptor.hpp"
 #include "mouse/MouseSelect.hpp"
 
 namespace kf {
@@ -14,11 +16,27 @@ constexpr uint16_t kSynReport = 0, kSynDropped = 3;
 constexpr uint16_t kRelX = 0x00, kRelY = 0x01;
 constexpr uint16_t kBtnLeft = 0x110, kBtnTask = 0x117;  // BTN_LEFT .. BTN_TASK: buttons 1..8
 
-// evdev passes the HID field's value on: at an int8 or int16 limit the sensor clipped.
-bool atFieldLimit(int32_t value) {
-  return value == 127 || value == -127 || value == -128 || value == 32767 || value == -32767 || value == -32768;
+// evdev passes the HID field's value on, clamped to the field's logical range (hid-input
+// does), but says nothing of that range: it comes from the HID device's report descriptor.
+EvdevMouseBackend::AxisLimits limitsOf(const std::vector<uint8_t>& descriptor) {
+  EvdevMouseBackend::AxisLimits limits;
+  HidReportDescriptor parsed;
+  HidMouseDecoder decoder;
+  std::string error;
+  if (descriptor.empty() || !parseHidReportDescriptor(descriptor.data(), descriptor.size(), parsed, error) ||
+      !decoder.build(parsed, error))
+    return limits;
+  limits.fromDescriptor = decoder.axisRange(limits.xLowest, limits.xHighest, limits.yLowest, limits.yHighest);
+  return limits;
 }
 }  // namespace
+
+bool EvdevMouseBackend::AxisLimits::atLimit(bool isX, int32_t value) const {
+  if (value == 0) return false;
+  if (!fromDescriptor)  // no descriptor (PS/2, a trackpoint): a guess from the usual field widths
+    return value == 127 || value == -127 || value == -128 || value == 32767 || value == -32767 || value == -32768;
+  return isX ? value <= xLowest || value >= xHighest : value <= yLowest || value >= yHighest;
+}
 
 std::unique_ptr<EvdevMouseBackend> EvdevMouseBackend::open(std::shared_ptr<EvdevApi> api, const std::string& which,
                                                            bool grab, std::string& error, OpenFailure* why,
@@ -43,6 +61,7 @@ bool EvdevMouseBackend::openInfo(const MouseInfo& info, std::string& error, Open
     return false;
   }
   current_ = info;
+  limits_ = limitsOf(info.hidDescriptor);
   const std::string name = handle->name();
   if (!name.empty()) current_.product = name;
   handle->id(current_.vendorId, current_.productId);
@@ -92,7 +111,7 @@ void EvdevMouseBackend::take(const EvdevEvent& event) {
   }
   if (event.type == kEvRel && (event.code == kRelX || event.code == kRelY)) {
     (event.code == kRelX ? dx_ : dy_) += event.value;
-    packetSaturated_ = packetSaturated_ || atFieldLimit(event.value);
+    packetSaturated_ = packetSaturated_ || limits_.atLimit(event.code == kRelX, event.value);
     packetHasData_ = true;
   } else if (event.type == kEvKey && event.code >= kBtnLeft && event.code <= kBtnTask) {
     const uint32_t bit = 1u << (event.code - kBtnLeft);

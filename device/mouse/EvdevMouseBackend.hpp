@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -26,6 +27,15 @@ class EvdevMouseBackend : public RealMouseBackend {
   // False when the kernel would not stamp with CLOCK_MONOTONIC: then arrival times are used.
   bool hasKernelTimestamps() const { return kernelTimestamps_; }
 
+  // Where a delta is at its field's limit, so saturated: from the HID descriptor under the node
+  // when there is one (MouseInfo::hidDescriptor), else guessed from 8- and 16-bit fields.
+  struct AxisLimits {
+    bool fromDescriptor = false;
+    int64_t xLowest = 0, xHighest = 0, yLowest = 0, yHighest = 0;
+    bool atLimit(bool isX, int32_t value) const;
+  };
+  const AxisLimits& axisLimits() const { return limits_; }  // the open's (the reader's own after)
+
  protected:
   int readSome(int timeoutMs) override;
   void closeHandle() override { handle_.reset(); }
@@ -42,6 +52,7 @@ class EvdevMouseBackend : public RealMouseBackend {
   bool grab_;
   std::atomic<bool> kernelTimestamps_{true};  // written by the reader at a re-open
   MouseInfo current_;                         // the reader thread's (and open's) own
+  AxisLimits limits_;                         // current_'s
   // The packet being assembled (events up to SYN_REPORT; may span reads).
   int32_t dx_ = 0, dy_ = 0;
   uint32_t buttons_ = 0;

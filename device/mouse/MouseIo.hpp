@@ -31,6 +31,10 @@ struct MouseInfo {
   bool external = true;       // USB or Bluetooth; false: built in (a trackpoint or touchpad: PS/2, I2C, SMBus)
   bool hasXY = true;          // its reports carry relative X and Y (hidapi: from the report descriptor)
   bool alsoKeyboard = false;  // hidapi: the node is a keyboard's too (evdev lists no such node)
+  // evdev: the report descriptor of the HID device under the event node (sysfs), so that a
+  // delta's saturation comes from its field's logical limits; empty for a mouse that is not HID
+  // (PS/2, a trackpoint), whose limits the backend can only guess.
+  std::vector<uint8_t> hidDescriptor;
 };
 
 // --- hidapi -------------------------------------------------------------------------------

@@ -326,7 +326,13 @@ class FakeEvdevApi : public EvdevApi {
  public:
   static constexpr const char* kNode = "/dev/input/event9";
   explicit FakeEvdevApi(FakeMouseScript script) : timeline(std::make_shared<FakeTimeline>(std::move(script))) {}
-  bool enumerateMice(std::vector<MouseInfo>& out, std::string&) override { return timeline->enumerate(kNode, out); }
+  // The node's HID device has the recording's descriptor (as sysfs shows it, MouseInfo::hidDescriptor).
+  bool enumerateMice(std::vector<MouseInfo>& out, std::string&) override {
+    timeline->enumerate(kNode, out);
+    for (MouseInfo& info : out)
+      if (info.path == kNode) info.hidDescriptor = timeline->script().recording.descriptor;
+    return true;
+  }
   std::unique_ptr<EvdevHandle> open(const std::string& path, std::string& error, OpenFailure& why) override {
     if (!timeline->open(path, kNode, error, why)) return nullptr;
     auto handle = std::make_unique<FakeEvdevHandle>(timeline);

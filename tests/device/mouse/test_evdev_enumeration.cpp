@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "mouse/MouseIo.hpp"
 #include "mouse/MouseSelect.hpp"
@@ -43,6 +44,11 @@ struct FakeSysfs {
     fs::create_directories(root / "sys/class/input");
   }
   ~FakeSysfs() { fs::remove_all(root); }
+  // The HID device's report descriptor (a HID device has one; a PS/2 mouse's parent does not).
+  void addDescriptor(const std::string& devicePath, const std::vector<uint8_t>& bytes) {
+    std::ofstream(root / "sys/devices" / devicePath / "report_descriptor", std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
   std::string classDir() const { return (root / "sys/class/input").string(); }
 
   // An input device at devices/<devicePath>/input/inputN with its event node.
@@ -66,6 +72,7 @@ struct FakeSysfs {
     write(input / "id/vendor", hex(vid));
     write(input / "id/product", hex(pid));
     fs::create_directory_symlink(input, input / event / "device");
+    fs::create_directory_symlink(root / "sys/devices" / devicePath, input / "device");  // its parent, the HID device
     fs::create_directory_symlink(input / event, root / "sys/class/input" / event);
   }
 };
@@ -93,6 +100,11 @@ TEST_CASE("evdev enumeration lists mice only, never a node that reports keys, US
   sysfs.add("event23", "pci0000:00/0000:00:14.0/usb1/1-3/1-3:1.0/0003:1532:0084.0007", 23, BUS_USB, 0x1532, 0x0084,
             "Razer Mouse Keyboard", {REL_X, REL_Y}, {BTN_LEFT, KEY_OK});  // macro keys on the mouse's node
 
+  // The paired mouse's HID device (hid-logitech-dj's child) has a descriptor; its bytes here
+  // stand for any (the enumeration passes them on, the backend parses them).
+  const std::vector<uint8_t> m705Descriptor = {0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x00, 0xff, 0xc0};
+  sysfs.addDescriptor(receiver + "/0003:046D:4082.0004", m705Descriptor);
+
   std::vector<MouseInfo> mice;
   std::string error;
   REQUIRE(evdevApiReadingSysfsAt(sysfs.classDir())->enumerateMice(mice, error));
@@ -105,6 +117,10 @@ TEST_CASE("evdev enumeration lists mice only, never a node that reports keys, US
   CHECK_FALSE(mice[1].external);
   CHECK(mice[2].path == "/dev/input/event6");
   CHECK_FALSE(mice[2].external);
+  // The descriptor under the node, bytes as they are (the saturation limits come from it); none
+  // for the PS/2 trackpoint.
+  CHECK(mice[0].hidDescriptor == m705Descriptor);
+  CHECK(mice[2].hidDescriptor.empty());
   // A keyboard's node, asked for by path, is refused before any open.
   MouseInfo out;
   CHECK_FALSE(selectMouse(mice, "/dev/input/event21", out, error));

@@ -358,6 +358,35 @@ TEST_CASE("saturated deltas (at the field's logical limit) are flagged and count
   CHECK(backend->counters().saturated == 2);
 }
 
+// evdev hands on the HID field's value without its range: the range comes from the descriptor of
+// the HID device under the node. A 12-bit mouse (logical -2047..2047, the synthetic 1 kHz
+// recording's descriptor) saturates at 2047, not at 127 as the 8-bit guess would have it; a
+// mouse with no descriptor (PS/2) keeps the guess.
+TEST_CASE("evdev: a delta saturates at the HID descriptor's logical limit, guessed only without one",
+          "[mouse][evdev]") {
+  HidRecording twelveBit;
+  std::string error;
+  REQUIRE(readHidRecorderFile(std::string(KF_HID_DATA_DIR) + "/synthetic-1khz-12bit-gaming.hid", twelveBit, error));
+  FakeMouseScript script = geniusScript();
+  auto report = [](double t, int16_t dx) {
+    return HidRecordedEvent{t,
+                            {1, 0, static_cast<uint8_t>(dx & 0xff), static_cast<uint8_t>(dx >> 8 & 0xff), 0, 0, 0, 0}};
+  };
+  script.recording.events = {report(0.02, 2047), report(0.04, 127), report(0.06, -2047), report(0.08, 5)};
+  const bool withDescriptor = GENERATE(true, false);
+  script.recording.descriptor = withDescriptor ? twelveBit.descriptor : std::vector<uint8_t>{};
+  auto api = std::make_shared<FakeEvdevApi>(script);
+  auto backend = EvdevMouseBackend::open(api, "", false, error);
+  REQUIRE(backend);
+  CHECK(backend->axisLimits().fromDescriptor == withDescriptor);
+  const auto reports = collectAll(*backend, *api->timeline);
+  REQUIRE(reports.size() == 4);
+  CHECK(bool(reports[0].flags & kSaturated) == withDescriptor);
+  CHECK(bool(reports[1].flags & kSaturated) == !withDescriptor);
+  CHECK(bool(reports[2].flags & kSaturated) == withDescriptor);
+  CHECK_FALSE(reports[3].flags & kSaturated);
+}
+
 TEST_CASE("a mouse device: reports reach the audio side's queue, status names the mouse", "[mouse]") {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
