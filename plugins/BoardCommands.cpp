@@ -273,10 +273,12 @@ void postBoardStatus(int index, Device& device) {
         (s.errors & board::kErrWatchdog) ? " (its watchdog tripped)" : "");
   Print(
       "kfStatus %d: board set-points sent %llu (last drive %.3f), late %llu, lost %llu (timeouts %llu, partial "
-      "%llu), stalls %llu, bad status %llu, unplugs %llu, reopens %llu%s%s\n",
+      "%llu), stalls %llu, bad status %llu, unplugs %llu, reopens %llu, resets %llu%s%s%s\n",
       index, count(t.setPointsSent), t.lastDriveSent / static_cast<double>(board::kDriveFull), count(t.lateTransfers),
       count(t.lostTransfers), count(t.timeouts), count(t.partials), count(t.stalls), count(t.badStatus),
-      count(t.unplugs), count(t.reopens), t.lastError.empty() ? "" : "; last error ", t.lastError.c_str());
+      count(t.unplugs), count(t.reopens), count(t.boardResets),
+      t.transfersLeaked ? "; a transfer never came back (left allocated)" : "", t.lastError.empty() ? "" : "; last error ",
+      t.lastError.c_str());
 }
 
 }  // namespace kf::sc

@@ -9,6 +9,7 @@ from kfharness import paths, sclang
 
 BOARD_LINE = re.compile(r"^kfStatus 5: board (\S+) (connected|NOT CONNECTED), (armed|disarmed); board state (\w+), "
                         r"current ([0-9.]+) of full scale")
+COUNTS_LINE = re.compile(r"^kfStatus 5: board set-points sent .*, resets (\d+)")
 TIMING_LINE = re.compile(r"^kfStatus 5: frames per 1 ms pump 0/1/2/3\+: ([0-9.]+)/([0-9.]+)/([0-9.]+)/([0-9.]+)")
 
 
@@ -87,6 +88,10 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
     assert len(replies) == 1, run.output[-3000:]
     assert replies[0].startswith("KF-BOARD-STATUS [ true, true, true, armed, "), replies
     assert replies[0].endswith(", true ]") and " 0.5," in replies[0], replies
+    # The emulated board's power-on reset is reported once: acknowledged by the CLEAR_ERRORS of
+    # the open, not counted again by the one before ARM, nor by any status frame after.
+    resets = [int(COUNTS_LINE.match(l).group(1)) for l in lines if COUNTS_LINE.match(l)]
+    assert resets and all(n == 1 for n in resets), resets
     timing = [TIMING_LINE.match(l) for l in lines if TIMING_LINE.match(l)]
     assert timing, "kfStatus reports the frames per pump"
     print("\n".join(l for l in lines if l.startswith("kfStatus 5:")))
