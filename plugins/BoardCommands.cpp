@@ -277,8 +277,8 @@ void postBoardStatus(int index, Device& device) {
       index, count(t.setPointsSent), t.lastDriveSent / static_cast<double>(board::kDriveFull), count(t.lateTransfers),
       count(t.lostTransfers), count(t.timeouts), count(t.partials), count(t.stalls), count(t.badStatus),
       count(t.unplugs), count(t.reopens), count(t.boardResets),
-      t.transfersLeaked ? "; a transfer never came back (left allocated)" : "", t.lastError.empty() ? "" : "; last error ",
-      t.lastError.c_str());
+      t.transfersLeaked ? "; a transfer never came back (left allocated)" : "",
+      t.lastError.empty() ? "" : "; last error ", t.lastError.c_str());
 }
 
 }  // namespace kf::sc
