@@ -87,7 +87,7 @@ FrictionDevice {
 	// rather than one composite command: each part already answers with its own reason, and a
 	// failed part is undone by one kfClose; a composite would repeat the mouse's and the board's
 	// arguments and stages in the plugin for the same outcome. See ARCHITECTURE.md.
-	*hardware { |server, mouse, board, profile, calibration, index = 0, backend = \hidapi, grab = false|
+	*hardware { |server, mouse, board, profile, calibration, index = 0, backend, grab = false|
 		^this.new.prInitMouse(server, index, mouse, backend, profile, grab)
 		.prInitBoard(board, calibration, "FrictionDevice.hardware").prOpen
 	}
@@ -257,6 +257,8 @@ FrictionDevice {
 	prUndoOpen { |step|
 		if(step == 0) { ^nil };
 		server.listSendMsg(this.closeMsg);
+		// The open itself succeeded: the device sclang held in the slot was replaced on the server.
+		this.class.at(server, index) !? { |previous| if(previous !== this) { previous.prForget(\replaced) } };
 		^"the % device it opened in slot % was closed again".format(kind, index)
 	}
 

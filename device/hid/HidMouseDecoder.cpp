@@ -17,8 +17,10 @@ HidMouseDecoder::Axis HidMouseDecoder::axisOf(const HidField& field, const Eleme
   Axis axis{element, element.isSigned ? -span / 2 : 0, element.isSigned ? span / 2 - 1 : span - 1};
   axis.highest = std::min<int64_t>(axis.highest, INT32_MAX);  // an unsigned 32-bit delta is no mouse's
   if (field.logicalMin < field.logicalMax) {
-    axis.lowest = std::max(axis.lowest, field.logicalMin);
-    axis.highest = std::min(axis.highest, field.logicalMax);
+    const int64_t lowest = std::max(axis.lowest, field.logicalMin);
+    const int64_t highest = std::min(axis.highest, field.logicalMax);
+    // A logical range the field's bits cannot hold (a broken descriptor) keeps the bits' range.
+    if (lowest < highest) axis.lowest = lowest, axis.highest = highest;
   }
   return axis;
 }
@@ -34,13 +36,16 @@ int32_t HidMouseDecoder::readAxis(const uint8_t* bytes, size_t size, bool have, 
 }
 
 bool HidMouseDecoder::axisRange(int64_t& xLowest, int64_t& xHighest, int64_t& yLowest, int64_t& yHighest) const {
+  bool found = false;
   for (const Layout& layout : layouts_) {
     if (!layout.haveX || !layout.haveY) continue;
-    xLowest = layout.x.lowest, xHighest = layout.x.highest;
-    yLowest = layout.y.lowest, yHighest = layout.y.highest;
-    return true;
+    xLowest = found ? std::min(xLowest, layout.x.lowest) : layout.x.lowest;
+    xHighest = found ? std::max(xHighest, layout.x.highest) : layout.x.highest;
+    yLowest = found ? std::min(yLowest, layout.y.lowest) : layout.y.lowest;
+    yHighest = found ? std::max(yHighest, layout.y.highest) : layout.y.highest;
+    found = true;
   }
-  return false;
+  return found;
 }
 
 bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& error) {

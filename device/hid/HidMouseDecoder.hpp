@@ -37,9 +37,11 @@ class HidMouseDecoder {
   bool decode(const uint8_t* bytes, size_t size, HidMouseDelta& out) const;
 
   bool usesReportIds() const { return usesReportIds_; }
-  // The range the first mouse report's X and Y are clamped to (a value at either end, other
-  // than 0, is saturated), for a reader that gets the values decoded by someone else: evdev
-  // passes the HID field's value on. False before build or without such a report.
+  // The range the mouse reports' X and Y are clamped to (a value at either end, other than 0, is
+  // saturated), for a reader that gets the values decoded by someone else: evdev passes the HID
+  // field's value on without saying which report it came from, so with several mouse reports
+  // the widest range (no false flags; a narrower report's limit then goes unflagged). False
+  // before build or without such a report.
   bool axisRange(int64_t& xLowest, int64_t& xHighest, int64_t& yLowest, int64_t& yHighest) const;
   // Report IDs that carry X/Y (0 when the descriptor has no IDs).
   std::vector<uint8_t> mouseReportIds() const;

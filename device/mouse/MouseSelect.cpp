@@ -112,12 +112,20 @@ bool findMouseAgain(std::vector<MouseInfo> mice, const MouseInfo& previous, Mous
     }
     sameMake.push_back(&m);
   }
-  if (sameMake.size() == 1) {
+  // Elsewhere only a mouse with a serial is known to be the same one: two mice of one make
+  // without serials (most) are told apart by their port alone, and the twin of an unplugged
+  // mouse, open in another slot or not, is not it.
+  const bool knownElsewhere = previous.busPath.empty() || !previous.serial.empty();
+  if (sameMake.size() == 1 && knownElsewhere) {
     out = *sameMake.front();
     return true;
   }
-  error = sameMake.empty()
-              ? "no mouse " + reselector(previous) + " is plugged in; there are:" + listOf(mice)
+  error = sameMake.empty() ? "no mouse " + reselector(previous) + " is plugged in; there are:" + listOf(mice)
+          : sameMake.size() == 1
+              ? "a mouse like " + reselector(previous) +
+                    " is plugged in elsewhere, but it has no serial to tell it from a twin: plug it back where "
+                    "it was, or open it again; there are:" +
+                    listOf(mice)
               : std::to_string(sameMake.size()) + " mice like " + reselector(previous) +
                     " are plugged in, none in its port: plug it back where it was; there are:" + listOf(mice);
   return false;

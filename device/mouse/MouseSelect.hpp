@@ -25,10 +25,10 @@ void orderMice(std::vector<MouseInfo>& mice);
 bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInfo& out, std::string& error);
 
 // The mouse `previous` after a replug (its node path may change): the one with its ids in its
-// port and interface; else, when its port is unknown or it came back elsewhere (another port, a
-// Bluetooth reconnection), the one mouse with its ids, serial and interface. Never one of
-// several of its make: a twin in another port is not it. False with a message that lists what
-// there is.
+// port and interface; else, when its port is unknown, or it has a serial and came back elsewhere
+// (another port, a Bluetooth reconnection), the one mouse with its ids, serial and interface.
+// Never one of several of its make, nor a serial-less one elsewhere: a twin in another port is
+// not it. False with a message that lists what there is.
 bool findMouseAgain(std::vector<MouseInfo> mice, const MouseInfo& previous, MouseInfo& out, std::string& error);
 
 // The selector of this mouse in this port ("VVVV:PPPP@busPath"; without a known port the ids

@@ -36,7 +36,12 @@ void RealMouseBackend::startReader() {
   sigfillset(&blocked);
   for (int fault : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS}) sigdelset(&blocked, fault);
   pthread_sigmask(SIG_BLOCK, &blocked, &previous);
-  thread_ = std::thread([this] { threadMain(); });
+  try {
+    thread_ = std::thread([this] { threadMain(); });
+  } catch (...) {  // no thread: the caller (a command's NRT thread) gets its own mask back
+    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    throw;
+  }
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
 }
 

@@ -346,4 +346,26 @@ TEST_CASE("saturation comes from each axis' logical limits within its field's bi
   const HidMouseDecoder packed = decoderFor(kPacked12);
   CHECK_FALSE(decodeOk(packed, {0x02, 0x81, 0xfb, 0xcf, 0x12, 0xff}).saturated);
   CHECK(decodeOk(packed, {0x02, 0x00, 0x01, 0xf8, 0x7f, 0x00}).saturated);
+  // A logical range the field's bits cannot hold (8 bits, -1000..-500: a broken descriptor)
+  // keeps the bits' range, not an empty one (std::clamp with lowest > highest is undefined).
+  const Bytes outside = {0x05, 0x01, 0x09, 0x30, 0x16, 0x18, 0xfc, 0x26,
+                         0x0c, 0xfe, 0x75, 0x08, 0x95, 0x01, 0x81, 0x06};
+  CHECK(decodeOk(decoderFor(outside), {0x64}).dxCounts == 100);
+  CHECK_FALSE(decodeOk(decoderFor(outside), {0x64}).saturated);
+  CHECK(decodeOk(decoderFor(outside), {0x80}).saturated);
+}
+
+TEST_CASE("the axes' range for evdev: the widest of the mouse reports'", "[hid]") {
+  // Report 1: X, Y 8 bits (-127..127); report 2: X, Y 16 bits (-32767..32767). evdev cannot tell
+  // which report a value came from: 127 from report 2 is no limit, so the range is report 2's.
+  const Bytes twoReports = {0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x85, 0x01, 0x09, 0x30, 0x09, 0x31, 0x15, 0x81,
+                            0x25, 0x7f, 0x75, 0x08, 0x95, 0x02, 0x81, 0x06, 0x85, 0x02, 0x09, 0x30, 0x09, 0x31,
+                            0x16, 0x01, 0x80, 0x26, 0xff, 0x7f, 0x75, 0x10, 0x95, 0x02, 0x81, 0x06, 0xc0};
+  int64_t xLo = 0, xHi = 0, yLo = 0, yHi = 0;
+  REQUIRE(decoderFor(twoReports).axisRange(xLo, xHi, yLo, yHi));
+  CHECK(xLo == -32767);
+  CHECK(xHi == 32767);
+  CHECK(yLo == -32767);
+  CHECK(yHi == 32767);
+  CHECK_FALSE(HidMouseDecoder().axisRange(xLo, xHi, yLo, yHi));
 }

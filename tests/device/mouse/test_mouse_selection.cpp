@@ -202,17 +202,32 @@ TEST_CASE("finding a mouse again: its port first; elsewhere only when it is the 
   REQUIRE(findMouseAgain({twin, other, back}, ours, out, error));
   CHECK(out.path == "/dev/hidraw9");
 
-  // Back in another port (or a Bluetooth mouse reconnected: a new hci handle in its path).
-  MouseInfo moved = ours;
+  // Without a serial, the one of its make in another port may be its twin (open in another slot,
+  // say) rather than it: not taken.
+  CHECK_FALSE(findMouseAgain({twin, other}, ours, out, error));
+  CHECK(error.find("no serial to tell it from a twin") != std::string::npos);
+
+  // With a serial: back in another port (or a Bluetooth mouse reconnected: a new hci handle in
+  // its path) it is found there.
+  MouseInfo withSerial = ours;
+  withSerial.serial = "A1B2";
+  MouseInfo moved = withSerial;
   moved.path = "/dev/hidraw4", moved.busPath = "usb1/1-4/1-4:1.0/0003:0458:0138";
-  REQUIRE(findMouseAgain({other, moved}, ours, out, error));
+  REQUIRE(findMouseAgain({other, moved}, withSerial, out, error));
   CHECK(out.path == "/dev/hidraw4");
-  // ... but with its twin plugged in too, neither is taken for it.
-  CHECK_FALSE(findMouseAgain({twin, other, moved}, ours, out, error));
+  // ... but with a twin of the same serial plugged in too, neither is taken for it.
+  MouseInfo twinWithSerial = twin;
+  twinWithSerial.serial = "A1B2";
+  CHECK_FALSE(findMouseAgain({twinWithSerial, other, moved}, withSerial, out, error));
   CHECK(error.find("none in its port") != std::string::npos);
   // Another interface of the same mouse is not it.
   MouseInfo vendorInterface = moved;
   vendorInterface.interfaceNumber = 1;
-  CHECK_FALSE(findMouseAgain({other, vendorInterface}, ours, out, error));
+  CHECK_FALSE(findMouseAgain({other, vendorInterface}, withSerial, out, error));
   CHECK(error.find("no mouse 0458:0138@usb1/1-2/1-2:1.0/0003:0458:0138 is plugged in") != std::string::npos);
+  // A mouse whose port was not known is found by its make alone, when there is one.
+  MouseInfo portUnknown = ours;
+  portUnknown.busPath.clear();
+  REQUIRE(findMouseAgain({other, twin}, portUnknown, out, error));
+  CHECK(out.path == "/dev/hidraw2");
 }
