@@ -1,5 +1,7 @@
 #include "LoudnessToFriction.hpp"
 
+#include "LoudnessKernels.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -18,17 +20,10 @@ inline bool isUsable(double v) { return std::isfinite(v); }
 constexpr double kLog10OfE = 0.43429448190325182765;
 constexpr double kLog10Of2 = 0.30102999566398119521;
 
-// log2 of a positive normal float: the exponent from the bits, the mantissa folded into
-// [sqrt(1/2), sqrt(2)), log2(1 + t) = t P(t) with P of degree 6 fitted (minimax, float
-// coefficients) on t in [-0.293, 0.415]. Worst error of the float evaluation, measured over the
-// whole range: 3.7e-7 (kFastLog2Error, with margin). Branch-free; the SSE2 version below does
-// the same operations four at a time.
-constexpr double kFastLog2Error = 4e-7;
-constexpr float kP0 = 1.4426996708f, kP1 = -0.7213758826f, kP2 = 0.4804650247f, kP3 = -0.3589618504f,
-                kP4 = 0.2972626686f, kP5 = -0.2726978362f, kP6 = 0.1706340909f;
-constexpr int32_t kSqrt2Bits = 0x3fb504f3;
+using loudness::FastMap;
 
 inline float fastLog2(float x) {
+  using namespace loudness;
   int32_t bits;
   std::memcpy(&bits, &x, 4);
   int32_t ex = (bits >> 23) - 127;
@@ -146,13 +141,17 @@ void LoudnessToFriction::setMapping(const FrictionMapping& wanted) {
   const double maxForce = std::max({std::fabs(m.loForceN), std::fabs(m.hiForceN), std::fabs(forceOffset_)});
   // log2 error: the polynomial, the float level (2^-24 relative), the float sum e + t P
   // (half an ulp of maxLog2); then the float product and sum (an ulp of maxForce each).
-  const double log2Error = kFastLog2Error + 1.5 * 0x1p-24 + maxLog2 * 0x1p-23;
+  const double log2Error = loudness::kFastLog2Error + 1.5 * 0x1p-24 + maxLog2 * 0x1p-23;
   const double boundN = std::fabs(forcePerLog2) * log2Error + 2.0 * maxForce * 0x1p-23;
   fastLog_ = m.hiDb != m.loDb && loLevel >= 1e-30 && hiLevel <= 1e30 && boundN <= kMaxFastLogErrorN;
-  loLevel_ = static_cast<float>(loLevel);
-  hiLevel_ = static_cast<float>(hiLevel);
-  forcePerLog2_ = static_cast<float>(forcePerLog2);
-  forceAtLog2Zero_ = static_cast<float>(forceOffset_);
+  fastMap_ = {static_cast<float>(loLevel),
+              static_cast<float>(hiLevel),
+              forceAtLoAbs_,
+              forceAtHiAbs_,
+              minForce_,
+              maxForce_,
+              static_cast<float>(forcePerLog2),
+              static_cast<float>(forceOffset_)};
 }
 
 inline float LoudnessToFriction::sanitizedAbs(float a) const {
@@ -179,15 +178,22 @@ float LoudnessToFriction::peekForce(float a) const {
 }
 
 void LoudnessToFriction::process(const float* in, float* forceN, int numSamples) {
+  const bool avx2 = KF_CORE_AVX2 && corePath() == CorePath::avx2;
   for (int done = 0; done < numSamples; done += kPiece) {
     const int count = std::min(kPiece, numSamples - done);
     if (fastLog_) {
-      alignas(16) float levels[kPiece];
-      runningMeans(in + done, levels, invRef_ / windowSamples_, count);
-      mapFast(levels, forceN + done, count);
+      alignas(32) float levels[kPiece];
+      runningMeans(in + done, levels, invRef_ / windowSamples_, count, avx2);
+#if KF_CORE_AVX2
+      if (avx2) {
+        loudness::mapFastAvx2(fastMap_, levels, forceN + done, count);
+        continue;
+      }
+#endif
+      loudness::mapFastPortable(fastMap_, levels, forceN + done, count);
     } else {
-      alignas(16) double means[kPiece];
-      runningMeans(in + done, means, 1.0 / windowSamples_, count);
+      alignas(32) double means[kPiece];
+      runningMeans(in + done, means, 1.0 / windowSamples_, count, avx2);
       mapExact(means, forceN + done, count);
     }
   }
@@ -198,10 +204,9 @@ void LoudnessToFriction::process(const float* in, float* forceN, int numSamples)
 // in groups of four whose prefix sums hang off the running sum. The ring is read and written
 // in contiguous runs, without a wrap test per sample.
 template <typename Mean>
-void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale, int count) {
+void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale, int count, bool avx2) {
   const int n = windowSamples_, cap = capacity_;
   float a[kPiece];
-  double diff[kPiece];
 #if defined(__SSE2__)
   {
     const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
@@ -219,18 +224,18 @@ void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale
 
   // The values leaving the window: from the ring for the first min(n, count) samples, from this
   // piece after that.
+  float old[kPiece];
   const int fromRing = std::min(n, count);
   int oldest = writeIndex_ - n;
   if (oldest < 0) oldest += cap;
   for (int i = 0; i < fromRing;) {
     const int run = std::min(fromRing - i, cap - oldest);
-    const float* old = history_ + oldest;
-    for (int k = 0; k < run; ++k) diff[i + k] = static_cast<double>(a[i + k]) - old[k];
+    std::memcpy(old + i, history_ + oldest, sizeof(float) * run);
     i += run;
     oldest += run;
     if (oldest == cap) oldest = 0;
   }
-  for (int i = fromRing; i < count; ++i) diff[i] = static_cast<double>(a[i]) - a[i - n];
+  if (count > fromRing) std::memcpy(old + fromRing, a, sizeof(float) * (count - fromRing));
 
   // Into the ring: only the last cap values matter when the piece is longer than the ring.
   const int keep = std::min(count, cap);
@@ -244,12 +249,35 @@ void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale
   }
   writeIndex_ = w;
 
-  double sum = sum_;
+#if KF_CORE_AVX2
+  if (avx2)
+    sum_ = loudness::runningMeansAvx2(a, old, sum_, scale, means, count);
+  else
+#endif
+    sum_ = loudness::runningMeansPortable(a, old, sum_, scale, means, count);
+  (void)avx2;
+
+  // Re-sum once per lap of the ring, so rounding cannot accumulate: the sum never carries more
+  // than capacity_ + kPiece additions' worth of error, however long it runs.
+  sinceResum_ += count;
+  if (sinceResum_ >= cap) {
+    sinceResum_ = 0;
+    resum();
+  }
+}
+
+namespace loudness {
+
+// Equation (1), four at a time: the differences (newest in, oldest out) in double, then prefix
+// sums of each group of four in two double pairs, each added to the running sum, which then
+// moves on by the group's total: one add per four samples on the serial path.
+template <typename Mean>
+double runningMeansSse(const float* a, const float* old, double sum, double scale, Mean* means, int count) {
+  double diff[LoudnessToFriction::kPiece];
+  for (int k = 0; k < count; ++k) diff[k] = static_cast<double>(a[k]) - old[k];
   int i = 0;
 #if defined(__SSE2__)
   {
-    // Four at a time: prefix sums of the four differences in two double pairs, each added to the
-    // running sum, which then moves on by the group's total.
     const __m128d zero = _mm_setzero_pd(), vScale = _mm_set1_pd(scale);
     __m128d s = _mm_set1_pd(sum);
     for (; i + 4 <= count; i += 4) {
@@ -274,27 +302,27 @@ void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale
     sum += diff[i];
     means[i] = static_cast<Mean>(std::max(sum, 0.0) * scale);
   }
-  sum_ = sum;
+  return sum;
+}
 
-  // Re-sum once per lap of the ring, so rounding cannot accumulate: the sum never carries more
-  // than capacity_ + kPiece additions' worth of error, however long it runs.
-  sinceResum_ += count;
-  if (sinceResum_ >= cap) {
-    sinceResum_ = 0;
-    resum();
-  }
+double runningMeansPortable(const float* a, const float* old, double sum, double scale, float* means, int count) {
+  return runningMeansSse(a, old, sum, scale, means, count);
+}
+
+double runningMeansPortable(const float* a, const float* old, double sum, double scale, double* means, int count) {
+  return runningMeansSse(a, old, sum, scale, means, count);
 }
 
 // Equation (2) on the fast logarithm, branch-free: clip in the linear domain, log2 by bits and
 // polynomial, the linear map, then the clip values where the level is at or beyond a bound.
-void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) const {
+void mapFastPortable(const FastMap& map, const float* levels, float* forceN, int count) {
   int i = 0;
 #if defined(__SSE2__)
   {
-    const __m128 lo = _mm_set1_ps(loLevel_), hi = _mm_set1_ps(hiLevel_);
-    const __m128 fLo = _mm_set1_ps(forceAtLoAbs_), fHi = _mm_set1_ps(forceAtHiAbs_);
-    const __m128 fMin = _mm_set1_ps(minForce_), fMax = _mm_set1_ps(maxForce_);
-    const __m128 a = _mm_set1_ps(forcePerLog2_), b = _mm_set1_ps(forceAtLog2Zero_);
+    const __m128 lo = _mm_set1_ps(map.loLevel), hi = _mm_set1_ps(map.hiLevel);
+    const __m128 fLo = _mm_set1_ps(map.forceAtLo), fHi = _mm_set1_ps(map.forceAtHi);
+    const __m128 fMin = _mm_set1_ps(map.minForce), fMax = _mm_set1_ps(map.maxForce);
+    const __m128 a = _mm_set1_ps(map.perLog2), b = _mm_set1_ps(map.atLog2Zero);
     const __m128i mantMask = _mm_set1_epi32(0x007fffff), one = _mm_set1_epi32(0x3f800000);
     const __m128i sqrt2 = _mm_set1_epi32(kSqrt2Bits), bias = _mm_set1_epi32(127);
     const __m128i halfBit = _mm_set1_epi32(1 << 23);
@@ -330,11 +358,13 @@ void LoudnessToFriction::mapFast(const float* levels, float* forceN, int count) 
 #endif
   for (; i < count; ++i) {  // the same operations, one at a time
     const float level = levels[i];
-    const float m = std::min(std::max(level, loLevel_), hiLevel_);
-    const float f = std::clamp(fastLog2(m) * forcePerLog2_ + forceAtLog2Zero_, minForce_, maxForce_);
-    forceN[i] = level >= hiLevel_ ? forceAtHiAbs_ : (level <= loLevel_ ? forceAtLoAbs_ : f);
+    const float m = std::min(std::max(level, map.loLevel), map.hiLevel);
+    const float f = std::clamp(fastLog2(m) * map.perLog2 + map.atLog2Zero, map.minForce, map.maxForce);
+    forceN[i] = level >= map.hiLevel ? map.forceAtHi : (level <= map.loLevel ? map.forceAtLo : f);
   }
 }
+
+}  // namespace loudness
 
 void LoudnessToFriction::mapExact(const double* means, float* forceN, int count) const {
   for (int i = 0; i < count; ++i) forceN[i] = mapMeanAbs(means[i]);

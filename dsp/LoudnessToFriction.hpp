@@ -8,6 +8,7 @@
 
 #include <cstdint>
 
+#include "LoudnessKernels.hpp"
 #include "PaperProfile.hpp"
 
 namespace kf {
@@ -65,9 +66,9 @@ class LoudnessToFriction {
   // The pieces of process(): equation (1) into means[], then equation (2) from them.
   // Mean is double (the means, for the exact path) or float (the levels mean / ref, for the
   // fast path); scale is 1 / n, or 1 / (n ref).
+  // avx2: the AVX2 loops (CorePath.hpp), else the portable ones.
   template <typename Mean>
-  void runningMeans(const float* in, Mean* means, double scale, int count);
-  void mapFast(const float* levels, float* forceN, int count) const;
+  void runningMeans(const float* in, Mean* means, double scale, int count, bool avx2);
   void mapExact(const double* means, float* forceN, int count) const;
 
   float* history_;
@@ -87,10 +88,9 @@ class LoudnessToFriction {
   float minForce_ = 0.f, maxForce_ = 0.f;
   double forcePerDb_ = 0.0, forceOffset_ = 0.0, invRef_ = 1.0;
   float maxAbs_ = 1e30f;  // |a| taken into the sum is clamped here (see setMapping)
-  // The fast path of equation (2), on the level mean / ref in float: clip in the linear domain
-  // to [loLevel_, hiLevel_], then force = log2(level) * forcePerLog2_ + forceAtLog2Zero_.
+  // The fast path of equation (2), on the level mean / ref in float (LoudnessKernels.hpp).
   bool fastLog_ = false;
-  float loLevel_ = 0.f, hiLevel_ = 1.f, forcePerLog2_ = 0.f, forceAtLog2Zero_ = 0.f;
+  loudness::FastMap fastMap_;
 };
 
 }  // namespace kf

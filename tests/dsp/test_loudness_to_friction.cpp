@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "CorePath.hpp"
 #include "LoudnessToFriction.hpp"
 
 using kf::FrictionMapping;
@@ -60,6 +61,21 @@ struct Noise {
   }
 };
 
+// Runs the code path it is given for as long as it lives, then the one before it again.
+struct PathScope {
+  kf::CorePath before = kf::corePath(), used;
+  explicit PathScope(kf::CorePath wanted) : used(kf::setCorePath(wanted)) {}
+  ~PathScope() { kf::setCorePath(before); }
+};
+
+// A test with EACH_CORE_PATH runs once per code path (CorePath.hpp); on a processor without
+// AVX2/FMA the avx2 run ends at once (setCorePath falls back to the portable path, run already).
+#define EACH_CORE_PATH()                                                                \
+  const kf::CorePath wantedPath = GENERATE(kf::CorePath::portable, kf::CorePath::avx2); \
+  PathScope pathScope(wantedPath);                                                      \
+  if (pathScope.used != wantedPath) return;                                             \
+  INFO("core path " << kf::corePathName(pathScope.used))
+
 std::vector<float> runCore(Core& c, const std::vector<float>& in) {
   std::vector<float> out(in.size());
   c.core.process(in.data(), out.data(), static_cast<int>(in.size()));
@@ -94,6 +110,7 @@ TEST_CASE("window length is round(sr x window), clamped to [1, max]") {
 }
 
 TEST_CASE("silence gives exactly loForce, from the first sample on") {
+  EACH_CORE_PATH();
   Core c(192);
   c.core.setWindowSamples(192);
   auto out = runCore(c, std::vector<float>(5000, 0.f));
@@ -101,6 +118,7 @@ TEST_CASE("silence gives exactly loForce, from the first sample on") {
 }
 
 TEST_CASE("a full-scale square gives exactly hiForce once the window is full") {
+  EACH_CORE_PATH();
   Core c(192);
   c.core.setWindowSamples(192);
   std::vector<float> in(4000);
@@ -110,6 +128,7 @@ TEST_CASE("a full-scale square gives exactly hiForce once the window is full") {
 }
 
 TEST_CASE("a full-scale sine gives 0.4530 N") {
+  EACH_CORE_PATH();
   // 1 kHz at 192 kHz: the 1 ms window holds whole periods, so the mean of |sin| is 2/pi up to
   // the sampling of the period.
   Core c(192);
@@ -122,6 +141,7 @@ TEST_CASE("a full-scale sine gives 0.4530 N") {
 }
 
 TEST_CASE("per-sample agreement with equations (1) and (2) at 44.1 to 192 kHz") {
+  EACH_CORE_PATH();
   for (double sr : {44100.0, 48000.0, 96000.0, 192000.0}) {
     const int n = kf::windowSamples(sr, 0.001, 400);
     Core c(400);
@@ -138,6 +158,7 @@ TEST_CASE("per-sample agreement with equations (1) and (2) at 44.1 to 192 kHz") 
 }
 
 TEST_CASE("NaN and Inf input never reach the output") {
+  EACH_CORE_PATH();
   Core c(48);
   c.core.setWindowSamples(48);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
@@ -155,6 +176,7 @@ TEST_CASE("NaN and Inf input never reach the output") {
 }
 
 TEST_CASE("denormals and tiny levels read as loForce") {
+  EACH_CORE_PATH();
   Core c(192);
   c.core.setWindowSamples(192);
   std::vector<float> in(2000);
@@ -164,6 +186,7 @@ TEST_CASE("denormals and tiny levels read as loForce") {
 }
 
 TEST_CASE("full scale and above clip at hiForce") {
+  EACH_CORE_PATH();
   Core c(48);
   c.core.setWindowSamples(48);
   for (float level : {1.f, 10.f, 1e6f, 3e38f}) {
@@ -173,6 +196,7 @@ TEST_CASE("full scale and above clip at hiForce") {
 }
 
 TEST_CASE("extreme and reversed mappings") {
+  EACH_CORE_PATH();
   SECTION("reversed dB bounds: louder means less friction") {
     FrictionMapping m{0.0, -30.0, 0.14, 0.5, 1.0};
     Core c(48);
@@ -235,6 +259,7 @@ TEST_CASE("extreme and reversed mappings") {
 // clamped away at both ends, for rising, reversed and far-off mappings. The last two went past
 // a bound by about 1e-7 N without the clamp (found by a random search near the bounds).
 TEST_CASE("the force never leaves [loForce, hiForce]") {
+  EACH_CORE_PATH();
   const FrictionMapping mappings[] = {FrictionMapping{},
                                       {0.0, -30.0, 0.14, 0.5, 1.0},
                                       {-30.0, 0.0, 0.5, 0.14, 1.0},
@@ -266,6 +291,7 @@ TEST_CASE("the force never leaves [loForce, hiForce]") {
 }
 
 TEST_CASE("the window can change while running, up to the maximum") {
+  EACH_CORE_PATH();
   Core c(500);
   c.core.setWindowSamples(48);
   Noise noise;
@@ -290,22 +316,25 @@ TEST_CASE("the window can change while running, up to the maximum") {
   }
 }
 
-TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation", "[long]") {
+namespace {
+
+// White noise at about -18 dB (inside the clip range) through a 192-sample window for `total`
+// samples; every `checkEvery` samples (a multiple of the block) the last output and the running
+// mean are checked against the last n samples recomputed in double. Returns the worst error.
+double driftWorstN(int64_t total, int64_t checkEvery) {
   const int n = 192;
   Core c(n);
   c.core.setWindowSamples(n);
   Noise noise;
   constexpr int kBlock = 4096;
   std::vector<float> in(kBlock), out(kBlock);
-  const int64_t total = 1000000000;
   int64_t done = 0;
   double worstN = 0.0;
   while (done < total) {
-    for (float& x : in) x = noise() * 0.25f;  // about -18 dB: inside the clip range
+    for (float& x : in) x = noise() * 0.25f;
     c.core.process(in.data(), out.data(), kBlock);
     done += kBlock;
-    if (done % (kBlock * 24414) == 0 || done >= total) {
-      // Recompute the last n samples' mean in double and compare every 10^8 samples.
+    if (done % checkEvery == 0 || done >= total) {
       double sum = 0;
       for (int k = 0; k < n; ++k) sum += std::fabs(double(in[kBlock - 1 - k]));
       const double want = paperEquation2(sum / n, FrictionMapping{});
@@ -314,6 +343,23 @@ TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation"
       REQUIRE(c.core.meanAbs() == Approx(sum / n).epsilon(1e-12));
     }
   }
+  return worstN;
+}
+
+}  // namespace
+
+// On the path this processor dispatches to (the one a server runs); the other path gets the
+// shorter run below, as the loops that carry the sum are the same from one lap to the next.
+TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation", "[long]") {
+  INFO("core path " << kf::corePathName(kf::corePath()));
+  const double worstN = driftWorstN(1000000000, 4096 * 24414);  // about every 10^8 samples
+  INFO("worst |error| " << worstN << " N");
+  CHECK(worstN < 1e-6);
+}
+
+TEST_CASE("no drift on the portable path: 10^7 samples against a double recomputation") {
+  PathScope pathScope(kf::CorePath::portable);
+  const double worstN = driftWorstN(10000000, 4096 * 244);  // about every 10^6 samples
   INFO("worst |error| " << worstN << " N");
   CHECK(worstN < 1e-6);
 }
@@ -321,6 +367,7 @@ TEST_CASE("no drift: 10^9 samples of white noise against a double recomputation"
 // The fast logarithm of equation (2): where it is used, its worst error over the whole clip
 // range is within 1e-6 N; where a bound says it could not be, the exact path is taken.
 TEST_CASE("fast logarithm: worst error over the clip range, and when it is not used") {
+  EACH_CORE_PATH();
   SECTION("the paper's mapping uses it, within 1e-6 N at every level across the clip range") {
     Core c(1);
     c.core.setWindowSamples(1);  // the output is the mapping of |a| itself
@@ -361,7 +408,54 @@ TEST_CASE("fast logarithm: worst error over the clip range, and when it is not u
   }
 }
 
+TEST_CASE("the code path is chosen from the processor and KF_CORE_PATH") {
+  using kf::CorePath;
+  CHECK(kf::chooseCorePath(true, nullptr) == CorePath::avx2);
+  CHECK(kf::chooseCorePath(true, "") == CorePath::avx2);
+  CHECK(kf::chooseCorePath(true, "avx2") == CorePath::avx2);
+  CHECK(kf::chooseCorePath(true, "portable") == CorePath::portable);
+  // Without AVX2/FMA the portable path runs, whatever is asked for.
+  CHECK(kf::chooseCorePath(false, nullptr) == CorePath::portable);
+  CHECK(kf::chooseCorePath(false, "avx2") == CorePath::portable);
+  CHECK(kf::chooseCorePath(false, "portable") == CorePath::portable);
+  {
+    PathScope scope(CorePath::avx2);
+    CHECK(scope.used == (kf::cpuHasAvx2Fma() ? CorePath::avx2 : CorePath::portable));
+    CHECK(kf::corePath() == scope.used);
+  }
+  {
+    PathScope scope(CorePath::portable);
+    CHECK(kf::corePath() == CorePath::portable);
+  }
+}
+
+// setCorePath really changes the code that runs: the AVX2 path sums eight at a time and uses
+// FMA, so somewhere in the last bits its forces differ from the portable ones; the two agree
+// within the float output's rounding (the test above compares block sizes with the same margin).
+TEST_CASE("the two code paths are different code and agree") {
+  if (!kf::cpuHasAvx2Fma()) return;  // one path only on this processor
+  Noise noise;
+  std::vector<float> in(20000);
+  for (size_t i = 0; i < in.size(); ++i)
+    in[i] = noise() * static_cast<float>(std::pow(10.0, -2.5 + 3.0 * i / in.size()));
+  std::vector<float> byPath[2];
+  for (kf::CorePath path : {kf::CorePath::portable, kf::CorePath::avx2}) {
+    PathScope scope(path);
+    Core c(48);
+    c.core.setWindowSamples(48);
+    byPath[static_cast<int>(path)] = runCore(c, in);
+  }
+  int differ = 0;
+  for (size_t i = 0; i < in.size(); ++i) {
+    REQUIRE(byPath[1][i] == Approx(byPath[0][i]).margin(2e-7));
+    differ += byPath[1][i] != byPath[0][i];
+  }
+  INFO(differ << " of " << in.size() << " forces differ");
+  CHECK(differ > 0);
+}
+
 TEST_CASE("block sizes, in-place processing and tiny rings give the same forces") {
+  EACH_CORE_PATH();
   Noise noise;
   std::vector<float> in(5000);
   for (size_t i = 0; i < in.size(); ++i)
