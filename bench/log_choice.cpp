@@ -13,8 +13,10 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "CorePath.hpp"
 #include "LoudnessToFriction.hpp"
 
 namespace {
@@ -212,18 +214,22 @@ int main() {
   KF_VARIANT("fast: bits + polynomial, degree 6", forcePoly6);
 #undef KF_VARIANT
 
-  // The real core (std::log10) on the same input, and how far its copy above agrees with it.
-  std::vector<float> history(capacity);
-  kf::LoudnessToFriction real(history.data(), capacity);
-  real.setWindowSamples(window);
-  const double realNs = bestSecondsOf(coreRepeats,
-                                      [&] {
-                                        for (int i = 0; i < samples; i += 64)
-                                          real.process(input.data() + i, coreOut.data() + i, 64);
-                                      }) /
-                        samples * 1e9;
-  std::printf("%-38s %12s %12.2f\n", "kf::LoudnessToFriction::process", "", realNs);
-  std::printf("RESULT name=\"kf::LoudnessToFriction::process\" core_ns=%.4f\n", realNs);
+  // The real core on the same input, on each code path this processor has (CorePath.hpp).
+  for (kf::CorePath path : {kf::CorePath::portable, kf::CorePath::avx2}) {
+    if (kf::setCorePath(path) != path) continue;
+    std::vector<float> history(capacity);
+    kf::LoudnessToFriction real(history.data(), capacity);
+    real.setWindowSamples(window);
+    const double realNs = bestSecondsOf(coreRepeats,
+                                        [&] {
+                                          for (int i = 0; i < samples; i += 64)
+                                            real.process(input.data() + i, coreOut.data() + i, 64);
+                                        }) /
+                          samples * 1e9;
+    const std::string name = std::string("kf::LoudnessToFriction::process, ") + kf::corePathName(path);
+    std::printf("%-38s %12s %12.2f\n", name.c_str(), "", realNs);
+    std::printf("RESULT name=\"%s\" core_ns=%.4f\n", name.c_str(), realNs);
+  }
   // Share of samples of (b) that took a logarithm (inside the clip range).
   {
     CoreCopy<forceLog10> c(capacity, window);

@@ -34,7 +34,9 @@ double runningMeansPortable(const float* a, const float* old, double sum, double
 void mapFastPortable(const FastMap& map, const float* levels, float* forceN, int count);
 
 #if KF_CORE_AVX2
-// The same, eight samples at a time: only to be called where cpuHasAvx2Fma().
+// The same, eight samples at a time (the polynomial in FMA): only to be called where
+// cpuHasAvx2Fma(). Two loops, not one: fused, the running sum's serial adds and the mapping's
+// branch left the out-of-order core less to overlap (1.9 against 1.4 ns a sample, measured).
 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, float* means, int count);
 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, double* means, int count);
 void mapFastAvx2(const FastMap& map, const float* levels, float* forceN, int count);

@@ -8,7 +8,6 @@
 #include <immintrin.h>
 
 #include <algorithm>
-#include <type_traits>
 
 #define KF_AVX2 __attribute__((target("avx2,fma")))
 
@@ -23,85 +22,105 @@ KF_AVX2 inline __m256d prefix4(__m256d d) {
   return _mm256_add_pd(d, _mm256_permute2f128_pd(d, d, 0x08));  // + (0, 0, p0, p1)
 }
 
-// Eight samples a step: the serial dependency is one add per eight (the running sum moving on
-// by the step's total); the prefix sums of the two halves hang off it.
-template <typename Mean>
-KF_AVX2 double runningMeans(const float* a, const float* old, double sum, double scale, Mean* means, int count) {
-  const __m256d zero = _mm256_setzero_pd(), vScale = _mm256_set1_pd(scale);
-  __m256d s = _mm256_set1_pd(sum);
-  int i = 0;
-  for (; i + 8 <= count; i += 8) {
-    const __m256 a8 = _mm256_loadu_ps(a + i), o8 = _mm256_loadu_ps(old + i);
-    __m256d d0 =
-        _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(a8)), _mm256_cvtps_pd(_mm256_castps256_ps128(o8)));
-    __m256d d1 =
-        _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(a8, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(o8, 1)));
-    d0 = prefix4(d0);
-    d1 = _mm256_add_pd(prefix4(d1), _mm256_permute4x64_pd(d0, 0xff));
-    const __m256d m0 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d0), zero), vScale);
-    const __m256d m1 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d1), zero), vScale);
-    s = _mm256_add_pd(s, _mm256_permute4x64_pd(d1, 0xff));
-    if constexpr (std::is_same_v<Mean, float>) {
-      _mm256_storeu_ps(means + i, _mm256_set_m128(_mm256_cvtpd_ps(m1), _mm256_cvtpd_ps(m0)));
-    } else {
-      _mm256_storeu_pd(means + i, m0);
-      _mm256_storeu_pd(means + i + 4, m1);
-    }
-  }
-  sum = _mm256_cvtsd_f64(s);
-  for (; i < count; ++i) {
-    sum += static_cast<double>(a[i]) - old[i];
-    means[i] = static_cast<Mean>(std::max(sum, 0.0) * scale);
-  }
-  return sum;
+// Eight samples of equation (1): the running sum s (in every lane) plus the prefix sums of
+// a - old, in m0 (samples 0..3) and m1 (4..7), clamped at 0 and scaled; s moves on by the total.
+// The serial dependency is one add per eight samples; the prefix sums hang off it.
+__attribute__((target("avx2,fma"), always_inline)) inline void meansEight(const float* a, const float* old, __m256d& s,
+                                                                          __m256d scale, __m256d& m0, __m256d& m1) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256 a8 = _mm256_loadu_ps(a), o8 = _mm256_loadu_ps(old);
+  __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(a8)), _mm256_cvtps_pd(_mm256_castps256_ps128(o8)));
+  __m256d d1 =
+      _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(a8, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(o8, 1)));
+  d0 = prefix4(d0);
+  d1 = _mm256_add_pd(prefix4(d1), _mm256_permute4x64_pd(d0, 0xff));
+  m0 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d0), zero), scale);
+  m1 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d1), zero), scale);
+  s = _mm256_add_pd(s, _mm256_permute4x64_pd(d1, 0xff));
 }
 
 }  // namespace
 
-KF_AVX2 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, float* means, int count) {
-  return runningMeans(a, old, sum, scale, means, count);
-}
-
 KF_AVX2 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, double* means, int count) {
-  return runningMeans(a, old, sum, scale, means, count);
-}
-
-// The operations of mapFastPortable, eight wide, the polynomial in FMA.
-KF_AVX2 void mapFastAvx2(const FastMap& map, const float* levels, float* forceN, int count) {
-  const __m256 lo = _mm256_set1_ps(map.loLevel), hi = _mm256_set1_ps(map.hiLevel);
-  const __m256 fLo = _mm256_set1_ps(map.forceAtLo), fHi = _mm256_set1_ps(map.forceAtHi);
-  const __m256 fMin = _mm256_set1_ps(map.minForce), fMax = _mm256_set1_ps(map.maxForce);
-  const __m256 a = _mm256_set1_ps(map.perLog2), b = _mm256_set1_ps(map.atLog2Zero);
-  const __m256i mantMask = _mm256_set1_epi32(0x007fffff), one = _mm256_set1_epi32(0x3f800000);
-  const __m256i sqrt2 = _mm256_set1_epi32(kSqrt2Bits), bias = _mm256_set1_epi32(127);
-  const __m256i halfBit = _mm256_set1_epi32(1 << 23);
+  const __m256d vScale = _mm256_set1_pd(scale);
+  __m256d s = _mm256_set1_pd(sum);
   int i = 0;
   for (; i + 8 <= count; i += 8) {
-    const __m256 level = _mm256_loadu_ps(levels + i);
-    const __m256 atLo = _mm256_cmp_ps(level, lo, _CMP_LE_OQ), atHi = _mm256_cmp_ps(level, hi, _CMP_GE_OQ);
-    if (_mm256_movemask_ps(_mm256_or_ps(atLo, atHi)) == 0xff) {  // all eight clipped: no logarithm
-      _mm256_storeu_ps(forceN + i, _mm256_blendv_ps(fLo, fHi, atHi));
-      continue;
-    }
-    const __m256i bits = _mm256_castps_si256(_mm256_min_ps(_mm256_max_ps(level, lo), hi));
-    __m256i ex = _mm256_sub_epi32(_mm256_srli_epi32(bits, 23), bias);
-    __m256i mbits = _mm256_or_si256(_mm256_and_si256(bits, mantMask), one);
-    const __m256i big = _mm256_cmpgt_epi32(mbits, sqrt2);  // all ones where the mantissa > sqrt(2)
-    mbits = _mm256_sub_epi32(mbits, _mm256_and_si256(big, halfBit));
-    ex = _mm256_sub_epi32(ex, big);
-    const __m256 t = _mm256_sub_ps(_mm256_castsi256_ps(mbits), _mm256_set1_ps(1.f));
-    __m256 p = _mm256_fmadd_ps(t, _mm256_set1_ps(kP6), _mm256_set1_ps(kP5));
-    p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP4));
-    p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP3));
-    p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP2));
-    p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP1));
-    p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP0));
-    const __m256 log2 = _mm256_fmadd_ps(t, p, _mm256_cvtepi32_ps(ex));
-    __m256 f = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(log2, a, b), fMin), fMax);
-    f = _mm256_blendv_ps(f, fLo, atLo);
-    f = _mm256_blendv_ps(f, fHi, atHi);  // hi wins, as in the exact path
-    _mm256_storeu_ps(forceN + i, f);
+    __m256d m0, m1;
+    meansEight(a + i, old + i, s, vScale, m0, m1);
+    _mm256_storeu_pd(means + i, m0);
+    _mm256_storeu_pd(means + i + 4, m1);
   }
+  sum = _mm256_cvtsd_f64(s);
+  for (; i < count; ++i) {
+    sum += static_cast<double>(a[i]) - old[i];
+    means[i] = std::max(sum, 0.0) * scale;
+  }
+  return sum;
+}
+
+KF_AVX2 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, float* means, int count) {
+  const __m256d vScale = _mm256_set1_pd(scale);
+  __m256d s = _mm256_set1_pd(sum);
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    __m256d m0, m1;
+    meansEight(a + i, old + i, s, vScale, m0, m1);
+    _mm256_storeu_ps(means + i, _mm256_set_m128(_mm256_cvtpd_ps(m1), _mm256_cvtpd_ps(m0)));
+  }
+  sum = _mm256_cvtsd_f64(s);
+  for (; i < count; ++i) {
+    sum += static_cast<double>(a[i]) - old[i];
+    means[i] = static_cast<float>(std::max(sum, 0.0) * scale);
+  }
+  return sum;
+}
+
+namespace {
+
+struct MapConstants {
+  __m256 lo, hi, fLo, fHi, fMin, fMax, a, b;
+  KF_AVX2 explicit MapConstants(const FastMap& map)
+      : lo(_mm256_set1_ps(map.loLevel)),
+        hi(_mm256_set1_ps(map.hiLevel)),
+        fLo(_mm256_set1_ps(map.forceAtLo)),
+        fHi(_mm256_set1_ps(map.forceAtHi)),
+        fMin(_mm256_set1_ps(map.minForce)),
+        fMax(_mm256_set1_ps(map.maxForce)),
+        a(_mm256_set1_ps(map.perLog2)),
+        b(_mm256_set1_ps(map.atLog2Zero)) {}
+};
+
+// The operations of mapFastPortable on eight levels, the polynomial in FMA.
+__attribute__((target("avx2,fma"), always_inline)) inline __m256 mapEight(const MapConstants& c, __m256 level) {
+  const __m256 atLo = _mm256_cmp_ps(level, c.lo, _CMP_LE_OQ), atHi = _mm256_cmp_ps(level, c.hi, _CMP_GE_OQ);
+  if (_mm256_movemask_ps(_mm256_or_ps(atLo, atHi)) == 0xff)  // all eight clipped: no logarithm
+    return _mm256_blendv_ps(c.fLo, c.fHi, atHi);
+  const __m256i bits = _mm256_castps_si256(_mm256_min_ps(_mm256_max_ps(level, c.lo), c.hi));
+  __m256i ex = _mm256_sub_epi32(_mm256_srli_epi32(bits, 23), _mm256_set1_epi32(127));
+  __m256i mbits = _mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007fffff)), _mm256_set1_epi32(0x3f800000));
+  const __m256i big = _mm256_cmpgt_epi32(mbits, _mm256_set1_epi32(kSqrt2Bits));  // mantissa > sqrt(2)
+  mbits = _mm256_sub_epi32(mbits, _mm256_and_si256(big, _mm256_set1_epi32(1 << 23)));
+  ex = _mm256_sub_epi32(ex, big);
+  const __m256 t = _mm256_sub_ps(_mm256_castsi256_ps(mbits), _mm256_set1_ps(1.f));
+  __m256 p = _mm256_fmadd_ps(t, _mm256_set1_ps(kP6), _mm256_set1_ps(kP5));
+  p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP4));
+  p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP3));
+  p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP2));
+  p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP1));
+  p = _mm256_fmadd_ps(t, p, _mm256_set1_ps(kP0));
+  const __m256 log2 = _mm256_fmadd_ps(t, p, _mm256_cvtepi32_ps(ex));
+  __m256 f = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(log2, c.a, c.b), c.fMin), c.fMax);
+  f = _mm256_blendv_ps(f, c.fLo, atLo);
+  return _mm256_blendv_ps(f, c.fHi, atHi);  // hi wins, as in the exact path
+}
+
+}  // namespace
+
+KF_AVX2 void mapFastAvx2(const FastMap& map, const float* levels, float* forceN, int count) {
+  const MapConstants c(map);
+  int i = 0;
+  for (; i + 8 <= count; i += 8) _mm256_storeu_ps(forceN + i, mapEight(c, _mm256_loadu_ps(levels + i)));
   if (i < count) mapFastPortable(map, levels + i, forceN + i, count - i);
 }
 

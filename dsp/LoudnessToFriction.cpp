@@ -181,32 +181,39 @@ void LoudnessToFriction::process(const float* in, float* forceN, int numSamples)
   const bool avx2 = KF_CORE_AVX2 && corePath() == CorePath::avx2;
   for (int done = 0; done < numSamples; done += kPiece) {
     const int count = std::min(kPiece, numSamples - done);
+    float a[kPiece], old[kPiece];
+    takeIn(in + done, a, old, count);
     if (fastLog_) {
+      const double scale = invRef_ / windowSamples_;
       alignas(32) float levels[kPiece];
-      runningMeans(in + done, levels, invRef_ / windowSamples_, count, avx2);
 #if KF_CORE_AVX2
       if (avx2) {
+        sum_ = loudness::runningMeansAvx2(a, old, sum_, scale, levels, count);
         loudness::mapFastAvx2(fastMap_, levels, forceN + done, count);
+        afterPiece(count);
         continue;
       }
 #endif
+      sum_ = loudness::runningMeansPortable(a, old, sum_, scale, levels, count);
       loudness::mapFastPortable(fastMap_, levels, forceN + done, count);
     } else {
       alignas(32) double means[kPiece];
-      runningMeans(in + done, means, 1.0 / windowSamples_, count, avx2);
+#if KF_CORE_AVX2
+      if (avx2)
+        sum_ = loudness::runningMeansAvx2(a, old, sum_, 1.0 / windowSamples_, means, count);
+      else
+#endif
+        sum_ = loudness::runningMeansPortable(a, old, sum_, 1.0 / windowSamples_, means, count);
       mapExact(means, forceN + done, count);
     }
+    afterPiece(count);
   }
 }
 
-// Equation (1) for a piece: the window's running sum, in double. The serial dependency is one
-// add per four samples: the differences (newest in, oldest out) are formed first, then summed
-// in groups of four whose prefix sums hang off the running sum. The ring is read and written
-// in contiguous runs, without a wrap test per sample.
-template <typename Mean>
-void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale, int count, bool avx2) {
+// A piece's input taken in: a = |in| sanitized, old = the values leaving the window, and a written
+// into the ring. The ring is read and written in contiguous runs, without a wrap test per sample.
+void LoudnessToFriction::takeIn(const float* in, float* a, float* old, int count) {
   const int n = windowSamples_, cap = capacity_;
-  float a[kPiece];
 #if defined(__SSE2__)
   {
     const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
@@ -224,7 +231,6 @@ void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale
 
   // The values leaving the window: from the ring for the first min(n, count) samples, from this
   // piece after that.
-  float old[kPiece];
   const int fromRing = std::min(n, count);
   int oldest = writeIndex_ - n;
   if (oldest < 0) oldest += cap;
@@ -248,19 +254,13 @@ void LoudnessToFriction::runningMeans(const float* in, Mean* means, double scale
     if (w == cap) w = 0;
   }
   writeIndex_ = w;
+}
 
-#if KF_CORE_AVX2
-  if (avx2)
-    sum_ = loudness::runningMeansAvx2(a, old, sum_, scale, means, count);
-  else
-#endif
-    sum_ = loudness::runningMeansPortable(a, old, sum_, scale, means, count);
-  (void)avx2;
-
+void LoudnessToFriction::afterPiece(int count) {
   // Re-sum once per lap of the ring, so rounding cannot accumulate: the sum never carries more
   // than capacity_ + kPiece additions' worth of error, however long it runs.
   sinceResum_ += count;
-  if (sinceResum_ >= cap) {
+  if (sinceResum_ >= capacity_) {
     sinceResum_ = 0;
     resum();
   }

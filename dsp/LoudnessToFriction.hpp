@@ -63,12 +63,10 @@ class LoudnessToFriction {
   float mapMeanAbs(double meanAbs) const;
   float sanitizedAbs(float a) const;
   void resum();
-  // The pieces of process(): equation (1) into means[], then equation (2) from them.
-  // Mean is double (the means, for the exact path) or float (the levels mean / ref, for the
-  // fast path); scale is 1 / n, or 1 / (n ref).
-  // avx2: the AVX2 loops (CorePath.hpp), else the portable ones.
-  template <typename Mean>
-  void runningMeans(const float* in, Mean* means, double scale, int count, bool avx2);
+  // The steps of a piece of process(): the input into the ring (takeIn), the running sum and
+  // equation (2) by the kernels of the code path (LoudnessKernels.hpp), then afterPiece.
+  void takeIn(const float* in, float* a, float* old, int count);
+  void afterPiece(int count);
   void mapExact(const double* means, float* forceN, int count) const;
 
   float* history_;

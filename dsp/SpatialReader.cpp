@@ -3,6 +3,12 @@
 #include <algorithm>
 #include <climits>
 
+#include "CorePath.hpp"
+
+#if KF_CORE_AVX2
+#include <immintrin.h>
+#endif
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #include <xmmintrin.h>
@@ -107,6 +113,60 @@ bool splitIndices(const float* positionMm, int positionStride, double originMm, 
   return border == 0;
 }
 
+#if KF_CORE_AVX2
+struct IndexConstants {
+  __m256d origin, spm, minusOne, end;
+};
+
+// Four indices -> whole parts and fractions, as split() computes them.
+__attribute__((target("avx2,fma"), always_inline)) inline void splitFour(const IndexConstants& c, const float* pos,
+                                                                         __m128i& whole, __m128& frac) {
+  __m256d x = _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pos)), c.origin), c.spm);
+  const __m256d inside = _mm256_and_pd(_mm256_cmp_pd(x, c.minusOne, _CMP_GT_OQ), _mm256_cmp_pd(x, c.end, _CMP_LT_OQ));
+  x = _mm256_blendv_pd(_mm256_set1_pd(kOutside), x, inside);
+  // floor by the magic number 1.5 * 2^52 (|x| < 2^31 here), one less where rounding went up.
+  const __m256d magic = _mm256_set1_pd(6755399441055744.0);
+  const __m256d rounded = _mm256_sub_pd(_mm256_add_pd(x, magic), magic);
+  const __m256d floorX =
+      _mm256_sub_pd(rounded, _mm256_and_pd(_mm256_cmp_pd(rounded, x, _CMP_GT_OQ), _mm256_set1_pd(1.0)));
+  frac = _mm256_cvtpd_ps(_mm256_sub_pd(x, floorX));
+  whole = _mm256_cvttpd_epi32(floorX);
+}
+
+// Pass 1 on the AVX2 path: splitIndices' operations four doubles wide (no FMA: the index is
+// (position - origin) * samplesPerMm rounded twice, as readSpatial() computes it). The whole part
+// is the floor converted by truncation, exact as the floor is an integer below 2^31.
+template <Interpolation I>
+__attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionMm, int positionStride, double originMm,
+                                                          double samplesPerMm, int64_t frames, int n, Piece& p) {
+  if (positionStride == 0) return splitIndices<I>(positionMm, 0, originMm, samplesPerMm, frames, n, p);
+  const int32_t lastWhole = static_cast<int32_t>(frames - 1 - kTapsRight<I>);
+  const IndexConstants c{_mm256_set1_pd(originMm), _mm256_set1_pd(samplesPerMm), _mm256_set1_pd(-1.0),
+                         _mm256_set1_pd(static_cast<double>(frames))};
+  const __m256i low = _mm256_set1_epi32(kTapsLeft<I>), high = _mm256_set1_epi32(lastWhole);
+  __m256i anyBorder = _mm256_setzero_si256();
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    __m128i w0, w1;
+    __m128 f0, f1;
+    splitFour(c, positionMm + i, w0, f0);
+    splitFour(c, positionMm + i + 4, w1, f1);
+    const __m256i whole = _mm256_set_m128i(w1, w0);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(p.whole + i), whole);
+    _mm256_storeu_ps(p.frac + i, _mm256_set_m128(f1, f0));
+    anyBorder =
+        _mm256_or_si256(anyBorder, _mm256_or_si256(_mm256_cmpgt_epi32(low, whole), _mm256_cmpgt_epi32(whole, high)));
+  }
+  int32_t border = !_mm256_testz_si256(anyBorder, anyBorder);
+  for (; i < n; ++i) {
+    split((static_cast<double>(positionMm[i]) - originMm) * samplesPerMm, static_cast<double>(frames), p.whole[i],
+          p.frac[i]);
+    border |= (p.whole[i] < kTapsLeft<I>) | (p.whole[i] > lastWhole);
+  }
+  return border == 0;
+}
+#endif
+
 template <Interpolation I>
 inline float kernel(const float* q, int64_t stride, float frac) {
   if constexpr (I == Interpolation::None) {
@@ -184,11 +244,18 @@ void readPadded(const SignalView& s, int channel, const Piece& p, float* out, in
 template <Interpolation I>
 void readBlock(const SignalView& s, const float* positionMm, int positionStride, double originMm, double samplesPerMm,
                float* const* out, int numSamples) {
+  const bool avx2 = KF_CORE_AVX2 && corePath() == CorePath::avx2;
   Piece p;
   for (int done = 0; done < numSamples; done += kPiece) {
     const int n = std::min(kPiece, numSamples - done);
-    const bool inside =
-        splitIndices<I>(positionMm + done * positionStride, positionStride, originMm, samplesPerMm, s.frames, n, p);
+    const float* pos = positionMm + done * positionStride;
+#if KF_CORE_AVX2
+    const bool inside = avx2 ? splitIndicesAvx2<I>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p)
+                             : splitIndices<I>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p);
+#else
+    const bool inside = splitIndices<I>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p);
+    (void)avx2;
+#endif
     if (inside && s.channels == 1) {
       readInside<I, 1>(s.data, 1, p, out[0] + done, n);
     } else if (inside) {

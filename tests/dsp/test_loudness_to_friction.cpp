@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "CorePath.hpp"
+#include "CorePathScope.hpp"
 #include "LoudnessToFriction.hpp"
 
 using kf::FrictionMapping;
@@ -60,21 +60,6 @@ struct Noise {
     return static_cast<float>((state >> 40) * (1.0 / 8388608.0) - 1.0);
   }
 };
-
-// Runs the code path it is given for as long as it lives, then the one before it again.
-struct PathScope {
-  kf::CorePath before = kf::corePath(), used;
-  explicit PathScope(kf::CorePath wanted) : used(kf::setCorePath(wanted)) {}
-  ~PathScope() { kf::setCorePath(before); }
-};
-
-// A test with EACH_CORE_PATH runs once per code path (CorePath.hpp); on a processor without
-// AVX2/FMA the avx2 run ends at once (setCorePath falls back to the portable path, run already).
-#define EACH_CORE_PATH()                                                                \
-  const kf::CorePath wantedPath = GENERATE(kf::CorePath::portable, kf::CorePath::avx2); \
-  PathScope pathScope(wantedPath);                                                      \
-  if (pathScope.used != wantedPath) return;                                             \
-  INFO("core path " << kf::corePathName(pathScope.used))
 
 std::vector<float> runCore(Core& c, const std::vector<float>& in) {
   std::vector<float> out(in.size());

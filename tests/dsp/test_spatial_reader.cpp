@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "CorePathScope.hpp"
 #include "SpatialReader.hpp"
 
 using kf::Interpolation;
@@ -161,6 +162,7 @@ TEST_CASE("a position far from the origin keeps its index exact in double") {
 // The UGen's path: readSpatialBlock must give readSpatial's values bit for bit, whatever the
 // mode, channel count, position rate, block length, and wherever the positions fall.
 TEST_CASE("the block reader equals the per-sample reader bit for bit") {
+  EACH_CORE_PATH();
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   for (int channels : {1, 2, 3}) {
     const int frames = 37;
@@ -208,6 +210,7 @@ TEST_CASE("the block reader equals the per-sample reader bit for bit") {
 }
 
 TEST_CASE("the block reader may write over its position input") {
+  EACH_CORE_PATH();
   std::vector<float> v(100);
   for (int i = 0; i < 100; ++i) v[i] = static_cast<float>(i % 9) - 4.f;
   SignalView s{v.data(), 100, 1};
@@ -223,6 +226,7 @@ TEST_CASE("the block reader may write over its position input") {
 }
 
 TEST_CASE("the block reader: empty signals are silent, indices at 1e7 stay exact") {
+  EACH_CORE_PATH();
   std::vector<float> pos(10, 1.f), o(10, -1.f);
   float* out[1] = {o.data()};
   for (auto mode : kAll) {
