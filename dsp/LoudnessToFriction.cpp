@@ -181,8 +181,9 @@ void LoudnessToFriction::process(const float* in, float* forceN, int numSamples)
   const bool avx2 = KF_CORE_AVX2 && corePath() == CorePath::avx2;
   for (int done = 0; done < numSamples; done += kPiece) {
     const int count = std::min(kPiece, numSamples - done);
-    float a[kPiece], old[kPiece];
-    takeIn(in + done, a, old, count);
+    float aCopy[kPiece], oldCopy[kPiece];
+    const float *a = aCopy, *old = oldCopy;
+    takeIn(in + done, count, aCopy, oldCopy, a, old);
     if (fastLog_) {
       const double scale = invRef_ / windowSamples_;
       alignas(32) float levels[kPiece];
@@ -212,22 +213,38 @@ void LoudnessToFriction::process(const float* in, float* forceN, int numSamples)
 
 // A piece's input taken in: a = |in| sanitized, old = the values leaving the window, and a written
 // into the ring. The ring is read and written in contiguous runs, without a wrap test per sample.
-void LoudnessToFriction::takeIn(const float* in, float* a, float* old, int count) {
-  const int n = windowSamples_, cap = capacity_;
+void LoudnessToFriction::sanitizeInto(const float* in, float* a, int count) const {
 #if defined(__SSE2__)
-  {
-    const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
-    int i = 0;
-    for (; i + 4 <= count; i += 4) {
-      const __m128 x = _mm_and_ps(_mm_loadu_ps(in + i), absMask);
-      // NaN -> 0 (an unordered compare is all zeros), then the clamp: Inf -> maxAbs.
-      _mm_storeu_ps(a + i, _mm_min_ps(_mm_and_ps(x, _mm_cmpord_ps(x, x)), maxAbs));
-    }
-    for (; i < count; ++i) a[i] = sanitizedAbs(in[i]);
+  const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const __m128 x = _mm_and_ps(_mm_loadu_ps(in + i), absMask);
+    // NaN -> 0 (an unordered compare is all zeros), then the clamp: Inf -> maxAbs.
+    _mm_storeu_ps(a + i, _mm_min_ps(_mm_and_ps(x, _mm_cmpord_ps(x, x)), maxAbs));
   }
+  for (; i < count; ++i) a[i] = sanitizedAbs(in[i]);
 #else
   for (int i = 0; i < count; ++i) a[i] = sanitizedAbs(in[i]);
 #endif
+}
+
+void LoudnessToFriction::takeIn(const float* in, int count, float* aCopy, float* oldCopy, const float*& a,
+                                const float*& old) {
+  const int n = windowSamples_, cap = capacity_, w0 = writeIndex_;
+  if (w0 >= n && w0 + count <= cap && cap >= n + count) {
+    // Most pieces: the piece and the window before it lie in the ring without a wrap, and the
+    // ring is long enough that writing the piece overwrites nothing still to leave. The new
+    // values go straight into the ring, and both runs are read there: no copies.
+    float* at = history_ + w0;
+    sanitizeInto(in, at, count);
+    a = at;
+    old = at - n;
+    writeIndex_ = w0 + count == cap ? 0 : w0 + count;
+    return;
+  }
+  sanitizeInto(in, aCopy, count);
+  a = aCopy;
+  old = oldCopy;
 
   // The values leaving the window: from the ring for the first min(n, count) samples, from this
   // piece after that.
@@ -236,19 +253,19 @@ void LoudnessToFriction::takeIn(const float* in, float* a, float* old, int count
   if (oldest < 0) oldest += cap;
   for (int i = 0; i < fromRing;) {
     const int run = std::min(fromRing - i, cap - oldest);
-    std::memcpy(old + i, history_ + oldest, sizeof(float) * run);
+    std::memcpy(oldCopy + i, history_ + oldest, sizeof(float) * run);
     i += run;
     oldest += run;
     if (oldest == cap) oldest = 0;
   }
-  if (count > fromRing) std::memcpy(old + fromRing, a, sizeof(float) * (count - fromRing));
+  if (count > fromRing) std::memcpy(oldCopy + fromRing, aCopy, sizeof(float) * (count - fromRing));
 
   // Into the ring: only the last cap values matter when the piece is longer than the ring.
   const int keep = std::min(count, cap);
   int w = (writeIndex_ + (count - keep)) % cap;
   for (int i = count - keep; i < count;) {
     const int run = std::min(count - i, cap - w);
-    std::memcpy(history_ + w, a + i, sizeof(float) * run);
+    std::memcpy(history_ + w, aCopy + i, sizeof(float) * run);
     i += run;
     w += run;
     if (w == cap) w = 0;

@@ -65,7 +65,10 @@ class LoudnessToFriction {
   void resum();
   // The steps of a piece of process(): the input into the ring (takeIn), the running sum and
   // equation (2) by the kernels of the code path (LoudnessKernels.hpp), then afterPiece.
-  void takeIn(const float* in, float* a, float* old, int count);
+  // a, old: where the kernels read the piece's |a| and the values leaving the window, in the
+  // ring itself where it can be, else in the copies.
+  void takeIn(const float* in, int count, float* aCopy, float* oldCopy, const float*& a, const float*& old);
+  void sanitizeInto(const float* in, float* a, int count) const;
   void afterPiece(int count);
   void mapExact(const double* means, float* forceN, int count) const;
 
