@@ -40,6 +40,8 @@ void mapFastPortable(const FastMap& map, const float* levels, float* forceN, int
 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, float* means, int count);
 double runningMeansAvx2(const float* a, const float* old, double sum, double scale, double* means, int count);
 void mapFastAvx2(const FastMap& map, const float* levels, float* forceN, int count);
+// a = |in| with NaN -> 0 and clamped at maxAbs, as LoudnessToFriction::sanitizeInto.
+void sanitizeAvx2(const float* in, float* a, float maxAbs, int count);
 #endif
 
 }  // namespace kf::loudness

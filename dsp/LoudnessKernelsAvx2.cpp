@@ -8,6 +8,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
 
 #define KF_AVX2 __attribute__((target("avx2,fma")))
 
@@ -122,6 +123,20 @@ KF_AVX2 void mapFastAvx2(const FastMap& map, const float* levels, float* forceN,
   int i = 0;
   for (; i + 8 <= count; i += 8) _mm256_storeu_ps(forceN + i, mapEight(c, _mm256_loadu_ps(levels + i)));
   if (i < count) mapFastPortable(map, levels + i, forceN + i, count - i);
+}
+
+KF_AVX2 void sanitizeAvx2(const float* in, float* a, float maxAbs, int count) {
+  const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), vMax = _mm256_set1_ps(maxAbs);
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    const __m256 x = _mm256_and_ps(_mm256_loadu_ps(in + i), absMask);
+    // NaN -> 0 (an unordered compare is all zeros), then the clamp: Inf -> maxAbs.
+    _mm256_storeu_ps(a + i, _mm256_min_ps(_mm256_and_ps(x, _mm256_cmp_ps(x, x, _CMP_ORD_Q)), vMax));
+  }
+  for (; i < count; ++i) {
+    const float x = std::fabs(in[i]);
+    a[i] = x <= maxAbs ? x : (x != x ? 0.f : maxAbs);
+  }
 }
 
 }  // namespace kf::loudness

@@ -214,6 +214,9 @@ void LoudnessToFriction::process(const float* in, float* forceN, int numSamples)
 // A piece's input taken in: a = |in| sanitized, old = the values leaving the window, and a written
 // into the ring. The ring is read and written in contiguous runs, without a wrap test per sample.
 void LoudnessToFriction::sanitizeInto(const float* in, float* a, int count) const {
+#if KF_CORE_AVX2
+  if (corePath() == CorePath::avx2) return loudness::sanitizeAvx2(in, a, maxAbs_, count);
+#endif
 #if defined(__SSE2__)
   const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), maxAbs = _mm_set1_ps(maxAbs_);
   int i = 0;

@@ -153,7 +153,7 @@ __attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionM
     splitFour(c, positionMm + i + 4, w1, f1);
     const __m256i whole = _mm256_set_m128i(w1, w0);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(p.whole + i), whole);
-    _mm256_storeu_ps(p.frac + i, _mm256_set_m128(f1, f0));
+    if constexpr (I != Interpolation::None) _mm256_storeu_ps(p.frac + i, _mm256_set_m128(f1, f0));  // none: unread
     anyBorder =
         _mm256_or_si256(anyBorder, _mm256_or_si256(_mm256_cmpgt_epi32(low, whole), _mm256_cmpgt_epi32(whole, high)));
   }
@@ -217,6 +217,27 @@ void readInside(const float* channelData, int64_t stride, const Piece& p, float*
     out[i] = kernel<I>(channelData + static_cast<int64_t>(p.whole[i]) * stride, stride, p.frac[i]);
 }
 
+#if KF_CORE_AVX2
+// Pass 2 on the AVX2 path, mono none and linear with every tap inside: the taps gathered eight
+// at a time, the linear kernel in the same operations and order as kernel() (the file is built
+// with -ffp-contract=off, so no FMA joins them), hence the same results bit for bit.
+template <Interpolation I>
+__attribute__((target("avx2,fma"))) void readInsideMonoAvx2(const float* data, const Piece& p, float* out, int n) {
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256i whole = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.whole + i));
+    const __m256 y1 = _mm256_i32gather_ps(data, whole, 4);
+    if constexpr (I == Interpolation::None) {
+      _mm256_storeu_ps(out + i, y1);
+    } else {
+      const __m256 y2 = _mm256_i32gather_ps(data + 1, whole, 4);
+      _mm256_storeu_ps(out + i, _mm256_add_ps(y1, _mm256_mul_ps(_mm256_loadu_ps(p.frac + i), _mm256_sub_ps(y2, y1))));
+    }
+  }
+  for (; i < n; ++i) out[i] = kernel<I>(data + p.whole[i], 1, p.frac[i]);
+}
+#endif
+
 // Pass 2 of a piece that touches a border or the outside: padded taps per sample.
 template <Interpolation I>
 void readPadded(const SignalView& s, int channel, const Piece& p, float* out, int n) {
@@ -257,6 +278,12 @@ void readBlock(const SignalView& s, const float* positionMm, int positionStride,
     (void)avx2;
 #endif
     if (inside && s.channels == 1) {
+#if KF_CORE_AVX2
+      if (I != Interpolation::Cubic && avx2) {
+        readInsideMonoAvx2<I>(s.data, p, out[0] + done, n);
+        continue;
+      }
+#endif
       readInside<I, 1>(s.data, 1, p, out[0] + done, n);
     } else if (inside) {
       for (int c = 0; c < s.channels; ++c) readInside<I, 0>(s.data + c, s.channels, p, out[c] + done, n);

@@ -90,6 +90,9 @@ class LoudnessToFrictionUGen : public SCUnit {
   // too): maxWindow. A window below half a sample is one sample.
   void updateWindow() {
     double windowS = in0(kWindowS);
+    if (mWindowSet && same(windowS, mWantedWindowS)) return;  // the usual block: nothing moved
+    mWindowSet = true;
+    mWantedWindowS = windowS;
     if (!(windowS > 0.0)) {
       if (mBadInputs.first(kBadWindow))
         kf::sc::postFromRt(mWorld, "LoudnessToFriction: window %g s is not > 0; the paper's %g s used.\n",
@@ -133,9 +136,11 @@ class LoudnessToFrictionUGen : public SCUnit {
   double mMaxWindowS = 0.0;  // maxWindow as used (the input, the paper's or the limit)
   // The core lives inside the unit, made once the history is allocated: no other allocation.
   std::optional<kf::LoudnessToFriction> mCore;
-  // The inputs the mapping was last made from.
+  // The inputs the mapping and the window were last made from.
   kf::FrictionMapping mWanted;
   bool mMapped = false;
+  double mWantedWindowS = 0.0;
+  bool mWindowSet = false;
   kf::sc::FirstTimeOnly mBadInputs;
 };
 
