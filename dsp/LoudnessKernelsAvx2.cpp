@@ -24,19 +24,18 @@ KF_AVX2 inline __m256d prefix4(__m256d d) {
 }
 
 // Eight samples of equation (1): the running sum s (in every lane) plus the prefix sums of
-// a - old, in m0 (samples 0..3) and m1 (4..7), clamped at 0 and scaled; s moves on by the total.
+// a - old, in m0 (samples 0..3) and m1 (4..7), scaled, not clamped at 0; s moves on by the total.
 // The serial dependency is one add per eight samples; the prefix sums hang off it.
 __attribute__((target("avx2,fma"), always_inline)) inline void meansEight(const float* a, const float* old, __m256d& s,
                                                                           __m256d scale, __m256d& m0, __m256d& m1) {
-  const __m256d zero = _mm256_setzero_pd();
   const __m256 a8 = _mm256_loadu_ps(a), o8 = _mm256_loadu_ps(old);
   __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(a8)), _mm256_cvtps_pd(_mm256_castps256_ps128(o8)));
   __m256d d1 =
       _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(a8, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(o8, 1)));
   d0 = prefix4(d0);
   d1 = _mm256_add_pd(prefix4(d1), _mm256_permute4x64_pd(d0, 0xff));
-  m0 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d0), zero), scale);
-  m1 = _mm256_mul_pd(_mm256_max_pd(_mm256_add_pd(s, d1), zero), scale);
+  m0 = _mm256_mul_pd(_mm256_add_pd(s, d0), scale);
+  m1 = _mm256_mul_pd(_mm256_add_pd(s, d1), scale);
   s = _mm256_add_pd(s, _mm256_permute4x64_pd(d1, 0xff));
 }
 
@@ -49,8 +48,8 @@ KF_AVX2 double runningMeansAvx2(const float* a, const float* old, double sum, do
   for (; i + 8 <= count; i += 8) {
     __m256d m0, m1;
     meansEight(a + i, old + i, s, vScale, m0, m1);
-    _mm256_storeu_pd(means + i, m0);
-    _mm256_storeu_pd(means + i + 4, m1);
+    _mm256_storeu_pd(means + i, _mm256_max_pd(m0, _mm256_setzero_pd()));
+    _mm256_storeu_pd(means + i + 4, _mm256_max_pd(m1, _mm256_setzero_pd()));
   }
   sum = _mm256_cvtsd_f64(s);
   for (; i < count; ++i) {
@@ -67,7 +66,10 @@ KF_AVX2 double runningMeansAvx2(const float* a, const float* old, double sum, do
   for (; i + 8 <= count; i += 8) {
     __m256d m0, m1;
     meansEight(a + i, old + i, s, vScale, m0, m1);
-    _mm256_storeu_ps(means + i, _mm256_set_m128(_mm256_cvtpd_ps(m1), _mm256_cvtpd_ps(m0)));
+    // No clamp at 0 (the portable loop has one): the fast path's low bound is >= 1e-30, so a
+    // sum rounded below 0 is at or below it and reads as silence all the same.
+    _mm_storeu_ps(means + i, _mm256_cvtpd_ps(m0));
+    _mm_storeu_ps(means + i + 4, _mm256_cvtpd_ps(m1));
   }
   sum = _mm256_cvtsd_f64(s);
   for (; i < count; ++i) {

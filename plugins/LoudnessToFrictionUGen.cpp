@@ -7,6 +7,7 @@
 // are kf::usableMapping's. A failed history allocation leaves the force of silence (loForce).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include "LoudnessToFriction.hpp"
@@ -21,9 +22,6 @@ enum BadInput { kBadWindow, kWindowBeyondMax, kBadLoDb, kBadHiDb, kBadLoForce, k
 
 // Upper bound on the history, whatever maxWindow asks: 2^22 samples is 21 s at 192 kHz.
 constexpr int kMaxHistorySamples = 1 << 22;
-
-// Two inputs are the same value (NaN included: a NaN held does not re-map every block).
-bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
 class LoudnessToFrictionUGen : public SCUnit {
  public:
@@ -89,10 +87,11 @@ class LoudnessToFrictionUGen : public SCUnit {
   // window NaN, 0 or negative: the paper's window (at most maxWindow); beyond maxWindow (inf
   // too): maxWindow. A window below half a sample is one sample.
   void updateWindow() {
-    double windowS = in0(kWindowS);
-    if (mWindowSet && same(windowS, mWantedWindowS)) return;  // the usual block: nothing moved
+    const float rawWindowS = in0(kWindowS);
+    if (mWindowSet && std::memcmp(&rawWindowS, &mRawWindowS, sizeof(float)) == 0) return;  // as updateMapping
     mWindowSet = true;
-    mWantedWindowS = windowS;
+    mRawWindowS = rawWindowS;
+    double windowS = rawWindowS;
     if (!(windowS > 0.0)) {
       if (mBadInputs.first(kBadWindow))
         kf::sc::postFromRt(mWorld, "LoudnessToFriction: window %g s is not > 0; the paper's %g s used.\n",
@@ -108,13 +107,12 @@ class LoudnessToFrictionUGen : public SCUnit {
   }
 
   void updateMapping() {
-    const kf::FrictionMapping wanted{in0(kLoDb), in0(kHiDb), in0(kLoForceN), in0(kHiForceN), in0(kRef)};
-    if (mMapped && same(wanted.loDb, mWanted.loDb) && same(wanted.hiDb, mWanted.hiDb) &&
-        same(wanted.loForceN, mWanted.loForceN) && same(wanted.hiForceN, mWanted.hiForceN) &&
-        same(wanted.ref, mWanted.ref))
-      return;  // a few pow()s: only when a parameter moved
+    // The five inputs compared as bits (a NaN held is the same NaN): the usual block ends here.
+    const float raw[5] = {in0(kLoDb), in0(kHiDb), in0(kLoForceN), in0(kHiForceN), in0(kRef)};
+    if (mMapped && std::memcmp(raw, mRawMapping, sizeof(raw)) == 0) return;  // a few pow()s: only on a change
     mMapped = true;
-    mWanted = wanted;
+    std::memcpy(mRawMapping, raw, sizeof(raw));
+    const kf::FrictionMapping wanted{raw[0], raw[1], raw[2], raw[3], raw[4]};
     const kf::FrictionMapping used = kf::usableMapping(wanted);
     noticeReplaced(kBadLoDb, "loDb", wanted.loDb, used.loDb, " dB", "a finite level");
     noticeReplaced(kBadHiDb, "hiDb", wanted.hiDb, used.hiDb, " dB", "a finite level");
@@ -137,9 +135,9 @@ class LoudnessToFrictionUGen : public SCUnit {
   // The core lives inside the unit, made once the history is allocated: no other allocation.
   std::optional<kf::LoudnessToFriction> mCore;
   // The inputs the mapping and the window were last made from.
-  kf::FrictionMapping mWanted;
+  float mRawMapping[5] = {};
   bool mMapped = false;
-  double mWantedWindowS = 0.0;
+  float mRawWindowS = 0.f;
   bool mWindowSet = false;
   kf::sc::FirstTimeOnly mBadInputs;
 };
