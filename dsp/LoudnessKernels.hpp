@@ -8,12 +8,13 @@
 
 namespace kf::loudness {
 
-// log2 of a positive normal float: the exponent from the bits, the mantissa folded into
-// [sqrt(1/2), sqrt(2)), log2(1 + t) = t P(t) with P of degree 6 fitted (minimax, float
-// coefficients) on t in [-0.293, 0.415]. Worst error against std::log2 in double over every float
-// in [0.5, 2) (every mantissa, both sides of the fold), the float sum e + t P included: 3.98e-7
-// with separate multiplies and adds (portable), 3.79e-7 with FMA (AVX2). kFastLog2Error holds
-// for both; setMapping adds the sum's rounding at larger exponents on top.
+// log2 of a positive normal float on the portable path: the exponent from the bits, the
+// mantissa folded into [sqrt(1/2), sqrt(2)), log2(1 + t) = t P(t) with P of degree 6 fitted
+// (minimax, float coefficients) on t in [-0.293, 0.415]. The AVX2 path has its own (an
+// eight-entry table and degree 4, LoudnessKernelsAvx2.cpp). Worst error against std::log2 in
+// double over every float in [0.5, 2) (every mantissa, both sides of the fold), the float sum
+// e + t P included: 3.98e-7 portable, 8.5e-8 AVX2. kFastLog2Error holds for both; setMapping
+// adds the sum's rounding at larger exponents on top.
 constexpr double kFastLog2Error = 4e-7;
 constexpr float kP0 = 1.4426996708f, kP1 = -0.7213758826f, kP2 = 0.4804650247f, kP3 = -0.3589618504f,
                 kP4 = 0.2972626686f, kP5 = -0.2726978362f, kP6 = 0.1706340909f;
