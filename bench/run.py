@@ -55,6 +55,9 @@ def arguments():
     ap.add_argument("--e2e-runs", type=int, default=3)
     ap.add_argument("--rtload-s", type=float, default=20.0, help="seconds of each run of the rtload part")
     ap.add_argument("--scale-runs", type=int, default=3, help="scale searches per sample rate")
+    ap.add_argument("--core-path", choices=["auto", "portable"], default=None,
+                    help="the cores' code path for everything the run starts: portable sets KF_CORE_PATH=portable "
+                         "(default: the environment's KF_CORE_PATH, else avx2 where the processor has it)")
     ap.add_argument("--no-report", action="store_true", help="print only; leave bench/REPORT.md and the plots alone")
     ap.add_argument("--report-only", action="store_true",
                     help="measure nothing: rewrite bench/REPORT.md from bench/results.json")

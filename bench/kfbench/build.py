@@ -11,7 +11,8 @@ def needed(bench):
     """True when a bench target is missing (then the build part runs even if not asked for)."""
     return not (bench.exe("bench", "KFBenchClock.so").exists()
                 and bench.exe("bench", "kf_reconstruction_bench").exists()
-                and bench.exe("bench", "kf_report_rate_bench").exists())
+                and bench.exe("bench", "kf_report_rate_bench").exists()
+                and bench.exe("bench", "kf_core_path").exists())
 
 
 def build(bench):
@@ -19,7 +20,8 @@ def build(bench):
         log(f"configuring {bench.build} (as scripts/setup.sh does)")
         subprocess.run(["cmake", "-S", str(paths.REPO_DIR), "-B", str(bench.build), "-DCMAKE_BUILD_TYPE=Release"],
                        check=True, stdout=subprocess.DEVNULL)
-    targets = ["KineticFriction", "KFBenchClock", "kf_log_choice", "kf_reconstruction_bench", "kf_report_rate_bench"]
+    targets = ["KineticFriction", "KFBenchClock", "kf_log_choice", "kf_reconstruction_bench", "kf_report_rate_bench",
+               "kf_core_path"]
     if bench.tests_enabled():
         targets.append("dsp_tests")
     log(f"building {', '.join(targets)} (-j2)")

@@ -25,12 +25,28 @@ def _values(values, digits=3, scale=1.0):
     return ", ".join(f"{v * scale:.{digits}f}" for v in values)
 
 
+def _where(tm):
+    """The code path and processor a timing render ran on (older results: '?')."""
+    return {"path": tm.get("core_path", "?"), "processor": tm.get("processor", "?")}
+
+
+def spatial_modes(tm):
+    """SpatialBufRd none and linear against BufRd with the same interpolation (CPU only: their
+    errors are the same kernels', see the spatial section)."""
+    if not tm:
+        return render("goal_spatial_modes_unmeasured", goal=SPATIAL_GOAL)
+    modes = {m: tm["ratios"][f"SpatialBufRd/BufRd {m}"]["cpu-empty"] for m in ("none", "linear")}
+    return render("goal_spatial_modes", goal=SPATIAL_GOAL, **_where(tm),
+                  status=_status(all(e["median"] <= SPATIAL_GOAL for e in modes.values())),
+                  ratios=", ".join(f"{m} {e['median']:.3f}x [{e['min']:.3f}..{e['max']:.3f}]" for m, e in modes.items()))
+
+
 def spatial(tm, sp):
     if not (tm and sp):
         return render("goal_spatial_unmeasured", goal=SPATIAL_GOAL)
     e = tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-empty"]
     long = sp["index"][LONG_LABEL]
-    return render("goal_spatial", goal=SPATIAL_GOAL, status=_status(e["median"] <= SPATIAL_GOAL), cpu=e,
+    return render("goal_spatial", goal=SPATIAL_GOAL, **_where(tm), status=_status(e["median"] <= SPATIAL_GOAL), cpu=e,
                   source=tm["ratios"]["SpatialBufRd/BufRd cubic"]["cpu-source"]["median"],
                   worst=max(en["SpatialBufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values()),
                   worst_bufrd=max(en["BufRd cubic"]["max_vs_signal"] for en in sp["pilot"].values()),
@@ -43,7 +59,7 @@ def loudness(tm, ld):
         return render("goal_loudness_unmeasured", goal=LOUDNESS_GOAL, error_goal=ERROR_GOAL_TEXT)
     e = tm["ratios"]["LoudnessToFriction/RunningSum chain"]["cpu-empty"]
     err = ld["errors"]["LoudnessToFriction"]["max_n"]
-    return render("goal_loudness", goal=LOUDNESS_GOAL, error_goal=ERROR_GOAL_TEXT,
+    return render("goal_loudness", goal=LOUDNESS_GOAL, error_goal=ERROR_GOAL_TEXT, **_where(tm),
                   status=_status(e["median"] <= LOUDNESS_GOAL and err <= LOUDNESS_ERROR_GOAL_N), cpu=e,
                   source=tm["ratios"]["LoudnessToFriction/RunningSum chain"]["cpu-source"]["median"], error=err)
 
@@ -89,7 +105,7 @@ def loaded(rt):
 
 def goals(results):
     """The goal lines, printed by the run and listed at the top of the report."""
-    return [spatial(results.get("timing"), results.get("spatial")),
+    return [spatial(results.get("timing"), results.get("spatial")), spatial_modes(results.get("timing")),
             loudness(results.get("timing"), results.get("loudness")),
             reconstruction(results.get("reconstruction")),
             *realtime(results.get("e2e")), loaded(results.get("rtload"))]

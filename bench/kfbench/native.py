@@ -1,12 +1,23 @@
 """The C++ benchmarks built in build/bench: the logarithm of equation (2) (kf_log_choice) and
 FrictionMouseIn's reconstruction modes against the simulated puck (kf_reconstruction_bench)."""
 import json
+import os
 import re
 import subprocess
 
 import numpy as np
 
 LAG_GOAL = 0.5  # predictive lag at most this share of linear's (the paper's mode)
+
+
+def core_path(bench):
+    """The cores' code path in this environment (KF_CORE_PATH) on this processor, as kf_core_path
+    reports it: {"path": "avx2" or "portable", "avx2_fma": bool, "requested": KF_CORE_PATH or None}."""
+    out = subprocess.run([str(bench.exe("bench", "kf_core_path"))], stdout=subprocess.PIPE, text=True,
+                         check=True).stdout
+    fields = dict(line.split(" ", 1) for line in out.splitlines() if " " in line)
+    return {"path": fields.get("path", "?"), "avx2_fma": fields.get("avx2_fma") == "yes",
+            "requested": os.environ.get("KF_CORE_PATH")}
 
 
 def run_log_choice(bench):

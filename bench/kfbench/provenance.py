@@ -1,5 +1,5 @@
 """Which code and machine measured a part: the commit (marked when the working tree had changes
-to tracked files other than the bench's own outputs), the date, the machine and its processor."""
+to tracked files other than the bench's own outputs), the date, the machine, its processor and the cores' code path."""
 import os
 import platform
 import subprocess
@@ -34,7 +34,8 @@ def processor():
     return platform.processor() or "?"
 
 
-def stamp(date):
+def stamp(date, core_path):
+    """core_path: the cores' code path (portable / avx2) the run's scsynth and native benches took."""
     mem_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
-    return {"commit": commit(), "date": date, "processor": processor(),
+    return {"commit": commit(), "date": date, "processor": processor(), "core_path": core_path,
             "machine": f"{os.cpu_count()} cores, {mem_gib:.0f} GiB, {platform.system()} {platform.release()}"}

@@ -45,9 +45,9 @@ def provenance(results):
     measured = results.get("measured", {})
     latest = results.get("meta", {}).get("date")
     rows = [(part, m.get("commit", "?"), m.get("date", "?") + ("" if m.get("date") == latest else " (an earlier run)"),
-             m.get("processor", "?"), m.get("machine", "?"))
+             m.get("processor", "?"), m.get("core_path", "?"), m.get("machine", "?"))
             for part in results if part not in ("meta", "measured") for m in [measured.get(part, {})]]
-    return [render("provenance", table=table(["part", "commit", "date", "processor", "machine"], rows))]
+    return [render("provenance", table=table(["part", "commit", "date", "processor", "code path", "machine"], rows))]
 
 
 def repeatability(results):

@@ -3,6 +3,7 @@ test, reconstruction, the realtime parts; then the summary, the goals, results.j
 run this time kept as they were, each with the commit and date that measured it), the report and
 the plots."""
 import json
+import os
 import time
 
 from kfharness import nrt
@@ -50,6 +51,8 @@ def run_nrt(bench, args, parts, results):
             f"{args.instances} instances per phase)")
         log(f"timing render took {_render(bench, 'timing', 4):.1f} s")
         results["timing"] = timing.analyse(bench, order, args.instances, args.phase_s)
+        # The code path scsynth's cores took (it runs in this environment) and the processor.
+        results["timing"].update(core_path=native.core_path(bench)["path"], processor=provenance.processor())
         _print({"timing": results["timing"]})
         if report_plots:
             plots.plot_timing(results["timing"], BENCH_DIR / "timing.png")
@@ -138,6 +141,10 @@ def merge_with_previous(results, stamp):
 
 def main(args):
     parts = args.only or PARTS
+    if args.core_path == "portable":  # inherited by scsynth and the native benches
+        os.environ["KF_CORE_PATH"] = "portable"
+    elif args.core_path == "auto":
+        os.environ.pop("KF_CORE_PATH", None)
     bench = Bench(args.build_dir)
     if args.report_only:
         report.write(json.loads(RESULTS_PATH.read_text()), REPORT_PATH, bench.relative(bench.build))
@@ -159,7 +166,8 @@ def main(args):
     log(f"bench took {results['meta']['bench_s'] / 60:.1f} min after {build_s:.0f} s of building")
     if not args.no_report:
         write_plots(results)
-        merged = merge_with_previous(results, provenance.stamp(results['meta']['date']))
+        merged = merge_with_previous(results, provenance.stamp(results['meta']['date'],
+                                                               native.core_path(bench)["path"]))
         RESULTS_PATH.write_text(json.dumps(merged, indent=1, default=float))
         report.write(merged, REPORT_PATH, bench.relative(bench.build))
         log(f"wrote {REPORT_PATH} and {RESULTS_PATH}")

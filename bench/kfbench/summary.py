@@ -22,7 +22,8 @@ def summary_lines(results):
     ld = results.get("loudness")
     if tm:
         lines.append(f"timing: {tm['instances']} instances x {tm['rounds']} rounds of {tm['phase_s']} s phases, "
-                     f"{SR // 1000} kHz, block {BLOCK}")
+                     f"{SR // 1000} kHz, block {BLOCK}; the cores' {tm.get('core_path', '?')} code path on "
+                     f"{tm.get('processor', '?')}")
         for label, e in tm["ratios"].items():
             c, w, cs = e["cpu-empty"], e["wall-empty"], e["cpu-source"]
             lines.append(f"  {label:38s} CPU {c['median']:.3f}x [{c['min']:.3f}..{c['max']:.3f}]  "
