@@ -136,10 +136,21 @@ __attribute__((target("avx2,fma"), always_inline)) inline void splitFour(const I
 // Pass 1 on the AVX2 path: splitIndices' operations four doubles wide (no FMA: the index is
 // (position - origin) * samplesPerMm rounded twice, as readSpatial() computes it). The whole part
 // is the floor converted by truncation, exact as the floor is an integer below 2^31.
-template <Interpolation I>
+// With Gather (mono none), pass 2 is done here too: each sample gathered at its whole part
+// clamped into the signal, right away. That is the output wherever the piece turns out to lie
+// inside; a piece that does not is read again by readPadded (the clamp only keeps the gathers
+// in memory).
+template <Interpolation I, bool Gather = false>
 __attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionMm, int positionStride, double originMm,
-                                                          double samplesPerMm, int64_t frames, int n, Piece& p) {
-  if (positionStride == 0) return splitIndices<I>(positionMm, 0, originMm, samplesPerMm, frames, n, p);
+                                                          double samplesPerMm, int64_t frames, int n, Piece& p,
+                                                          const float* data = nullptr, float* out = nullptr) {
+  static_assert(!Gather || I == Interpolation::None, "the gather reads one tap");
+  if (positionStride == 0) {
+    const bool inside = splitIndices<I>(positionMm, 0, originMm, samplesPerMm, frames, n, p);
+    if constexpr (Gather)
+      if (inside) std::fill_n(out, n, data[p.whole[0]]);
+    return inside;
+  }
   const int32_t lastWhole = static_cast<int32_t>(frames - 1 - kTapsRight<I>);
   const IndexConstants c{_mm256_set1_pd(originMm), _mm256_set1_pd(samplesPerMm), _mm256_set1_pd(-1.0),
                          _mm256_set1_pd(static_cast<double>(frames))};
@@ -153,6 +164,8 @@ __attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionM
     splitFour(c, positionMm + i + 4, w1, f1);
     const __m256i whole = _mm256_set_m128i(w1, w0);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(p.whole + i), whole);
+    if constexpr (Gather)
+      _mm256_storeu_ps(out + i, _mm256_i32gather_ps(data, _mm256_min_epi32(_mm256_max_epi32(whole, low), high), 4));
     if constexpr (I != Interpolation::None) _mm256_storeu_ps(p.frac + i, _mm256_set_m128(f1, f0));  // none: unread
     anyBorder =
         _mm256_or_si256(anyBorder, _mm256_or_si256(_mm256_cmpgt_epi32(low, whole), _mm256_cmpgt_epi32(whole, high)));
@@ -162,6 +175,7 @@ __attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionM
     split((static_cast<double>(positionMm[i]) - originMm) * samplesPerMm, static_cast<double>(frames), p.whole[i],
           p.frac[i]);
     border |= (p.whole[i] < kTapsLeft<I>) | (p.whole[i] > lastWhole);
+    if constexpr (Gather) out[i] = data[std::clamp(p.whole[i], kTapsLeft<I>, lastWhole)];
   }
   return border == 0;
 }
@@ -217,20 +231,6 @@ void readInside(const float* channelData, int64_t stride, const Piece& p, float*
     out[i] = kernel<I>(channelData + static_cast<int64_t>(p.whole[i]) * stride, stride, p.frac[i]);
 }
 
-#if KF_CORE_AVX2
-// Pass 2 on the AVX2 path, mono none with every tap inside: the samples gathered eight at a time.
-// (Linear gathered both taps the same way, its kernel in kernel()'s operations and order, but
-// measured slower than the scalar loop: 2.23 against 2.09 ns a sample in the timing render.)
-__attribute__((target("avx2,fma"))) void readInsideMonoNoneAvx2(const float* data, const Piece& p, float* out, int n) {
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m256i whole = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.whole + i));
-    _mm256_storeu_ps(out + i, _mm256_i32gather_ps(data, whole, 4));
-  }
-  for (; i < n; ++i) out[i] = data[p.whole[i]];
-}
-#endif
-
 // Pass 2 of a piece that touches a border or the outside: padded taps per sample.
 template <Interpolation I>
 void readPadded(const SignalView& s, int channel, const Piece& p, float* out, int n) {
@@ -264,6 +264,17 @@ void readBlock(const SignalView& s, const float* positionMm, int positionStride,
     const int n = std::min(kPiece, numSamples - done);
     const float* pos = positionMm + done * positionStride;
 #if KF_CORE_AVX2
+    if constexpr (I == Interpolation::None) {
+      // Mono none in one pass, where writing a sample's output cannot change a position not yet
+      // read: the output is the position array itself, or apart from it.
+      float* o = out[0] + done;
+      const bool apart = o == pos || o + n <= pos || pos + (n - 1) * positionStride < o;
+      if (avx2 && s.channels == 1 && apart) {
+        if (!splitIndicesAvx2<I, true>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p, s.data, o))
+          readPadded<I>(s, 0, p, o, n);
+        continue;
+      }
+    }
     const bool inside = avx2 ? splitIndicesAvx2<I>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p)
                              : splitIndices<I>(pos, positionStride, originMm, samplesPerMm, s.frames, n, p);
 #else
@@ -271,12 +282,6 @@ void readBlock(const SignalView& s, const float* positionMm, int positionStride,
     (void)avx2;
 #endif
     if (inside && s.channels == 1) {
-#if KF_CORE_AVX2
-      if (I == Interpolation::None && avx2) {
-        readInsideMonoNoneAvx2(s.data, p, out[0] + done, n);
-        continue;
-      }
-#endif
       readInside<I, 1>(s.data, 1, p, out[0] + done, n);
     } else if (inside) {
       for (int c = 0; c < s.channels; ++c) readInside<I, 0>(s.data + c, s.channels, p, out[c] + done, n);
