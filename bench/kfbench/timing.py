@@ -22,6 +22,12 @@ for _interp in (4, 2, 1):
 DEFS.update({"srcin": "Out.ar(201, In.ar(103))", "ltf": "Out.ar(201, LoudnessToFriction.ar(In.ar(103)))",
              "chain": f"Out.ar(201, {running_sum_chain_sc('In.ar(103)')})",
              "amp": f"Out.ar(201, {amplitude_chain_sc('In.ar(103)')})"})
+# The device UGens, per instance, on the simulated device the score opens on slot 0 (stepped in
+# lockstep with the render): FrictionMouseIn's four outputs, and FrictionOut's force (every
+# instance writes to the one slot, whose frames combine them).
+DEVICE_SLOT = 0
+DEFS.update({"mousein": f"Out.ar(202, FrictionMouseIn.ar({DEVICE_SLOT}))",
+             "fout": f"Out.ar(201, FrictionOut.ar({DEVICE_SLOT}, In.ar(103).abs))"})
 PHASES = ["empty"] + list(DEFS)
 SETTLE_S = 0.25  # a phase is measured from SETTLE_S after its start to TAIL_S before its end
 TAIL_S = 0.05
@@ -57,7 +63,7 @@ def score_code(bench, order, instances, phase_s):
     defs = ",\n".join(f"    SynthDef(\\kfb_{name}, {{ {body} }})" for name, body in DEFS.items())
     return scores.code("timing", defs=defs, order=", ".join(f"\\{p}" for p in order), instances=instances,
                        phase_s=phase_s, mappings=MAPPINGS, frames=PILOT_FRAMES, speeds=SPEEDS, origin=ORIGIN,
-                       loudness_in=LOUDNESS_IN_SC, pilot_wav=scores.sc_path(bench.work / "pilot.wav"),
+                       loudness_in=LOUDNESS_IN_SC, slot=DEVICE_SLOT, pilot_wav=scores.sc_path(bench.work / "pilot.wav"),
                        osc=scores.sc_path(bench.work / "timing.osc"))
 
 
