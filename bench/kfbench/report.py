@@ -71,7 +71,8 @@ def notes(results):
                    far=sp["index"][spatial.FAR_LABEL], far_origin=spatial.FAR_ORIGIN_MM, n=LTF_N,
                    loudness_goal=goals.LOUDNESS_GOAL, error_goal=goals.ERROR_GOAL_TEXT,
                    log_current=logs["std::log10 (double)"],
-                   log_exact=logs["std::log (double) * log10(e), the exact path"], errors=ld["errors"])]
+                   log_exact=logs["std::log (double) * log10(e), the exact path"], errors=ld["errors"],
+                   path=tm.get("core_path", "?"))]
 
 
 def timing_section(tm):
