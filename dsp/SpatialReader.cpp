@@ -118,18 +118,20 @@ struct IndexConstants {
   __m256d origin, spm, minusOne, end;
 };
 
-// Four indices -> whole parts and fractions, as split() computes them.
+// Four indices -> whole parts and fractions, as split() computes them; floor by vroundpd (AVX),
+// exact. Without Outside (none), indices outside (-1, frames) keep their own floor instead of
+// kOutside: none's padded read gives 0 for any whole part outside the signal, which is where
+// they all are, and one beyond int32 (also NaN, Inf) converts to INT32_MIN, outside too.
+template <bool Outside>
 __attribute__((target("avx2,fma"), always_inline)) inline void splitFour(const IndexConstants& c, const float* pos,
                                                                          __m128i& whole, __m128& frac) {
   __m256d x = _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pos)), c.origin), c.spm);
-  const __m256d inside = _mm256_and_pd(_mm256_cmp_pd(x, c.minusOne, _CMP_GT_OQ), _mm256_cmp_pd(x, c.end, _CMP_LT_OQ));
-  x = _mm256_blendv_pd(_mm256_set1_pd(kOutside), x, inside);
-  // floor by the magic number 1.5 * 2^52 (|x| < 2^31 here), one less where rounding went up.
-  const __m256d magic = _mm256_set1_pd(6755399441055744.0);
-  const __m256d rounded = _mm256_sub_pd(_mm256_add_pd(x, magic), magic);
-  const __m256d floorX =
-      _mm256_sub_pd(rounded, _mm256_and_pd(_mm256_cmp_pd(rounded, x, _CMP_GT_OQ), _mm256_set1_pd(1.0)));
-  frac = _mm256_cvtpd_ps(_mm256_sub_pd(x, floorX));
+  if constexpr (Outside) {
+    const __m256d inside = _mm256_and_pd(_mm256_cmp_pd(x, c.minusOne, _CMP_GT_OQ), _mm256_cmp_pd(x, c.end, _CMP_LT_OQ));
+    x = _mm256_blendv_pd(_mm256_set1_pd(kOutside), x, inside);
+  }
+  const __m256d floorX = _mm256_round_pd(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  if constexpr (Outside) frac = _mm256_cvtpd_ps(_mm256_sub_pd(x, floorX));
   whole = _mm256_cvttpd_epi32(floorX);
 }
 
@@ -159,9 +161,9 @@ __attribute__((target("avx2,fma"))) bool splitIndicesAvx2(const float* positionM
   int i = 0;
   for (; i + 8 <= n; i += 8) {
     __m128i w0, w1;
-    __m128 f0, f1;
-    splitFour(c, positionMm + i, w0, f0);
-    splitFour(c, positionMm + i + 4, w1, f1);
+    __m128 f0{}, f1{};  // none: not computed
+    splitFour<I != Interpolation::None>(c, positionMm + i, w0, f0);
+    splitFour<I != Interpolation::None>(c, positionMm + i + 4, w1, f1);
     const __m256i whole = _mm256_set_m128i(w1, w0);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(p.whole + i), whole);
     if constexpr (Gather)
