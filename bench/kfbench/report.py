@@ -61,7 +61,10 @@ def notes(results):
     r = tm["ratios"]
     logs = {row["name"]: row for row in lc["rows"]}
     long = sp["index"][spatial.LONG_LABEL]
-    return [render("notes", ns={k: float(np.median(v)) for k, v in tm["ns"]["cpu"].items()},
+    ns = {k: float(np.median(v)) for k, v in tm["ns"]["cpu"].items()}
+    # Timing results from before the device UGens were in the render have no such phases.
+    device_ugens = render("notes_device_ugens", mousein=ns["mousein"], fout=ns["fout"]) + "\n" if "mousein" in ns else ""
+    return [render("notes", ns=ns, device_ugens=device_ugens,
                    spat_cubic=r["SpatialBufRd/BufRd cubic"]["cpu-empty"]["median"],
                    spat_linear=r["SpatialBufRd/BufRd linear"]["cpu-empty"]["median"],
                    spat_none=r["SpatialBufRd/BufRd none"]["cpu-empty"]["median"],
