@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cstring>
 
 namespace kf::board {
@@ -9,6 +10,7 @@ namespace kf::board {
 namespace {
 double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 constexpr double kFrameS = 0.001;
+constexpr double kHeldReplyLimitS = 10.0;  // a held ARM reply comes anyway: a broken test ends
 }  // namespace
 
 std::shared_ptr<EmulatedUsb> EmulatedUsb::create(std::string serial) {
@@ -24,7 +26,7 @@ class EmulatedPort : public usb::Port {
  public:
   explicit EmulatedPort(std::shared_ptr<EmulatedUsb> bus) : bus_(std::move(bus)) {}
   ~EmulatedPort() override {
-    close();
+    close(0.0);
     // What this port left in flight can never be delivered to it now.
     std::lock_guard<std::mutex> lock(bus_->mutex_);
     auto& pending = bus_->pending_;
@@ -80,21 +82,45 @@ class EmulatedPort : public usb::Port {
     if (alive()) ++bus_->releases_;
   }
 
-  void close() override {
-    std::lock_guard<std::mutex> lock(bus_->mutex_);
-    if (generation_ != 0) {
-      --bus_->openHandles_;
-      bus_->closesInFlight_ += ownInFlight(-1);
+  void close(double callbackWaitS) override {
+    std::unique_lock<std::mutex> lock(bus_->mutex_);
+    if (generation_ == 0 || leaked_) return;
+    if (ownInFlight(-1) > 0 && callbackWaitS > 0.0) {
+      // As LibusbPort: cancel them and run events until they are back or the wait is over.
+      ++bus_->closeWaits_;
+      for (EmulatedUsb::Pending& pending : bus_->pending_)
+        if (pending.owner == this) {
+          pending.cancelled = true;
+          pending.dueS = std::min(pending.dueS, bus_->nowS());
+        }
+      runCallbacks(lock, bus_->nowS() + callbackWaitS, INT_MAX, [this] { return ownInFlight(-1) == 0; });
     }
+    if (const int inFlight = ownInFlight(-1)) {
+      bus_->closesInFlight_ += inFlight;
+      leaked_ = true;  // never freed: the handle stays open
+      return;
+    }
+    --bus_->openHandles_;
     generation_ = 0;
   }
 
   usb::Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data,
                       uint16_t length, unsigned, int* transferred) override {
-    std::lock_guard<std::mutex> lock(bus_->mutex_);
+    std::unique_lock<std::mutex> lock(bus_->mutex_);
     if (!alive()) return usb::Result::kNoDevice;
+    if (ownInFlight(-1) > 0 && std::this_thread::get_id() != eventThread_) ++bus_->eventsOffThread_;
     if (index != kInterfaceNumber) return usb::Result::kPipe;
-    return bus_->board_.control(requestType, request, value, data, length, transferred, bus_->nowS());
+    if (request == static_cast<uint8_t>(Request::kArm) && bus_->holdArm_) {
+      ++bus_->armsHeld_;
+      bus_->changed_.notify_all();
+      runCallbacks(lock, bus_->nowS() + kHeldReplyLimitS, INT_MAX, [this] { return !bus_->holdArm_; });
+      --bus_->armsHeld_;
+      if (!alive()) return usb::Result::kNoDevice;
+    }
+    const usb::Result result =
+        bus_->board_.control(requestType, request, value, data, length, transferred, bus_->nowS());
+    runCallbacks(lock, bus_->nowS(), INT_MAX, [] { return false; });  // those due by the reply
+    return result;
   }
 
   usb::Result clearHalt(uint8_t endpoint) override {
@@ -160,7 +186,19 @@ class EmulatedPort : public usb::Port {
   usb::Result handleEvents(int timeoutMs) override {
     const double deadlineS = bus_->nowS() + timeoutMs * 1e-3;
     std::unique_lock<std::mutex> lock(bus_->mutex_);
-    while (true) {
+    eventThread_ = std::this_thread::get_id();
+    runCallbacks(lock, deadlineS, 1, [] { return false; });
+    return usb::Result::kOk;
+  }
+
+ private:
+  // Under `lock`, released around each callback (they submit again): runs this port's
+  // callbacks as they come due, the earliest first, until `stop()` holds, `maxCallbacks` ran
+  // or the bus clock passes deadlineS.
+  template <class Stop>
+  void runCallbacks(std::unique_lock<std::mutex>& lock, double deadlineS, int maxCallbacks, Stop stop) {
+    int ran = 0;
+    while (ran < maxCallbacks && !stop()) {
       const double nowS = bus_->nowS();
       bus_->board_.advance(nowS);
       // The earliest transfer that is done by now (cancelled and dead ones are done at once).
@@ -184,14 +222,15 @@ class EmulatedPort : public usb::Port {
         complete(done, nowS);
         lock.unlock();
         if (done.transfer->callback != nullptr) done.transfer->callback(*done.transfer);
-        return usb::Result::kOk;
+        lock.lock();
+        ++ran;
+        continue;
       }
-      if (nowS >= deadlineS) return usb::Result::kOk;
+      if (nowS >= deadlineS) return;
       bus_->changed_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, earliestS - nowS)));
     }
   }
 
- private:
   bool alive() const { return generation_ != 0 && generation_ == bus_->generation_ && bus_->plugged_; }
 
   // Under the lock: this port's transfers whose callbacks have not run (endpoint -1: any).
@@ -231,7 +270,9 @@ class EmulatedPort : public usb::Port {
   }
 
   std::shared_ptr<EmulatedUsb> bus_;
-  int generation_ = 0;  // of the plug-in it was opened on; 0: not open
+  int generation_ = 0;           // of the plug-in it was opened on; 0: not open
+  bool leaked_ = false;          // closed with a transfer in flight: the handle stays open
+  std::thread::id eventThread_;  // the last to call handleEvents
   std::string skipped_;
 };
 
@@ -302,6 +343,23 @@ int EmulatedUsb::resubmitsInFlight() {
 int EmulatedUsb::haltsInFlight() {
   std::lock_guard<std::mutex> lock(mutex_);
   return haltsInFlight_;
+}
+int EmulatedUsb::eventsOffThread() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return eventsOffThread_;
+}
+int EmulatedUsb::closeWaits() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return closeWaits_;
+}
+void EmulatedUsb::holdArmReply(bool hold) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  holdArm_ = hold;
+  changed_.notify_all();
+}
+int EmulatedUsb::armsHeld() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return armsHeld_;
 }
 
 void EmulatedUsb::setDenyAccess(bool deny) {

@@ -4,13 +4,16 @@
 // that time out, partial transfers, a stalled endpoint, unplugging (transfers in flight end
 // with kNoDevice) and plugging back in, permission denied at open, a board that never arms,
 // a bus reset or suspend, an over-current fault, a board of another protocol version, a
-// stranger sharing the test IDs, callbacks that arrive late. It checks the host keeps libusb's
-// transfer life cycle (UsbPort.hpp): each breach is counted (lifeCycleBreaches()).
+// stranger sharing the test IDs, callbacks that arrive late or never, an ARM whose reply comes
+// late. Like libusb, a control request runs the callbacks that come due meanwhile on its
+// caller's thread. It checks the host keeps libusb's transfer life cycle and thread rules
+// (UsbPort.hpp): each breach is counted.
 #pragma once
 
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "board/BoardEmulator.hpp"
@@ -45,6 +48,10 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   // endpoint) comes this much later than due: a host that frees or closes before its
   // callbacks ran is caught.
   void delayCallbacks(double seconds, uint8_t endpoint = 0);
+  // While held, an ARM request's reply does not come (its caller handles events meanwhile, as
+  // libusb does); armsHeld() counts the ARM requests waiting.
+  void holdArmReply(bool hold);
+  int armsHeld();
   // A device with the board's IDs but another interface, listed before the board.
   void addStranger(usb::InterfaceIdentity iface);
   int strangerTouches();  // opens, claims, control requests on strangers: must stay 0
@@ -61,10 +68,17 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   int clearHalts();
   bool isOpen();  // a host holds it open
   // Breaches of the transfer life cycle: a handle closed, a transfer resubmitted, or a halt
-  // cleared on its endpoint, while a transfer's callback had not run.
+  // cleared on its endpoint, while a transfer's callback had not run. A handle closed so is
+  // leaked (kept open), as LibusbPort does.
   int closesInFlight();
   int resubmitsInFlight();
   int haltsInFlight();
+  // Control requests sent, while the port had transfers in flight, from a thread other than
+  // the one handling its events: libusb would run their callbacks on that thread.
+  int eventsOffThread();
+  // Closes that waited for transfers in flight (callbackWaitS > 0): the host waits for its own
+  // before closing, so this is a second wait after it gave up.
+  int closeWaits();
 
  private:
   friend class EmulatedPort;
@@ -98,6 +112,9 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   std::vector<usb::InterfaceIdentity> strangers_;
   int strangerTouches_ = 0;
   int closesInFlight_ = 0, resubmitsInFlight_ = 0, haltsInFlight_ = 0;
+  int eventsOffThread_ = 0, closeWaits_ = 0;
+  bool holdArm_ = false;
+  int armsHeld_ = 0;
 };
 
 }  // namespace kf::board

@@ -34,6 +34,8 @@ const char* describe(Result result) {
       return "timed out";
     case Result::kPipe:
       return "stall (the board refused the request)";
+    case Result::kLeaked:
+      return "a USB transfer never completed; restart the server to use the board again";
     case Result::kOther:
       break;
   }
@@ -138,12 +140,16 @@ bool readInterface(libusb_device* device, int number, InterfaceIdentity& out) {
   return found;
 }
 
-constexpr double kCallbackWaitS = 10.0;  // past this a transfer that never returns is leaked
+constexpr double kCallbackWaitS = 10.0;  // the destructor's wait: past this a transfer is leaked
+
+// A leaked transfer keeps its handle open and the interface claimed in this process, so no
+// port of it can use the board again (a new one would find the interface busy).
+std::atomic<bool> gLeakedInProcess{false};
 
 class LibusbPort : public Port {
  public:
   ~LibusbPort() override {
-    close();
+    close(kCallbackWaitS);
     exit();
   }
 
@@ -161,7 +167,11 @@ class LibusbPort : public Port {
 
   Result open(const DeviceIds& ids) override {
     if (context_ == nullptr) return Result::kInvalid;
-    close();
+    // The driver refuses on its own after it gave a transfer up (UsbBoardBackend::connectLocked,
+    // tested on the emulator); this covers a new port in the same process, which no test here
+    // can show: it takes a device or stack whose transfer never calls back.
+    if (leaked_ || gLeakedInProcess.load()) return Result::kLeaked;
+    close(0.0);
     skipped_.clear();
     libusb_device** list = nullptr;
     const ssize_t count = libusb_get_device_list(context_, &list);
@@ -219,12 +229,13 @@ class LibusbPort : public Port {
     if (handle_ != nullptr) libusb_release_interface(handle_, number);
   }
 
-  void close() override {
+  void close(double callbackWaitS) override {
     if (leaked_) return;
-    // Cancel what is still in flight and wait for each callback before anything is freed.
+    // Cancel what is still in flight and wait for each callback before anything is freed, for
+    // as long as the caller has left: once it gave up, not again.
     bool inFlight = cancelInFlight();
-    if (inFlight && context_ != nullptr) {
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kCallbackWaitS);
+    if (inFlight && context_ != nullptr && callbackWaitS > 0.0) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(callbackWaitS);
       while ((inFlight = anyInFlight()) && std::chrono::steady_clock::now() < deadline) {
         timeval timeout{0, 10000};
         libusb_handle_events_timeout_completed(context_, &timeout, nullptr);
@@ -235,6 +246,7 @@ class LibusbPort : public Port {
       // and the context instead, and say so.
       std::fprintf(stderr, "KineticFriction: a USB transfer never came back; its handle is leaked\n");
       leaked_ = true;
+      gLeakedInProcess.store(true);
       return;
     }
     if (handle_ != nullptr) {
@@ -251,6 +263,7 @@ class LibusbPort : public Port {
 
   Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data, uint16_t length,
                  unsigned timeoutMs, int* transferred) override {
+    // Handles events on this thread until it completes: the event thread only (UsbPort.hpp).
     if (handle_ == nullptr) return Result::kNoDevice;
     const int moved = libusb_control_transfer(handle_, requestType, request, value, index, data, length, timeoutMs);
     if (transferred != nullptr) *transferred = moved < 0 ? 0 : moved;
@@ -277,8 +290,11 @@ class LibusbPort : public Port {
     if (owned->inFlight) return Result::kBusy;  // its callback has not run: not ours to refill
     libusb_fill_interrupt_transfer(owned->raw, handle_, transfer.endpoint, transfer.buffer, transfer.length, &onDone,
                                    owned, transfer.timeoutMs);
+    // In flight before it is submitted: its callback may run on the event thread before
+    // libusb_submit_transfer returns here, and clears it.
+    owned->inFlight = true;
     const Result result = resultOf(libusb_submit_transfer(owned->raw));
-    owned->inFlight = result == Result::kOk;
+    if (result != Result::kOk) owned->inFlight = false;
     return result;
   }
 

@@ -12,10 +12,6 @@ namespace {
 constexpr uint8_t kVendorOut = 0x41;  // vendor, interface, host to device
 constexpr uint8_t kVendorIn = 0xC1;
 constexpr unsigned kControlTimeoutMs = 200;
-// How long to wait for a callback after cancelling before the transfer is given up as leaked.
-// libusb calls back every cancelled transfer (LIBUSB_TRANSFER_CANCELLED, or its real end if it
-// had finished first), so this is only a bound on a broken stack, not on a slow transfer.
-constexpr double kCallbackWaitS = 10.0;
 
 double steadyS() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
@@ -53,6 +49,11 @@ void UsbBoardBackend::setError(const std::string& error) {
 }
 
 bool UsbBoardBackend::connectLocked(std::string& error) {
+  if (leaked_) {
+    // Its handle is still open with the interface claimed: nothing in this process can use it.
+    error = usb::describe(usb::Result::kLeaked);
+    return false;
+  }
   usb::Result result = port_->open(ids_);
   if (result == usb::Result::kNotFound) {
     error = "no friction board found (" + idsText(ids_) + "); is it plugged in?";
@@ -67,13 +68,12 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
   result = port_->claimInterface(board::kInterfaceNumber);
   if (result != usb::Result::kOk) {
     error = std::string("cannot claim the friction board's interface: ") + usb::describe(result);
-    port_->close();
+    port_->close(0.0);
     return false;
   }
   uint8_t reply[board::kVersionSize] = {};
   int moved = 0;
-  result = port_->control(kVendorIn, static_cast<uint8_t>(board::Request::kGetVersion), 0, board::kInterfaceNumber,
-                          reply, board::kVersionSize, kControlTimeoutMs, &moved);
+  result = control(kVendorIn, static_cast<uint8_t>(board::Request::kGetVersion), 0, reply, board::kVersionSize, &moved);
   board::VersionReply version;
   if (result != usb::Result::kOk || !board::decodeVersion(reply, static_cast<size_t>(moved), version)) {
     error = std::string("the board did not answer GET_VERSION: ") + usb::describe(result);
@@ -95,7 +95,7 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     if (clearErrorsLocked(cleared, error)) return true;
   }
   port_->releaseInterface(board::kInterfaceNumber);
-  port_->close();
+  port_->close(0.0);
   return false;
 }
 
@@ -103,8 +103,7 @@ bool UsbBoardBackend::clearErrorsLocked(board::ClearReply& reply, std::string& e
   uint8_t data[board::kClearReplySize] = {};
   int moved = 0;
   const usb::Result result =
-      port_->control(kVendorIn, static_cast<uint8_t>(board::Request::kClearErrors), 0, board::kInterfaceNumber, data,
-                     board::kClearReplySize, kControlTimeoutMs, &moved);
+      control(kVendorIn, static_cast<uint8_t>(board::Request::kClearErrors), 0, data, board::kClearReplySize, &moved);
   if (result != usb::Result::kOk || !board::decodeClearReply(data, static_cast<size_t>(moved), reply)) {
     error = std::string("the board did not answer CLEAR_ERRORS: ") + usb::describe(result);
     return false;
@@ -133,19 +132,67 @@ bool UsbBoardBackend::open(std::string& error) {
   connected_.store(true);
   stopping_.store(false);
   opened_.store(true);
+  {
+    std::lock_guard<std::mutex> wakeLock(wakeMutex_);
+    eventThreadServes_ = true;
+  }
   thread_ = std::thread([this] { run(); });
   return true;
 }
 
 void UsbBoardBackend::close() {
   if (!opened_.exchange(false)) return;
-  stopping_.store(true);
+  {
+    // Under the lock: else the store and notify could fall between the reconnect wait's check
+    // of stopping_ and its sleep, which then lasts a whole reopenPeriodS. (No test here shows
+    // it: the window is a few instructions wide.)
+    std::lock_guard<std::mutex> wakeLock(wakeMutex_);
+    stopping_.store(true);
+  }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
+usb::Result UsbBoardBackend::control(uint8_t requestType, uint8_t request, uint16_t value, uint8_t* data,
+                                     uint16_t length, int* moved) {
+  std::unique_lock<std::mutex> lock(wakeMutex_);
+  if (!eventThreadServes_ || eventThreadId_.load() == std::this_thread::get_id()) {
+    lock.unlock();
+    return port_->control(requestType, request, value, board::kInterfaceNumber, data, length, kControlTimeoutMs, moved);
+  }
+  ControlRequest posted{requestType, request, value, data, length};
+  controlDone_.wait(lock, [this] { return controlRequest_ == nullptr || !eventThreadServes_; });
+  if (!eventThreadServes_) return usb::Result::kNoDevice;  // closed meanwhile
+  controlRequest_ = &posted;
+  wake_.notify_all();  // a reconnect wait
+  controlDone_.wait(lock, [&posted] { return posted.done; });
+  if (moved != nullptr) *moved = posted.moved;
+  return posted.result;
+}
+
+void UsbBoardBackend::serveControl() {
+  ControlRequest* request = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(wakeMutex_);
+    request = controlRequest_;
+  }
+  if (request == nullptr) return;
+  int moved = 0;
+  const usb::Result result =
+      port_->control(request->requestType, request->request, request->value, board::kInterfaceNumber, request->data,
+                     request->length, kControlTimeoutMs, &moved);
+  {
+    std::lock_guard<std::mutex> lock(wakeMutex_);
+    request->moved = moved;
+    request->result = result;
+    request->done = true;
+    controlRequest_ = nullptr;
+  }
+  controlDone_.notify_all();
+}
+
 bool UsbBoardBackend::arm(std::string& error) {
-  std::lock_guard<std::mutex> lock(portMutex_);
+  std::lock_guard<std::mutex> lock(commandMutex_);
   if (!connected_.load()) {
     error = "the friction board is not connected";
     return false;
@@ -173,8 +220,8 @@ bool UsbBoardBackend::arm(std::string& error) {
   }
   // From off: set-points carry 0 until the device has restarted its slew limiter.
   latestDrive_.store(kRestartPending, std::memory_order_relaxed);
-  const usb::Result result = port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kArm), board::kArmKey,
-                                            board::kInterfaceNumber, nullptr, 0, kControlTimeoutMs, nullptr);
+  const usb::Result result =
+      control(kVendorOut, static_cast<uint8_t>(board::Request::kArm), board::kArmKey, nullptr, 0, nullptr);
   if (result == usb::Result::kPipe) {
     error = "the board refused to arm (a fault, over temperature or no coil supply: see its error flags)";
     return false;
@@ -183,16 +230,19 @@ bool UsbBoardBackend::arm(std::string& error) {
     error = std::string("arming failed: ") + usb::describe(result);
     return false;
   }
-  armed_.store(true);
+  // The ARM took 1-3 ms (up to its timeout), and the device's frames meanwhile took the restart
+  // above and raised the drive while the set-points carried 0: restart again, then let the
+  // drive through. Release, so that the event thread that sees armed_ sees this restart.
+  latestDrive_.store(kRestartPending, std::memory_order_relaxed);
+  armed_.store(true, std::memory_order_release);
   return true;
 }
 
 bool UsbBoardBackend::disarm(std::string& error) {
   armed_.store(false);  // set-points carry 0 from now on, whatever the board answers
-  std::lock_guard<std::mutex> lock(portMutex_);
+  std::lock_guard<std::mutex> lock(commandMutex_);
   if (!connected_.load()) return true;
-  const usb::Result result = port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0,
-                                            board::kInterfaceNumber, nullptr, 0, kControlTimeoutMs, nullptr);
+  const usb::Result result = control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0, nullptr, 0, nullptr);
   if (result != usb::Result::kOk) {
     error = std::string("disarming failed: ") + usb::describe(result);
     return false;
@@ -245,7 +295,7 @@ void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
 
 void UsbBoardBackend::submitSetPoint(int slot) {
   usb::Transfer& transfer = outTransfers_[slot];
-  const uint16_t drive = armed_.load(std::memory_order_relaxed) ? latestDrive() : 0;
+  const uint16_t drive = armed_.load(std::memory_order_acquire) ? latestDrive() : 0;  // acquire: see arm()
   board::encodeSetPoint({++sequence_, drive}, transfer.buffer);
   const usb::Result result = port_->submit(transfer);
   if (result == usb::Result::kOk) {
@@ -370,13 +420,15 @@ bool UsbBoardBackend::anyInFlight() const { return statusBusy_ || anyOutInFlight
 
 bool UsbBoardBackend::waitForTransfers() {
   // No shorter bound: a transfer's callback may come as late as its timeout, or later under
-  // load, and until it ran libusb owns the transfer (UsbPort.hpp).
-  const double deadlineS = steadyS() + kCallbackWaitS;
+  // load, and until it ran libusb owns the transfer (UsbPort.hpp). Once given up, not again.
+  const double deadlineS = steadyS() + options_.callbackWaitS;
   while (anyInFlight()) {
-    if (steadyS() > deadlineS) {
+    if (leaked_ || steadyS() > deadlineS) {
+      leaked_ = true;
       std::lock_guard<PiMutex> lock(telemetryMutex_);
       telemetry_.transfersLeaked = true;
-      telemetry_.lastError = "a USB transfer never came back; it was not freed";
+      telemetry_.lastError =
+          "a USB transfer never came back (it was not freed); restart the server to use the board again";
       return false;
     }
     port_->handleEvents(5);
@@ -396,15 +448,17 @@ void UsbBoardBackend::dropHandle() {
   connected_.store(false);
   armed_.store(false);
   port_->releaseInterface(board::kInterfaceNumber);
-  port_->close();
+  port_->close(0.0);  // waitForTransfers waited already: the port does not wait again
 }
 
 void UsbBoardBackend::run() {
+  eventThreadId_.store(std::this_thread::get_id());
   threadScheduling_.store(scheduleThisThread("usb", options_.thread));
   submitIdle();
   while (!stopping_.load()) {
     if (connected_.load()) {
       port_->handleEvents(5);
+      serveControl();
       if (unplugged_) {
         cancelAll();
         waitForTransfers();  // they come back with kNoDevice: only then is the handle dropped
@@ -426,9 +480,11 @@ void UsbBoardBackend::run() {
       {
         std::unique_lock<std::mutex> lock(wakeMutex_);
         wake_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, nextReopenS_ - steadyS())),
-                       [this] { return stopping_.load(); });
+                       [this] { return stopping_.load() || controlRequest_ != nullptr; });
       }
       if (stopping_.load()) break;
+      serveControl();  // no handle: the port answers kNoDevice
+      if (steadyS() < nextReopenS_) continue;
       std::string error;
       std::lock_guard<std::mutex> lock(portMutex_);
       if (connectLocked(error)) {
@@ -447,16 +503,26 @@ void UsbBoardBackend::run() {
     }
   }
   shutdownLink();
+  std::lock_guard<std::mutex> lock(wakeMutex_);
+  eventThreadServes_ = false;
+  eventThreadId_.store(std::thread::id());  // a later thread may get this id
+  if (controlRequest_ != nullptr) {         // posted after the loop ended: never sent
+    controlRequest_->result = usb::Result::kNoDevice;
+    controlRequest_->done = true;
+    controlRequest_ = nullptr;
+  }
+  controlDone_.notify_all();
 }
 
 void UsbBoardBackend::shutdownLink() {
   if (connected_.load() && !unplugged_) {
     // Cancel what is queued and wait for every callback, so no transfer is left in flight.
     cancelAll();
-    waitForTransfers();
-    // The last set-point: drive 0. Then DISARM, release, close.
+    const bool allBack = waitForTransfers();
+    // The last set-point: drive 0 (unless a transfer was given up: DISARM does it). Then
+    // DISARM, release, close.
     board::encodeSetPoint({++sequence_, 0}, zeroTransfer_.buffer);
-    if (port_->submit(zeroTransfer_) == usb::Result::kOk) {
+    if (allBack && port_->submit(zeroTransfer_) == usb::Result::kOk) {
       zeroBusy_ = true;
       const double giveUpS = steadyS() + 0.1;  // a board that takes nothing: DISARM does it
       while (zeroBusy_ && steadyS() < giveUpS) port_->handleEvents(5);
@@ -465,8 +531,7 @@ void UsbBoardBackend::shutdownLink() {
     }
     armed_.store(false);
     std::lock_guard<std::mutex> lock(portMutex_);
-    port_->control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0, board::kInterfaceNumber, nullptr, 0,
-                   kControlTimeoutMs, nullptr);
+    control(kVendorOut, static_cast<uint8_t>(board::Request::kDisarm), 0, nullptr, 0, nullptr);
   } else if (connected_.load()) {
     cancelAll();
     waitForTransfers();

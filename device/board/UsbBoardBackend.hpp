@@ -10,7 +10,8 @@
 // limiter brings it up (takeRestartFromOff). close(): cancel, wait for the callbacks, one
 // set-point of drive 0, DISARM, release, close. commandDrive/driveOff are lock-free (the
 // device thread, or the audio thread in lockstep); open, close, arm and disarm run on a
-// non-realtime thread.
+// non-realtime thread, and once the event thread runs their control requests are sent by it
+// (a synchronous request runs transfer callbacks on the thread that sends it: UsbPort.hpp).
 #pragma once
 
 #include <atomic>
@@ -39,6 +40,10 @@ struct BoardOptions {
   unsigned transferTimeoutMs = 20;
   double reopenPeriodS = 0.25;   // after an unplug, how often to look for the board
   double lateTransferS = 0.002;  // a set-point completing later than this after the previous
+  // A transfer whose callback has not come back this long after it was cancelled is given up:
+  // leaked, never freed, and the board cannot be opened again until the server restarts.
+  // libusb calls back every cancelled transfer, so this only bounds a broken stack.
+  double callbackWaitS = 10.0;
   // commandForce (no drive given): the linear map of an uncalibrated board.
   double minForceN = 0.14;
   double maxForceN = 1.4;
@@ -99,12 +104,28 @@ class UsbBoardBackend : public ForceBackend {
   // slew limiter; until it has, frames store drive 0 (they were computed before the reset).
   static constexpr uint32_t kRestartPending = 1u << 16;
 
+  // A control request as the event thread sends it for another thread.
+  struct ControlRequest {
+    uint8_t requestType = 0;
+    uint8_t request = 0;
+    uint16_t value = 0;
+    uint8_t* data = nullptr;
+    uint16_t length = 0;
+    int moved = 0;
+    usb::Result result = usb::Result::kOther;
+    bool done = false;
+  };
+
+  // Sends a control request on the event thread: directly there (or before it started), else
+  // posted to it and waited for.
+  usb::Result control(uint8_t requestType, uint8_t request, uint16_t value, uint8_t* data, uint16_t length, int* moved);
+  void serveControl();  // event thread: sends the posted request, if any
   static void onTransfer(usb::Transfer& transfer);
   void onSetPoint(usb::Transfer& transfer);
   void onStatus(usb::Transfer& transfer);
   void run();
   bool connectLocked(std::string& error);  // portMutex_ held
-  // CLEAR_ERRORS, portMutex_ held: what was set and what persists, counted in the telemetry.
+  // CLEAR_ERRORS (through control()): what was set and what persists, counted in the telemetry.
   bool clearErrorsLocked(board::ClearReply& reply, std::string& error);
   void submitSetPoint(int slot);
   void submitStatus();
@@ -114,7 +135,8 @@ class UsbBoardBackend : public ForceBackend {
   bool anyInFlight() const;
   bool anyOutInFlight() const;
   // Runs events until every callback ran (however long their timeouts); false (and the
-  // transfers leaked, never freed) if one has not come back after kCallbackWaitS.
+  // transfers leaked, never freed) if one has not come back after options_.callbackWaitS, and
+  // at once once that happened.
   bool waitForTransfers();
   void cancelAll();
   void shutdownLink();
@@ -126,7 +148,7 @@ class UsbBoardBackend : public ForceBackend {
   // so that after an unplug the same board is opened again, never another in its place (its
   // calibration table is that board's).
   usb::DeviceIds ids_;
-  std::mutex portMutex_;  // open/claim/control/release/close between the event and NRT threads
+  std::mutex portMutex_;  // open/claim/release/close: by open() before the event thread, then by it
 
   // Event thread only.
   usb::Transfer outTransfers_[kMaxInFlight];
@@ -140,6 +162,7 @@ class UsbBoardBackend : public ForceBackend {
   bool haltOut_ = false;  // EP 0x01 stalled: cleared once no OUT transfer is in flight
   bool haltIn_ = false;   // EP 0x81 likewise
   bool unplugged_ = false;
+  bool leaked_ = false;  // a transfer was given up: the board is not opened again
   double nextReopenS_ = 0.0;
 
   std::atomic<uint32_t> latestDrive_{0};  // drive bits, and kRestartPending
@@ -149,8 +172,13 @@ class UsbBoardBackend : public ForceBackend {
   std::atomic<bool> opened_{false};
   std::thread thread_;
   ThreadSchedulingCell threadScheduling_;
-  std::mutex wakeMutex_;
+  std::mutex commandMutex_;  // arm and disarm, one at a time (never held by the event thread)
+  std::mutex wakeMutex_;     // the reconnect wait, and the posted control request
   std::condition_variable wake_;
+  std::condition_variable controlDone_;
+  ControlRequest* controlRequest_ = nullptr;  // posted, not yet sent
+  bool eventThreadServes_ = false;            // posted requests are sent by the event thread
+  std::atomic<std::thread::id> eventThreadId_{};
 
   // Shared by the realtime event thread and status readers at normal priority (PiMutex.hpp).
   mutable PiMutex telemetryMutex_;

@@ -2,7 +2,10 @@
 // driver runs against the real libusb (makeLibusbPort) or the board emulator (tests): a
 // context, open by IDs and serial, claim/release, synchronous control requests, asynchronous
 // interrupt transfers (submit, cancel, callbacks run by handleEvents), clear halt, close.
-// Thread rules are libusb's: handleEvents on one thread; control, submit and cancel from any.
+// Thread rules: handleEvents on one thread, the event thread; submit and cancel from any; control
+// only from the event thread while transfers are in flight, since a synchronous request handles
+// events on its caller's thread (libusb_handle_events_completed) and would run their callbacks
+// there.
 // Life cycle (libusb's API docs, "asynchronous I/O"): a submitted transfer is the library's
 // until its callback ran — cancel only asks for that callback, so its storage is not reused or
 // freed before; clearHalt only on an endpoint with no transfer in flight ("cancel all pending
@@ -16,7 +19,7 @@
 namespace kf::usb {
 
 // The outcomes the driver tells apart (libusb's error codes, reduced).
-enum class Result { kOk, kIo, kInvalid, kAccess, kNoDevice, kNotFound, kBusy, kTimeout, kPipe, kOther };
+enum class Result { kOk, kIo, kInvalid, kAccess, kNoDevice, kNotFound, kBusy, kTimeout, kPipe, kLeaked, kOther };
 const char* describe(Result result);
 
 enum class TransferStatus { kCompleted, kError, kTimedOut, kCancelled, kStall, kNoDevice, kOverflow };
@@ -76,9 +79,12 @@ class Port {
   virtual Result claimInterface(int number) = 0;
   virtual void releaseInterface(int number) = 0;
   // Every transfer must be back first (its callback ran); one that is not is cancelled and
-  // waited for, and if it never comes back it is leaked with its handle, never freed.
-  virtual void close() = 0;
-  // Synchronous control request; *transferred gets the data bytes moved.
+  // waited for up to callbackWaitS (what is left of the caller's own wait: 0 once it gave up),
+  // and if it has not come back then it is leaked with its handle, never freed; open() then
+  // answers kLeaked.
+  virtual void close(double callbackWaitS) = 0;
+  // Synchronous control request; *transferred gets the data bytes moved. On the event thread
+  // (above): it runs the callbacks that come due meanwhile.
   virtual Result control(uint8_t requestType, uint8_t request, uint16_t value, uint16_t index, uint8_t* data,
                          uint16_t length, unsigned timeoutMs, int* transferred) = 0;
   virtual Result clearHalt(uint8_t endpoint) = 0;

@@ -1,7 +1,8 @@
 // The board driver's life cycle against the emulated bus: the interface checked before a
 // device with the (shared test) IDs is touched, the protocol version, CLEAR_ERRORS on open and
-// before ARM, ARM through the slew limiter, and libusb's transfer rules with callbacks that
-// arrive late (EmulatedUsb counts every breach).
+// before ARM, ARM through the slew limiter (also when its reply is slow), control requests on
+// the event thread, and libusb's transfer rules with callbacks that arrive late or never
+// (EmulatedUsb counts every breach).
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <thread>
@@ -46,6 +47,7 @@ void checkNoBreach(EmulatedUsb& bus) {
   CHECK(bus.closesInFlight() == 0);
   CHECK(bus.resubmitsInFlight() == 0);
   CHECK(bus.haltsInFlight() == 0);
+  CHECK(bus.eventsOffThread() == 0);
 }
 
 }  // namespace
@@ -216,4 +218,109 @@ TEST_CASE("board reopen: after an unplug the same board is opened again, not ano
   REQUIRE(waitFor([&] { return backend->telemetry().connected; }));
   CHECK(backend->telemetry().serial == "KF-0001");
   backend->close();
+}
+
+TEST_CASE("board control: ARM, DISARM and CLEAR_ERRORS are sent by the event thread", "[board]") {
+  // Sent from the caller's thread while transfers are in flight, libusb would run their
+  // callbacks there, beside the event thread that owns their state.
+  auto bus = EmulatedUsb::create();
+  auto backend = openBoard(bus);
+  REQUIRE(waitFor([&] { return backend->telemetry().haveStatus && bus->validFrames() > 5; }));  // in flight
+  std::string error;
+  for (int i = 0; i < 3; ++i) {
+    REQUIRE(armAlone(*backend, error));
+    CHECK(bus->state() == BoardState::kArmed);
+    REQUIRE(backend->disarm(error));
+    CHECK(bus->state() == BoardState::kDisarmed);
+  }
+  CHECK(backend->telemetry().boardResets == 1);  // each CLEAR_ERRORS answered: the power-on one
+  backend->close();
+  checkNoBreach(*bus);
+}
+
+TEST_CASE("board arm: frames applied while the ARM's reply is on its way do not jump the drive", "[board]") {
+  DeviceSpec spec;
+  spec.maxForceSlewNPerS = 100.0;  // 0.1 N per 1 ms frame: 13 frames from min to max
+  auto bus = EmulatedUsb::create();
+  std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
+  Device device(spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
+                std::make_shared<CountingForceSink>(), /*lockstep=*/true);
+  REQUIRE(device.attachBoard(board) == nullptr);
+  device.pump(0.0);
+  double frameS = 0.0;
+  auto frame = [&](float forceN) {
+    frameS += spec.forceFramePeriodS;
+    device.pushForceFrame({frameS, forceN, frameS});
+    return board->latestDrive();
+  };
+  bus->holdArmReply(true);
+  std::string error;
+  bool armed = false;
+  std::thread arming([&] { armed = board->arm(error); });
+  REQUIRE(waitFor([&] { return bus->armsHeld() == 1; }));
+  // 40 frames while ARM is in flight (on USB 1-3 ms, up to its 200 ms timeout): they take the
+  // restart and ramp the request to the top while the set-points still carry 0.
+  for (int i = 0; i < 40; ++i) frame(1.4f);
+  REQUIRE(board->latestDrive() == kDriveFull);
+  bus->holdArmReply(false);
+  arming.join();
+  INFO(error);
+  REQUIRE(armed);
+  const uint64_t frames = bus->validFrames();
+  REQUIRE(waitFor([&] { return bus->validFrames() > frames + 5; }));
+  CHECK(bus->drive() == 0);  // no frame since ARM returned: not the ramp made before
+  const double maxStep =
+      spec.maxForceSlewNPerS * spec.forceFramePeriodS / (spec.maxForceN - spec.minForceN) * kDriveFull + 1.0;
+  uint16_t previous = 0;
+  int steps = 0;
+  while (previous < kDriveFull && steps < 100) {
+    const uint16_t drive = frame(1.4f);
+    CHECK(drive - previous <= maxStep);
+    previous = drive;
+    ++steps;
+  }
+  CHECK(steps == 13);  // up from the minimum again
+  device.close();
+}
+
+TEST_CASE("board transfers: a callback that never comes back is given up once; open says restart", "[board]") {
+  auto bus = EmulatedUsb::create();
+  BoardOptions options;
+  options.callbackWaitS = 0.05;  // 10 s in use
+  auto backend = openBoard(bus, options);
+  REQUIRE(waitFor([&] { return backend->telemetry().haveStatus && bus->validFrames() > 5; }));  // in flight
+  bus->delayCallbacks(1e9, kSetPointEndpoint);                                                  // never
+  backend->close();
+  CHECK(backend->telemetry().transfersLeaked);
+  CHECK(bus->closeWaits() == 0);  // given up once, by the driver: the port did not wait again
+  CHECK(bus->closesInFlight() > 0);
+  CHECK(bus->isOpen());  // leaked with its handle, never freed
+  std::string error;
+  CHECK_FALSE(backend->open(error));
+  CHECK(error == "a USB transfer never completed; restart the server to use the board again");
+  CHECK(bus->interfaceClaims() == 1);  // not opened again
+}
+
+TEST_CASE("board transfers: after an unplug with a callback that never comes back, the status says restart",
+          "[board]") {
+  auto bus = EmulatedUsb::create();
+  BoardOptions options;
+  options.callbackWaitS = 0.05;
+  options.reopenPeriodS = 0.02;
+  auto backend = openBoard(bus, options);
+  REQUIRE(waitFor([&] { return backend->telemetry().haveStatus && bus->validFrames() > 5; }));
+  bus->delayCallbacks(1e9, kSetPointEndpoint);
+  bus->unplug();
+  REQUIRE(waitFor([&] { return backend->telemetry().transfersLeaked; }));
+  bus->replug();
+  const uint64_t frames = bus->validFrames();
+  std::this_thread::sleep_for(100ms);  // five reopen periods
+  const BoardTelemetry t = backend->telemetry();
+  CHECK_FALSE(t.connected);
+  CHECK(t.reopens == 0);
+  CHECK(t.lastError.find("restart the server") != std::string::npos);
+  CHECK(bus->interfaceClaims() == 1);
+  CHECK(bus->validFrames() == frames);
+  backend->close();
+  CHECK(bus->closeWaits() == 0);
 }
