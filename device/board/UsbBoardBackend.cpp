@@ -420,10 +420,10 @@ bool UsbBoardBackend::anyInFlight() const { return statusBusy_ || anyOutInFlight
 
 bool UsbBoardBackend::waitForTransfers() {
   // No shorter bound: a transfer's callback may come as late as its timeout, or later under
-  // load, and until it ran libusb owns the transfer (UsbPort.hpp). Once given up, not again.
+  // load, and until it ran libusb owns the transfer (UsbPort.hpp).
   const double deadlineS = steadyS() + options_.callbackWaitS;
   while (anyInFlight()) {
-    if (leaked_ || steadyS() > deadlineS) {
+    if (steadyS() > deadlineS) {
       leaked_ = true;
       std::lock_guard<PiMutex> lock(telemetryMutex_);
       telemetry_.transfersLeaked = true;

@@ -135,8 +135,7 @@ class UsbBoardBackend : public ForceBackend {
   bool anyInFlight() const;
   bool anyOutInFlight() const;
   // Runs events until every callback ran (however long their timeouts); false (and the
-  // transfers leaked, never freed) if one has not come back after options_.callbackWaitS, and
-  // at once once that happened.
+  // transfers leaked, never freed) if one has not come back after options_.callbackWaitS.
   bool waitForTransfers();
   void cancelAll();
   void shutdownLink();
