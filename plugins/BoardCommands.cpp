@@ -116,9 +116,9 @@ bool openStage(World*, void* raw) {  // NRT
       kf::CalibrationTable::linear(data->device->spec().minForceN, data->device->spec().maxForceN));
   const kf::BoardTelemetry t = board->telemetry();
   Print("kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA) is disarmed\n",
-        data->args.index, t.serial.c_str(), emulate ? " (emulated)" : "", t.version.protocolMajor,
-        t.version.protocolMinor, t.version.firmwareMajor, t.version.firmwareMinor, t.version.firmwarePatch,
-        t.version.fullScaleCurrentMa);
+        data->args.index, t.serial.empty() ? "(no serial)" : t.serial.c_str(), emulate ? " (emulated)" : "",
+        t.version.protocolMajor, t.version.protocolMinor, t.version.firmwareMajor, t.version.firmwareMinor,
+        t.version.firmwarePatch, t.version.fullScaleCurrentMa);
   return true;
 }
 
@@ -166,7 +166,7 @@ bool calibrateStage(World*, void* raw) {  // NRT
       failWith(data, "kfBoardCalibrate: %s", error.c_str());
       return false;
     }
-    if (!table.checkBoard(board != nullptr ? board->telemetry().serial : "", error)) {
+    if (!table.checkBoard(board != nullptr, board != nullptr ? board->telemetry().serial : "", error)) {
       failWith(data, "kfBoardCalibrate: %s", error.c_str());
       return false;
     }
@@ -264,7 +264,8 @@ void postBoardStatus(int index, Device& device) {
   const board::Status& s = t.status;
   auto count = [](uint64_t value) { return static_cast<unsigned long long>(value); };
   Print("kfStatus %d: board %s %s, %s; board state %s, current %.3f of full scale, %.2f degC, errors 0x%04x%s\n", index,
-        t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED", t.armed ? "armed" : "disarmed",
+        t.serial.empty() ? "(no serial)" : t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED",
+        t.armed ? "armed" : "disarmed",
         !t.haveStatus                             ? "unknown"
         : s.state == board::BoardState::kArmed    ? "armed"
         : s.state == board::BoardState::kDisarmed ? "disarmed"

@@ -497,6 +497,11 @@ void UsbBoardBackend::run() {
         std::lock_guard<PiMutex> telemetryLock(telemetryMutex_);
         ++telemetry_.reopens;
         telemetry_.lastError.clear();
+        // Nothing tells a board without a serial from another with its IDs: it is taken, but
+        // the user is told (disarmed, and no calibration table can be loaded for it).
+        if (ids_.serial.empty())
+          telemetry_.lastError =
+              "a board without a USB serial was plugged in: it may be another board than before; it is disarmed";
       } else {
         nextReopenS_ = steadyS() + options_.reopenPeriodS;
       }

@@ -102,15 +102,21 @@ bool CalibrationTable::parse(const std::string& text, CalibrationTable& out, std
   return true;
 }
 
-bool CalibrationTable::checkBoard(const std::string& boardSerial, std::string& error) const {
+bool CalibrationTable::checkBoard(bool boardOpen, const std::string& boardSerial, std::string& error) const {
   // Short enough for a /kfFail reason (200 characters) with the command's name.
+  if (boardOpen && boardSerial.empty()) {
+    error =
+        "the board reports no USB serial, so no table can be matched to it: give its firmware one "
+        "(PROTOCOL.md 1), or use it uncalibrated";
+    return false;
+  }
   if (serial_.empty()) {
     error = "the table names no board: if it was measured on this one, add \"serial " +
             (boardSerial.empty() ? std::string("<serial>") : boardSerial) +
             "\" after its header; else measure this board";
     return false;
   }
-  if (boardSerial.empty()) {
+  if (!boardOpen) {
     error = "the table is for board " + serial_ + " and no board is open: add the board first, then load its table";
     return false;
   }

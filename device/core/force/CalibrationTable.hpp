@@ -40,11 +40,12 @@ class CalibrationTable {
   const std::string& serial() const { return serial_; }
   void setSerial(std::string serial) { serial_ = std::move(serial); }
 
-  // May this table drive the board whose USB serial is boardSerial ("" when no board is open)?
-  // Only when it names that board: a table measured on another board is refused, and so is
-  // one that names none (it cannot be checked; docs/calibration-format.md says why). False
-  // with a message that says what to do.
-  bool checkBoard(const std::string& boardSerial, std::string& error) const;
+  // May this table drive the open board (boardOpen) whose USB serial is boardSerial? Only when
+  // it names that board: a table measured on another board is refused, and so is one that
+  // names none (it cannot be checked; docs/calibration-format.md says why), and any table for a
+  // board that reports no serial (it cannot be matched). False with a message that says what
+  // to do.
+  bool checkBoard(bool boardOpen, const std::string& boardSerial, std::string& error) const;
 
  private:
   std::vector<CalibrationPoint> points_{{0.0, 0.0}, {1.0, 0.0}};

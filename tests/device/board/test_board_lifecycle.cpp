@@ -324,3 +324,20 @@ TEST_CASE("board transfers: after an unplug with a callback that never comes bac
   backend->close();
   CHECK(bus->closeWaits() == 0);
 }
+
+TEST_CASE("board reopen: a board without a serial is taken again and the status says it may be another", "[board]") {
+  auto bus = EmulatedUsb::create("");
+  BoardOptions options;
+  options.reopenPeriodS = 0.02;
+  auto backend = openBoard(bus, options);
+  CHECK(backend->telemetry().lastError.empty());
+  bus->unplug();
+  REQUIRE(waitFor([&] { return !backend->telemetry().connected; }));
+  bus->replug();
+  REQUIRE(waitFor([&] { return backend->telemetry().connected; }));
+  const BoardTelemetry t = backend->telemetry();
+  CHECK(t.lastError.find("without a USB serial") != std::string::npos);
+  CHECK(t.lastError.find("may be another board") != std::string::npos);
+  CHECK_FALSE(t.armed);
+  backend->close();
+}

@@ -132,16 +132,25 @@ TEST_CASE("a table saved to a file loads back the same, with its serial", "[cali
 TEST_CASE("a table drives only the board it names", "[calibration]") {
   CalibrationTable table = tableOf({{0.0, 0.14}, {1.0, 1.4}});
   std::string error;
-  CHECK_FALSE(table.checkBoard("KF0042", error));  // names no board: cannot be checked
+  CHECK_FALSE(table.checkBoard(true, "KF0042", error));  // names no board: cannot be checked
   CHECK(error.find("names no board") != std::string::npos);
   CHECK(error.find("add \"serial KF0042\"") != std::string::npos);  // the line to add
   table.setSerial("KF0042");
-  CHECK(table.checkBoard("KF0042", error));
-  CHECK_FALSE(table.checkBoard("KF0043", error));
+  CHECK(table.checkBoard(true, "KF0042", error));
+  CHECK_FALSE(table.checkBoard(true, "KF0043", error));
   CHECK(error.find("measured on board KF0042, not on this one (KF0043)") != std::string::npos);
-  CHECK_FALSE(table.checkBoard("", error));
+  CHECK_FALSE(table.checkBoard(false, "", error));
   CHECK(error.find("no board is open") != std::string::npos);
-  CHECK(error.size() < 150);  // a /kfFail reason holds 200 characters with the command and path
+  CHECK(error.size() < 150);
+  // A board open that reports no serial: no table matches it, whatever the table names.
+  CHECK_FALSE(table.checkBoard(true, "", error));
+  CHECK(error.find("reports no USB serial") != std::string::npos);
+  CHECK(error.find("no board is open") == std::string::npos);
+  CHECK(error.size() < 150);
+  table.setSerial("");
+  CHECK_FALSE(table.checkBoard(true, "", error));
+  CHECK(error.find("reports no USB serial") !=
+        std::string::npos);  // a /kfFail reason holds 200 characters with the command and path
   // The serial line of a file: one word, required when present.
   CalibrationTable parsed;
   CHECK_FALSE(CalibrationTable::parse("kf-calibration 1\nserial\n0 0.14\n", parsed, error));
