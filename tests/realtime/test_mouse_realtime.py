@@ -17,7 +17,7 @@ def test_list_and_open_without_a_mouse(jack):
         // Inside a Routine an open the server refuses is an Error, with the server's reason.
         [
             { if(found.isEmpty) { FrictionDevice.mouse(s, 0) } },  // "the first mouse": there is none
-            { FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none") },
+            { FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none", \hidapi) },
             { FrictionDevice.mouse(s, 2, "/dev/input/event-kf-none", \evdev, nil, true) }
         ].do { |open| try(open) { |error| ("KF-REFUSED " ++ error.errorString).postln } };
         s.sendMsg('/cmd', 'kfReopenMouse', 3);
