@@ -14,6 +14,20 @@ constexpr double kFadeT = 1.0;         // then speed (and extrapolation) go to 0
 
 constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/core/spec/Report.hpp)
 
+// The first k in [lo, hi) where isPast(k) holds, hi if none; isPast must be false up to some k
+// and true from there on.
+template <typename Predicate>
+int firstSampleWhere(int lo, int hi, Predicate isPast) {
+  while (lo < hi) {
+    const int mid = lo + (hi - lo) / 2;
+    if (isPast(mid))
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
 }  // namespace
 
 TrajectoryMode trajectoryModeFromCode(int code) {
@@ -83,8 +97,12 @@ void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm, bo
   lastQueuedTimeS_ = timeS;
 }
 
-double TrajectoryReconstructor::positionAt(const Axis& axis, double sinceAnchorS) const {
-  const double s = sinceAnchorS / intervalS_;  // in intervals
+// Anchor plus extrapolation plus the fading correction (the header's p(t)); e and fade in T.
+double TrajectoryReconstructor::blend(const Axis& axis, double extrapolateT, double fade) const {
+  return axis.anchorMm + axis.speedMmPerS * (extrapolateT * intervalS_) + axis.correctionMm * fade;
+}
+
+double TrajectoryReconstructor::positionAt(const Axis& axis, double s) const {
   double extrapolateT = 0.0;
   double fade = 0.0;
   if (mode_ == TrajectoryMode::Predictive) {
@@ -97,11 +115,10 @@ double TrajectoryReconstructor::positionAt(const Axis& axis, double sinceAnchorS
   }
   if (mode_ != TrajectoryMode::Hold && s < 1.0) fade = 1.0 - std::max(0.0, s);
   if (extrapolateT == 0.0 && fade == 0.0) return axis.anchorMm;  // exactly the reported sum
-  return axis.anchorMm + axis.speedMmPerS * (extrapolateT * intervalS_) + axis.correctionMm * fade;
+  return blend(axis, extrapolateT, fade);
 }
 
-double TrajectoryReconstructor::speedAt(const Axis& axis, double sinceAnchorS) const {
-  const double s = sinceAnchorS / intervalS_;
+double TrajectoryReconstructor::speedAt(const Axis& axis, double s) const {
   if (s < kStaleT) return axis.speedMmPerS;
   if (s < kStaleT + kFadeT) return axis.speedMmPerS * (1.0 - (s - kStaleT) / kFadeT);
   return 0.0;
@@ -118,7 +135,8 @@ void TrajectoryReconstructor::take(const Pending& report, double nowS) {
   double takeS = std::min(report.timeS, nowS);
   if (hasRendered_) takeS = std::max(takeS, lastRenderTimeS_);
   double beforeMm[2];
-  for (int a = 0; a < 2; ++a) beforeMm[a] = hasAnchor_ ? positionAt(axes_[a], takeS - anchorTimeS_) : axes_[a].anchorMm;
+  const double phase = (takeS - anchorTimeS_) / intervalS_;
+  for (int a = 0; a < 2; ++a) beforeMm[a] = hasAnchor_ ? positionAt(axes_[a], phase) : axes_[a].anchorMm;
   // The new T applies from this report on (positions before it were rendered with the old).
   const double measuredS = rate_.hasEstimate() ? 1.0 / ReportRateEstimator::snapToUsbRateHz(rate_.rateHz()) : 0.0;
   intervalS_ = measuredS > 0.0 && std::fabs(measuredS - nominalIntervalS_) > kRateBand * nominalIntervalS_
@@ -144,28 +162,95 @@ void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int n
 
 void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int numSamples, double originXMm,
                                      double originYMm, float* xMm, float* yMm, float* vxMmPerS, float* vyMmPerS) {
-  float* positionOut[2] = {xMm, yMm};
-  float* speedOut[2] = {vxMmPerS, vyMmPerS};
-  const double originMm[2] = {originXMm, originYMm};
-  for (int i = 0; i < numSamples; ++i) {
-    const double nowS = startTimeS + i * sampleDurS;
-    while (pendingCount_ > 0 && queue_[pendingHead_].timeS <= nowS) {
-      take(queue_[pendingHead_], nowS);
-      pendingHead_ = (pendingHead_ + 1) % kQueueCapacity;
-      --pendingCount_;
-    }
-    const double sinceS = nowS - anchorTimeS_;
-    for (int a = 0; a < 2; ++a) {
-      const Axis& axis = axes_[a];
-      const double pMm = hasAnchor_ ? positionAt(axis, sinceS) : axis.anchorMm;
-      const double vMmPerS = hasAnchor_ ? speedAt(axis, sinceS) : 0.0;
-      renderedMm_[a] = pMm;
-      renderedSpeedMmPerS_[a] = vMmPerS;
-      if (positionOut[a]) positionOut[a][i] = static_cast<float>(pMm - originMm[a]);
-      if (speedOut[a]) speedOut[a][i] = static_cast<float>(vMmPerS);
-    }
-    lastRenderTimeS_ = nowS;
+  if (numSamples <= 0) return;
+  const SampleClock clock{startTimeS, sampleDurS};
+  // Sample times that do not increase (a bad sample duration) cannot be searched: then every
+  // sample is a run of its own, which is the per-sample rule itself.
+  const bool searchable = std::isfinite(sampleDurS) && sampleDurS >= 0.0;
+  const Outputs out{{xMm, yMm}, {vxMmPerS, vyMmPerS}, {originXMm, originYMm}};
+  int i = 0;
+  while (i < numSamples) {
+    takeDueReports(clock, i);
+    const int end = searchable ? endOfRun(clock, i, numSamples) : i + 1;
+    renderRun(clock, i, end, out);
+    lastRenderTimeS_ = clock.timeS(end - 1);
     hasRendered_ = true;
+    i = end;
+  }
+}
+
+// Every pending report whose time has come by sample i, in order. take() needs the time of the
+// sample before (lastRenderTimeS_), which render() keeps up to date at each run's end.
+void TrajectoryReconstructor::takeDueReports(const SampleClock& clock, int i) {
+  const double nowS = clock.timeS(i);
+  while (pendingCount_ > 0 && queue_[pendingHead_].timeS <= nowS) {
+    take(queue_[pendingHead_], nowS);
+    pendingHead_ = (pendingHead_ + 1) % kQueueCapacity;
+    --pendingCount_;
+  }
+}
+
+// The first sample after i at which the next pending report is due (numSamples if none is):
+// sample times increase, so a binary search finds it with the per-sample comparison.
+int TrajectoryReconstructor::endOfRun(const SampleClock& clock, int i, int numSamples) const {
+  if (pendingCount_ == 0) return numSamples;
+  const double dueS = queue_[pendingHead_].timeS;
+  return firstSampleWhere(i + 1, numSamples, [&](int k) { return dueS <= clock.timeS(k); });
+}
+
+// Samples [from, to) with no report taken between them. The phase s rises with the sample, so
+// each of positionAt's and speedAt's branches holds for one contiguous stretch: the stretches'
+// ends are found once (with the very comparisons those functions make, so the output is
+// bit-for-bit theirs), and each is filled by a loop without branches.
+void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int to, const Outputs& out) {
+  const Phase phase{clock, anchorTimeS_, intervalS_};
+  const auto firstAtOrAbove = [&](int lo, double threshold) {
+    return firstSampleWhere(lo, to, [&](int k) { return !(phase.at(k) < threshold); });
+  };
+  // Stretch ends, in T: 1 ends the fade, kExtrapolateT the extrapolation, kStaleT the held speed,
+  // kStaleT + kFadeT the fade of speed and extrapolation.
+  const int fadeEnd = firstAtOrAbove(from, 1.0);
+  const int extrapolateEnd = firstAtOrAbove(fadeEnd, kExtrapolateT);
+  const int staleStart = firstAtOrAbove(extrapolateEnd, kStaleT);
+  const int restStart = firstAtOrAbove(staleStart, kStaleT + kFadeT);
+  const double lastPhase = phase.at(to - 1);
+  for (int a = 0; a < 2; ++a) {
+    const Axis& axis = axes_[a];
+    renderedMm_[a] = hasAnchor_ ? positionAt(axis, lastPhase) : axis.anchorMm;
+    renderedSpeedMmPerS_[a] = hasAnchor_ ? speedAt(axis, lastPhase) : 0.0;
+    if (float* p = out.positionMm[a]) {
+      const double originMm = out.originMm[a];
+      const auto put = [&](int lo, int hi, auto positionOf) {
+        for (int k = lo; k < hi; ++k) p[k] = static_cast<float>(positionOf(k) - originMm);
+      };
+      const auto anchor = [&](int) { return axis.anchorMm; };
+      if (!hasAnchor_ || mode_ == TrajectoryMode::Hold) {
+        put(from, to, anchor);
+      } else if (mode_ == TrajectoryMode::Linear) {
+        put(from, fadeEnd, [&](int k) { return blend(axis, 0.0, 1.0 - std::max(0.0, phase.at(k))); });
+        put(fadeEnd, to, anchor);
+      } else {
+        // Extrapolation and fade are never both 0 before restStart (the fade is > 0 below s = 1,
+        // the extrapolation >= 1 from there to kStaleT and > 0 below kStaleT + kFadeT), so
+        // positionAt's exact-anchor shortcut applies from restStart on only.
+        put(from, fadeEnd, [&](int k) {
+          const double s = std::max(0.0, phase.at(k));
+          return blend(axis, s, 1.0 - s);
+        });
+        put(fadeEnd, extrapolateEnd, [&](int k) { return blend(axis, std::max(0.0, phase.at(k)), 0.0); });
+        put(extrapolateEnd, staleStart, [&](int) { return blend(axis, kExtrapolateT, 0.0); });
+        put(staleStart, restStart,
+            [&](int k) { return blend(axis, kExtrapolateT * (1.0 - (phase.at(k) - kStaleT) / kFadeT), 0.0); });
+        put(restStart, to, anchor);
+      }
+    }
+    if (float* v = out.speedMmPerS[a]) {
+      const double speed = hasAnchor_ ? axis.speedMmPerS : 0.0;
+      const int held = hasAnchor_ ? staleStart : from, fading = hasAnchor_ ? restStart : from;
+      std::fill(v + from, v + held, static_cast<float>(speed));
+      for (int k = held; k < fading; ++k) v[k] = static_cast<float>(speed * (1.0 - (phase.at(k) - kStaleT) / kFadeT));
+      std::fill(v + fading, v + to, 0.0f);
+    }
   }
 }
 

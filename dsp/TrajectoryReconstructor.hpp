@@ -117,10 +117,32 @@ class TrajectoryReconstructor {
     double correctionMm = 0.0;  // c: position before the latest report minus the anchor
   };
 
+  // Sample i of a render() call is at startS + i * durS, computed so wherever it is needed.
+  struct SampleClock {
+    double startS, durS;
+    double timeS(int i) const { return startS + i * durS; }
+  };
+  // s: the time since the anchor in intervals T.
+  struct Phase {
+    SampleClock clock;
+    double anchorS, intervalS;
+    double at(int i) const { return (clock.timeS(i) - anchorS) / intervalS; }
+  };
+  struct Outputs {
+    float* positionMm[2];
+    float* speedMmPerS[2];
+    double originMm[2];
+  };
+
   void enqueue(double timeS, double dxMm, double dyMm, bool isShift);
   void take(const Pending& report, double nowS);
-  double positionAt(const Axis& axis, double sinceAnchorS) const;
-  double speedAt(const Axis& axis, double sinceAnchorS) const;
+  void takeDueReports(const SampleClock& clock, int i);
+  int endOfRun(const SampleClock& clock, int i, int numSamples) const;
+  void renderRun(const SampleClock& clock, int from, int to, const Outputs& out);
+  // The output at phase s (see the header comment); render() fills whole runs with the same.
+  double positionAt(const Axis& axis, double s) const;
+  double speedAt(const Axis& axis, double s) const;
+  double blend(const Axis& axis, double extrapolateT, double fade) const;
 
   double nominalIntervalS_;
   double intervalS_;
