@@ -97,11 +97,6 @@ void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm, bo
   lastQueuedTimeS_ = timeS;
 }
 
-// Anchor plus extrapolation plus the fading correction (the header's p(t)); e and fade in T.
-double TrajectoryReconstructor::blend(const Axis& axis, double extrapolateT, double fade) const {
-  return axis.anchorMm + axis.speedMmPerS * (extrapolateT * intervalS_) + axis.correctionMm * fade;
-}
-
 double TrajectoryReconstructor::positionAt(const Axis& axis, double s) const {
   double extrapolateT = 0.0;
   double fade = 0.0;
@@ -171,7 +166,8 @@ void TrajectoryReconstructor::render(double startTimeS, double sampleDurS, int n
   int i = 0;
   while (i < numSamples) {
     takeDueReports(clock, i);
-    const int end = searchable ? endOfRun(clock, i, numSamples) : i + 1;
+    // At most kMaxRun samples at a time: renderRun keeps their phases on the stack.
+    const int end = searchable ? std::min(i + kMaxRun, endOfRun(clock, i, numSamples)) : i + 1;
     renderRun(clock, i, end, out);
     lastRenderTimeS_ = clock.timeS(end - 1);
     hasRendered_ = true;
@@ -213,6 +209,16 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
   const int extrapolateEnd = firstAtOrAbove(fadeEnd, kExtrapolateT);
   const int staleStart = firstAtOrAbove(extrapolateEnd, kStaleT);
   const int restStart = firstAtOrAbove(staleStart, kStaleT + kFadeT);
+  // s of the samples whose output depends on it, computed once for both axes in a loop of its
+  // own (the division is most of a sample's cost): up to the end of the fade (linear) or of the
+  // extrapolation (predictive), and over the fade of speed. s(k) = phases[k - from].
+  double phases[kMaxRun];
+  const int variableEnd = !hasAnchor_ || mode_ == TrajectoryMode::Hold ? from
+                          : mode_ == TrajectoryMode::Linear            ? fadeEnd
+                                                                       : extrapolateEnd;
+  phase.fill(phases, from, from, variableEnd);
+  if (hasAnchor_) phase.fill(phases, from, staleStart, restStart);
+  const auto s = [&](int k) { return phases[k - from]; };
   const double lastPhase = phase.at(to - 1);
   for (int a = 0; a < 2; ++a) {
     const Axis& axis = axes_[a];
@@ -227,20 +233,20 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
       if (!hasAnchor_ || mode_ == TrajectoryMode::Hold) {
         put(from, to, anchor);
       } else if (mode_ == TrajectoryMode::Linear) {
-        put(from, fadeEnd, [&](int k) { return blend(axis, 0.0, 1.0 - std::max(0.0, phase.at(k))); });
+        put(from, fadeEnd, [&](int k) { return blend(axis, 0.0, 1.0 - std::max(0.0, s(k))); });
         put(fadeEnd, to, anchor);
       } else {
         // Extrapolation and fade are never both 0 before restStart (the fade is > 0 below s = 1,
         // the extrapolation >= 1 from there to kStaleT and > 0 below kStaleT + kFadeT), so
         // positionAt's exact-anchor shortcut applies from restStart on only.
         put(from, fadeEnd, [&](int k) {
-          const double s = std::max(0.0, phase.at(k));
-          return blend(axis, s, 1.0 - s);
+          const double e = std::max(0.0, s(k));
+          return blend(axis, e, 1.0 - e);
         });
-        put(fadeEnd, extrapolateEnd, [&](int k) { return blend(axis, std::max(0.0, phase.at(k)), 0.0); });
+        put(fadeEnd, extrapolateEnd, [&](int k) { return blend(axis, std::max(0.0, s(k)), 0.0); });
         put(extrapolateEnd, staleStart, [&](int) { return blend(axis, kExtrapolateT, 0.0); });
         put(staleStart, restStart,
-            [&](int k) { return blend(axis, kExtrapolateT * (1.0 - (phase.at(k) - kStaleT) / kFadeT), 0.0); });
+            [&](int k) { return blend(axis, kExtrapolateT * (1.0 - (s(k) - kStaleT) / kFadeT), 0.0); });
         put(restStart, to, anchor);
       }
     }
@@ -248,7 +254,7 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
       const double speed = hasAnchor_ ? axis.speedMmPerS : 0.0;
       const int held = hasAnchor_ ? staleStart : from, fading = hasAnchor_ ? restStart : from;
       std::fill(v + from, v + held, static_cast<float>(speed));
-      for (int k = held; k < fading; ++k) v[k] = static_cast<float>(speed * (1.0 - (phase.at(k) - kStaleT) / kFadeT));
+      for (int k = held; k < fading; ++k) v[k] = static_cast<float>(speed * (1.0 - (s(k) - kStaleT) / kFadeT));
       std::fill(v + fading, v + to, 0.0f);
     }
   }

@@ -105,6 +105,7 @@ class TrajectoryReconstructor {
 
  private:
   static constexpr int kQueueCapacity = 64;  // 0.5 s of 125 Hz reports
+  static constexpr int kMaxRun = 256;        // samples rendered with one stack buffer of phases
 
   struct Pending {
     double timeS;
@@ -127,6 +128,10 @@ class TrajectoryReconstructor {
     SampleClock clock;
     double anchorS, intervalS;
     double at(int i) const { return (clock.timeS(i) - anchorS) / intervalS; }
+    // at(k) into out[k - base] for k in [from, to): a loop the compiler vectorises.
+    void fill(double* out, int base, int from, int to) const {
+      for (int k = from; k < to; ++k) out[k - base] = at(k);
+    }
   };
   struct Outputs {
     float* positionMm[2];
@@ -142,7 +147,11 @@ class TrajectoryReconstructor {
   // The output at phase s (see the header comment); render() fills whole runs with the same.
   double positionAt(const Axis& axis, double s) const;
   double speedAt(const Axis& axis, double s) const;
-  double blend(const Axis& axis, double extrapolateT, double fade) const;
+  // Anchor plus extrapolation plus the fading correction (p(t) above); e and fade in T. Here,
+  // so that render's loops inline it (and vectorise).
+  double blend(const Axis& axis, double extrapolateT, double fade) const {
+    return axis.anchorMm + axis.speedMmPerS * (extrapolateT * intervalS_) + axis.correctionMm * fade;
+  }
 
   double nominalIntervalS_;
   double intervalS_;
