@@ -18,6 +18,9 @@ constexpr uint32_t kAfterLossFlag = 2;  // ReportFlag::kAfterLoss (device/core/s
 // and true from there on.
 template <typename Predicate>
 int firstSampleWhere(int lo, int hi, Predicate isPast) {
+  // Most runs lie wholly on one side (no report due, no stretch end crossed): one test settles it.
+  if (lo == hi || !isPast(hi - 1)) return hi;
+  if (isPast(lo)) return lo;
   while (lo < hi) {
     const int mid = lo + (hi - lo) / 2;
     if (isPast(mid))
@@ -205,7 +208,11 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
   };
   // Stretch ends, in T: 1 ends the fade, kExtrapolateT the extrapolation, kStaleT the held speed,
   // kStaleT + kFadeT the fade of speed and extrapolation.
-  const int fadeEnd = firstAtOrAbove(from, 1.0);
+  // Samples up to the anchor (s <= 0, taken late or at the sample's own time) neither
+  // extrapolate nor have faded: std::max(0, s) is 0 there, and s itself after.
+  // (A NaN phase counts as past every end, as in positionAt, where it reads the anchor.)
+  const int afterAnchor = firstSampleWhere(from, to, [&](int k) { return !(phase.at(k) <= 0.0); });
+  const int fadeEnd = firstAtOrAbove(afterAnchor, 1.0);
   const int extrapolateEnd = firstAtOrAbove(fadeEnd, kExtrapolateT);
   const int staleStart = firstAtOrAbove(extrapolateEnd, kStaleT);
   const int restStart = firstAtOrAbove(staleStart, kStaleT + kFadeT);
@@ -216,7 +223,7 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
   const int variableEnd = !hasAnchor_ || mode_ == TrajectoryMode::Hold ? from
                           : mode_ == TrajectoryMode::Linear            ? fadeEnd
                                                                        : extrapolateEnd;
-  phase.fill(phases, from, from, variableEnd);
+  phase.fill(phases, from, afterAnchor, variableEnd);
   if (hasAnchor_) phase.fill(phases, from, staleStart, restStart);
   const auto s = [&](int k) { return phases[k - from]; };
   const double lastPhase = phase.at(to - 1);
@@ -233,17 +240,16 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
       if (!hasAnchor_ || mode_ == TrajectoryMode::Hold) {
         put(from, to, anchor);
       } else if (mode_ == TrajectoryMode::Linear) {
-        put(from, fadeEnd, [&](int k) { return blend(axis, 0.0, 1.0 - std::max(0.0, s(k))); });
+        put(from, afterAnchor, [&](int) { return blend(axis, 0.0, 1.0 - 0.0); });
+        put(afterAnchor, fadeEnd, [&](int k) { return blend(axis, 0.0, 1.0 - s(k)); });
         put(fadeEnd, to, anchor);
       } else {
         // Extrapolation and fade are never both 0 before restStart (the fade is > 0 below s = 1,
         // the extrapolation >= 1 from there to kStaleT and > 0 below kStaleT + kFadeT), so
         // positionAt's exact-anchor shortcut applies from restStart on only.
-        put(from, fadeEnd, [&](int k) {
-          const double e = std::max(0.0, s(k));
-          return blend(axis, e, 1.0 - e);
-        });
-        put(fadeEnd, extrapolateEnd, [&](int k) { return blend(axis, std::max(0.0, s(k)), 0.0); });
+        put(from, afterAnchor, [&](int) { return blend(axis, 0.0, 1.0 - 0.0); });
+        put(afterAnchor, fadeEnd, [&](int k) { return blend(axis, s(k), 1.0 - s(k)); });
+        put(fadeEnd, extrapolateEnd, [&](int k) { return blend(axis, s(k), 0.0); });
         put(extrapolateEnd, staleStart, [&](int) { return blend(axis, kExtrapolateT, 0.0); });
         put(staleStart, restStart,
             [&](int k) { return blend(axis, kExtrapolateT * (1.0 - (s(k) - kStaleT) / kFadeT), 0.0); });

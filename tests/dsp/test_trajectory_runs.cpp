@@ -6,6 +6,7 @@
 // change of the measured update rate, all three modes and 44.1-192 kHz.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -28,16 +29,19 @@ struct Report {
 // Bursts of reports every T (jittered off the sample grid), then a gap of 1.2-4.5 T: the gaps
 // carry the phase across 1, 1.5, 2 and 3 T within one run. From 0.4 s on the mouse reports at
 // 1 kHz, so the measured rate replaces the nominal T. Some reports are late (timed before the
-// block they arrive in).
-std::vector<Report> reportSchedule(std::mt19937& rng, double durationS) {
+// block they arrive in), and some fall on a sample's time (taken with s = 0 there).
+std::vector<Report> reportSchedule(std::mt19937& rng, double durationS, double sampleDurS) {
   std::uniform_int_distribution<int> counts(-12, 12), burst(1, 6);
   std::uniform_real_distribution<double> jitter(-0.1, 0.1), gap(1.2, 4.5);
   std::vector<Report> reports;
   double t = 0.003;
   while (t < durationS) {
     const double intervalS = t < 0.4 ? kIntervalS : 0.001;
-    for (int k = burst(rng); k > 0; --k, t += intervalS)
-      reports.push_back({t + jitter(rng) * intervalS, counts(rng) * kCountMm, counts(rng) * kCountMm});
+    for (int k = burst(rng); k > 0; --k, t += intervalS) {
+      double timeS = t + jitter(rng) * intervalS;
+      if (k % 3 == 0) timeS = std::round(timeS / sampleDurS) * sampleDurS;
+      reports.push_back({timeS, counts(rng) * kCountMm, counts(rng) * kCountMm});
+    }
     t += gap(rng) * intervalS;
   }
   return reports;
@@ -53,8 +57,8 @@ TEST_CASE("TrajectoryReconstructor: blocks of any size render bit for bit as sam
   for (double sampleRateHz : {44100.0, 48000.0, 96000.0, 192000.0}) {
     for (TrajectoryMode mode : {TrajectoryMode::Hold, TrajectoryMode::Linear, TrajectoryMode::Predictive}) {
       INFO("rate " << sampleRateHz << " Hz, mode " << static_cast<int>(mode));
-      const std::vector<Report> reports = reportSchedule(rng, durationS);
       const double durS = 1.0 / sampleRateHz;
+      const std::vector<Report> reports = reportSchedule(rng, durationS, durS);
       const int total = static_cast<int>(durationS * sampleRateHz);
       const double originXMm = 12.5, originYMm = -3.0;
       std::uniform_int_distribution<int> smallBlock(1, 70), pick(0, 3);
@@ -75,9 +79,16 @@ TEST_CASE("TrajectoryReconstructor: blocks of any size render bit for bit as sam
         TrajectoryReconstructor perSample = blocks;
         blocks.render(startS, durS, n, originXMm, originYMm, out[0].data() + start, out[1].data() + start,
                       out[2].data() + start, out[3].data() + start);
-        for (int i = 0; i < n; ++i)
+        for (int i = 0; i < n; ++i) {
           perSample.render(startS + i * durS, durS, 1, originXMm, originYMm, ref[0].data() + start + i,
                            ref[1].data() + start + i, ref[2].data() + start + i, ref[3].data() + start + i);
+          // The rendered* values come from the per-sample rule itself (positionAt, speedAt), not
+          // from the stretches: a sample alone must be exactly that.
+          REQUIRE(sameBits(ref[0][start + i], static_cast<float>(perSample.renderedXMm() - originXMm)));
+          REQUIRE(sameBits(ref[1][start + i], static_cast<float>(perSample.renderedYMm() - originYMm)));
+          REQUIRE(sameBits(ref[2][start + i], static_cast<float>(perSample.renderedSpeedXMmPerS())));
+          REQUIRE(sameBits(ref[3][start + i], static_cast<float>(perSample.renderedSpeedYMmPerS())));
+        }
         REQUIRE(blocks.renderedXMm() == perSample.renderedXMm());
         REQUIRE(blocks.renderedYMm() == perSample.renderedYMm());
         REQUIRE(blocks.renderedSpeedXMmPerS() == perSample.renderedSpeedXMmPerS());
