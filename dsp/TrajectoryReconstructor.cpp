@@ -206,12 +206,12 @@ void TrajectoryReconstructor::renderRun(const SampleClock& clock, int from, int 
   const auto firstAtOrAbove = [&](int lo, double threshold) {
     return firstSampleWhere(lo, to, [&](int k) { return !(phase.at(k) < threshold); });
   };
+  // Samples up to the anchor's time (s <= 0: a report taken at a sample's own time) neither
+  // extrapolate nor have faded: positionAt's std::max(0, s) is 0 there and s itself after, so
+  // the loops need no max. A NaN phase counts as past every end: positionAt reads the anchor.
+  const int afterAnchor = firstSampleWhere(from, to, [&](int k) { return !(phase.at(k) <= 0.0); });
   // Stretch ends, in T: 1 ends the fade, kExtrapolateT the extrapolation, kStaleT the held speed,
   // kStaleT + kFadeT the fade of speed and extrapolation.
-  // Samples up to the anchor (s <= 0, taken late or at the sample's own time) neither
-  // extrapolate nor have faded: std::max(0, s) is 0 there, and s itself after.
-  // (A NaN phase counts as past every end, as in positionAt, where it reads the anchor.)
-  const int afterAnchor = firstSampleWhere(from, to, [&](int k) { return !(phase.at(k) <= 0.0); });
   const int fadeEnd = firstAtOrAbove(afterAnchor, 1.0);
   const int extrapolateEnd = firstAtOrAbove(fadeEnd, kExtrapolateT);
   const int staleStart = firstAtOrAbove(extrapolateEnd, kStaleT);
