@@ -29,7 +29,8 @@
 // Reports wait in a fixed queue until rendering reaches their time, so several reports in one
 // block are taken in order at their own times. A report whose time has already been rendered
 // is taken at the next sample (p stays continuous; its lateness becomes lag). Nothing here
-// allocates.
+// allocates. render() works in runs between report takes: within a run each branch of the rule
+// holds for one stretch of samples, filled by a loop of its own (bit for bit the per-sample rule).
 #pragma once
 
 #include <array>
@@ -118,7 +119,8 @@ class TrajectoryReconstructor {
     double correctionMm = 0.0;  // c: position before the latest report minus the anchor
   };
 
-  // Sample i of a render() call is at startS + i * durS, computed so wherever it is needed.
+  // Sample i of a render() call is at startS + i * durS: one expression wherever it is needed,
+  // so every comparison with a sample's time gives what the per-sample rule gives.
   struct SampleClock {
     double startS, durS;
     double timeS(int i) const { return startS + i * durS; }
