@@ -36,6 +36,7 @@ def test_list_and_open_without_a_mouse(jack):
         rows = run.lines("KF-POS ")
         assert len(rows) >= 5 and all(float(v) == 0.0 for row in rows for v in row)
     assert len(run.lines("KF-REFUSED ")) == (3 if count == 0 else 2), out[-3000:]
-    assert "kfOpenMouse: /dev/hidraw-kf-none: " in out
-    assert "kfOpenMouse: /dev/input/event-kf-none: " in out
+    # A path is opened only if it is a mouse the backend lists (never a keyboard's node): say so.
+    assert "kfOpenMouse: /dev/hidraw-kf-none is not a mouse this backend lists" in out
+    assert "kfOpenMouse: /dev/input/event-kf-none is not a mouse this backend lists" in out
     assert "kfReopenMouse: no mouse is open at index 3" in out
