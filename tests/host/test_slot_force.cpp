@@ -86,7 +86,7 @@ TEST_CASE("several writers: one frame per millisecond, forces above the minimum 
   }
 }
 
-TEST_CASE("idle writers stay at the floor together; NaN, Inf and forces below the minimum add nothing") {
+TEST_CASE("idle writers stay at the floor together, NaN, Inf and forces below the minimum add nothing") {
   auto slot = makeSlot(4);
   Recorder sink;
   const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -283,7 +283,7 @@ TEST_CASE("board arm: frames applied while the ARM's reply is on its way do not 
   device.close();
 }
 
-TEST_CASE("board transfers: a callback that never comes back is given up once; open says restart", "[board]") {
+TEST_CASE("board transfers: a callback that never comes back is given up once, open says restart", "[board]") {
   auto bus = EmulatedUsb::create();
   BoardOptions options;
   options.callbackWaitS = 0.05;  // 10 s in use

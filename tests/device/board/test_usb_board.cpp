@@ -81,7 +81,7 @@ TEST_CASE("board emulator: the watchdog turns the current off 20 ms after the la
   CHECK(board.state() == BoardState::kDisarmed);
 }
 
-TEST_CASE("board emulator: disarmed boards never drive; ARM needs its key", "[board]") {
+TEST_CASE("board emulator: disarmed boards never drive, ARM needs its key", "[board]") {
   BoardEmulator board(0.0);
   uint8_t frame[kSetPointSize];
   encodeSetPoint({1, 40000}, frame);

@@ -7,7 +7,7 @@
 
 using namespace kf;
 
-TEST_CASE("count size from a measured stroke, either direction; CPI as a starting value", "[profile]") {
+TEST_CASE("count size from a measured stroke, either direction, CPI as a starting value", "[profile]") {
   // 100 mm along the ruler, 4762 counts: the paper's 0.021 mm.
   CHECK(countMmFromStroke(4762, 100.0) == Approx(0.0209996));
   CHECK(countMmFromStroke(-4762, 100.0) == countMmFromStroke(4762, 100.0));
@@ -65,7 +65,7 @@ TEST_CASE("mouse profile: written, read back, applied to the spec", "[profile]")
   CHECK_FALSE(MouseProfile{}.applyTo(fromCpi));
 }
 
-TEST_CASE("mouse profile: malformed lines are named; unknown keys ignored", "[profile]") {
+TEST_CASE("mouse profile: malformed lines are named, unknown keys ignored", "[profile]") {
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-profile-bad.txt";
   std::string error;
   MouseProfile p;
@@ -107,7 +107,7 @@ TEST_CASE("mouse profile: the axes' swap and signs are written, read back and ap
   CHECK(yMm == Approx(-100 * 0.03));  // y from the mouse's x, reversed, at countMmY
 }
 
-TEST_CASE("counts to mm: countMmY sizes y, 0 means as x; signs reverse; a spec refuses sign 0", "[profile]") {
+TEST_CASE("counts to mm: countMmY sizes y, 0 means as x, signs reverse, a spec refuses sign 0", "[profile]") {
   DeviceSpec spec;
   spec.countMm = 0.02;
   double xMm = 0.0, yMm = 0.0;

@@ -67,7 +67,7 @@ TEST_CASE("skipIdle starts one interval before the first movement") {
   CHECK(pollUntil(replay, 1.5).dx + p.dx == 125 * 3);
 }
 
-TEST_CASE("startS starts at a file time; rate plays faster on the same path") {
+TEST_CASE("startS starts at a file time, rate plays faster on the same path") {
   ReplayOptions options;
   options.startS = 1.5;
   options.rate = 2.0;
