@@ -192,7 +192,8 @@ TEST_CASE("a hidraw node's descriptor says whether it carries X/Y and whether it
   CHECK(mice.front().path == "/dev/hidraw6");
 }
 
-TEST_CASE("finding a mouse again: its port first, elsewhere only with a serial, the one of its make", "[mouse][select]") {
+TEST_CASE("finding a mouse again: its port first, elsewhere only with a serial, the one of its make",
+          "[mouse][select]") {
   const MouseInfo ours = mouse("/dev/hidraw7", 0x0458, 0x0138, "usb1/1-2/1-2:1.0/0003:0458:0138", 0);
   const MouseInfo twin = mouse("/dev/hidraw2", 0x0458, 0x0138, "usb1/1-1/1-1:1.0/0003:0458:0138", 0);
   const MouseInfo other = mouse("/dev/hidraw3", 0x046d, 0xc077, "usb1/1-3/1-3:1.0/0003:046D:C077", 0);
