@@ -7,6 +7,7 @@
 #include <chrono>
 #include <thread>
 
+#include "BoardTestSupport.hpp"
 #include "board/EmulatedUsb.hpp"
 #include "board/UsbBoardBackend.hpp"
 #include "core/Device.hpp"
@@ -14,34 +15,12 @@
 
 using namespace kf;
 using namespace kf::board;
+using kf::test::armAlone;
+using kf::test::openBoard;
+using kf::test::waitFor;
 using namespace std::chrono_literals;
 
 namespace {
-
-template <class Done>
-bool waitFor(Done done, std::chrono::milliseconds limit = 3000ms) {
-  const auto start = std::chrono::steady_clock::now();
-  while (!done()) {
-    if (std::chrono::steady_clock::now() - start > limit) return false;
-    std::this_thread::sleep_for(1ms);
-  }
-  return true;
-}
-
-std::shared_ptr<UsbBoardBackend> openBoard(const std::shared_ptr<EmulatedUsb>& bus, BoardOptions options = {}) {
-  auto backend = std::make_shared<UsbBoardBackend>(bus->makePort(), options);
-  std::string error;
-  INFO(error);
-  REQUIRE(backend->open(error));
-  return backend;
-}
-
-// A device's part when the driver runs alone: ARM restarts from off, acknowledged at once.
-bool armAlone(UsbBoardBackend& backend, std::string& error) {
-  if (!backend.arm(error)) return false;
-  backend.takeRestartFromOff();
-  return true;
-}
 
 void checkNoBreach(EmulatedUsb& bus) {
   CHECK(bus.closesInFlight() == 0);

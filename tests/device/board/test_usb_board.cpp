@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "BoardTestSupport.hpp"
 #include "board/BoardEmulator.hpp"
 #include "board/EmulatedUsb.hpp"
 #include "board/UsbBoardBackend.hpp"
@@ -13,38 +14,12 @@
 
 using namespace kf;
 using namespace kf::board;
+using kf::test::armAlone;
+using kf::test::openBoard;
+using kf::test::waitFor;
 using namespace std::chrono_literals;
 
-namespace {
-
-// Waits (bounded) until `done` holds.
-template <class Done>
-bool waitFor(Done done, std::chrono::milliseconds limit = 2000ms) {
-  const auto start = std::chrono::steady_clock::now();
-  while (!done()) {
-    if (std::chrono::steady_clock::now() - start > limit) return false;
-    std::this_thread::sleep_for(1ms);
-  }
-  return true;
-}
-
-std::unique_ptr<UsbBoardBackend> openBoard(const std::shared_ptr<EmulatedUsb>& bus, BoardOptions options = {}) {
-  auto backend = std::make_unique<UsbBoardBackend>(bus->makePort(), options);
-  std::string error;
-  INFO(error);
-  REQUIRE(backend->open(error));
-  return backend;
-}
-
-// Arms a board driven without a Device, playing the device's part: ARM restarts the force from
-// off, and the device acknowledges that (takeRestartFromOff) before its next frame.
-bool armAlone(UsbBoardBackend& backend, std::string& error) {
-  if (!backend.arm(error)) return false;
-  backend.takeRestartFromOff();
-  return true;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("board emulator: the watchdog turns the current off 20 ms after the last valid frame", "[board]") {
   BoardEmulator board(0.0);
