@@ -104,22 +104,42 @@ TEST_CASE("board errors: open and arm clear them, a reset is reported once, a pe
   checkNoBreach(*bus);
 }
 
-TEST_CASE("board arm: the force starts from the minimum through the slew limiter", "[board]") {
-  DeviceSpec spec;
-  spec.maxForceSlewNPerS = 100.0;  // 0.1 N per 1 ms frame: 13 frames from min to max
-  auto bus = EmulatedUsb::create();
+// A lockstep device whose board drive slews 0.1 N per 1 ms frame (13 frames from min to max):
+// frames pushed are applied at once, so a test sees each frame's drive.
+struct SlewedBoardDevice {
+  DeviceSpec spec = [] {
+    DeviceSpec s;
+    s.maxForceSlewNPerS = 100.0;
+    return s;
+  }();
+  std::shared_ptr<EmulatedUsb> bus = EmulatedUsb::create();
   std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
-  Device device(spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
-                std::make_shared<CountingForceSink>(), /*lockstep=*/true);
-  REQUIRE(device.attachBoard(board) == nullptr);
-  device.pump(0.0);  // lockstep: frames pushed from now on are applied at once
+  Device device{spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
+                std::make_shared<CountingForceSink>(), /*lockstep=*/true};
   double frameS = 0.0;
-  auto frame = [&](float forceN) {
+
+  SlewedBoardDevice() {
+    REQUIRE(device.attachBoard(board) == nullptr);
+    device.pump(0.0);  // lockstep: frames pushed from now on are applied at once
+  }
+  // Pushes the next frame's force; the drive the board was given for it.
+  uint16_t frame(float forceN) {
     frameS += spec.forceFramePeriodS;
     device.pushForceFrame({frameS, forceN, frameS});
     return board->latestDrive();
-  };
-  for (int i = 0; i < 40; ++i) frame(1.4f);  // disarmed: the request has slewed up to the top
+  }
+  // One frame's worth of slew in drive units (linear table): 0.1 N of 1.26 N, +1 for rounding.
+  double maxStepDrive() const {
+    return spec.maxForceSlewNPerS * spec.forceFramePeriodS / (spec.maxForceN - spec.minForceN) * kDriveFull + 1.0;
+  }
+};
+
+TEST_CASE("board arm: the force starts from the minimum through the slew limiter", "[board]") {
+  SlewedBoardDevice rig;
+  const std::shared_ptr<EmulatedUsb>& bus = rig.bus;
+  const std::shared_ptr<UsbBoardBackend>& board = rig.board;
+  Device& device = rig.device;
+  for (int i = 0; i < 40; ++i) rig.frame(1.4f);  // disarmed: the request has slewed up to the top
   REQUIRE(board->latestDrive() == kDriveFull);
   std::string error;
   REQUIRE(board->arm(error));
@@ -127,13 +147,11 @@ TEST_CASE("board arm: the force starts from the minimum through the slew limiter
   const uint64_t frames = bus->validFrames();
   REQUIRE(waitFor([&] { return bus->validFrames() > frames + 5; }));
   CHECK(bus->drive() == 0);  // no frame since ARM: the board is not driven to the old request
-  // One frame's worth of slew in drive units (linear table): 0.1 N of 1.26 N, +1 for rounding.
-  const double maxStep =
-      spec.maxForceSlewNPerS * spec.forceFramePeriodS / (spec.maxForceN - spec.minForceN) * kDriveFull + 1.0;
+  const double maxStep = rig.maxStepDrive();
   uint16_t previous = 0;
   int steps = 0;
   while (previous < kDriveFull && steps < 100) {
-    const uint16_t drive = frame(1.4f);
+    const uint16_t drive = rig.frame(1.4f);
     CHECK(drive - previous <= maxStep);
     CHECK(drive > previous);
     previous = drive;
@@ -218,20 +236,10 @@ TEST_CASE("board control: ARM, DISARM and CLEAR_ERRORS are sent by the event thr
 }
 
 TEST_CASE("board arm: frames applied while the ARM's reply is on its way do not jump the drive", "[board]") {
-  DeviceSpec spec;
-  spec.maxForceSlewNPerS = 100.0;  // 0.1 N per 1 ms frame: 13 frames from min to max
-  auto bus = EmulatedUsb::create();
-  std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
-  Device device(spec, std::make_shared<ReplayBackend>(std::vector<TimedReport>{}),
-                std::make_shared<CountingForceSink>(), /*lockstep=*/true);
-  REQUIRE(device.attachBoard(board) == nullptr);
-  device.pump(0.0);
-  double frameS = 0.0;
-  auto frame = [&](float forceN) {
-    frameS += spec.forceFramePeriodS;
-    device.pushForceFrame({frameS, forceN, frameS});
-    return board->latestDrive();
-  };
+  SlewedBoardDevice rig;
+  const std::shared_ptr<EmulatedUsb>& bus = rig.bus;
+  const std::shared_ptr<UsbBoardBackend>& board = rig.board;
+  Device& device = rig.device;
   bus->holdArmReply(true);
   std::string error;
   bool armed = false;
@@ -239,7 +247,7 @@ TEST_CASE("board arm: frames applied while the ARM's reply is on its way do not 
   REQUIRE(waitFor([&] { return bus->armsHeld() == 1; }));
   // 40 frames while ARM is in flight (on USB 1-3 ms, up to its 200 ms timeout): they take the
   // restart and ramp the request to the top while the set-points still carry 0.
-  for (int i = 0; i < 40; ++i) frame(1.4f);
+  for (int i = 0; i < 40; ++i) rig.frame(1.4f);
   REQUIRE(board->latestDrive() == kDriveFull);
   bus->holdArmReply(false);
   arming.join();
@@ -248,12 +256,11 @@ TEST_CASE("board arm: frames applied while the ARM's reply is on its way do not 
   const uint64_t frames = bus->validFrames();
   REQUIRE(waitFor([&] { return bus->validFrames() > frames + 5; }));
   CHECK(bus->drive() == 0);  // no frame since ARM returned: not the ramp made before
-  const double maxStep =
-      spec.maxForceSlewNPerS * spec.forceFramePeriodS / (spec.maxForceN - spec.minForceN) * kDriveFull + 1.0;
+  const double maxStep = rig.maxStepDrive();
   uint16_t previous = 0;
   int steps = 0;
   while (previous < kDriveFull && steps < 100) {
-    const uint16_t drive = frame(1.4f);
+    const uint16_t drive = rig.frame(1.4f);
     CHECK(drive - previous <= maxStep);
     previous = drive;
     ++steps;

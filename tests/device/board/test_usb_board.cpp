@@ -19,8 +19,6 @@ using kf::test::openBoard;
 using kf::test::waitFor;
 using namespace std::chrono_literals;
 
-namespace {}  // namespace
-
 TEST_CASE("board emulator: the watchdog turns the current off 20 ms after the last valid frame", "[board]") {
   BoardEmulator board(0.0);
   int moved = 0;
