@@ -148,11 +148,13 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 
 
 def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None,
-                    server_options=None):
+                    server_options=None, booted=None):
     """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync` and
     GUI work) with `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang
     processes are gone when it returns, whatever happened. `env`: extra environment variables;
-    `server_options`: ServerOptions to set over the defaults, e.g. {"memSize": 524288}."""
+    `server_options`: ServerOptions to set over the defaults, e.g. {"memSize": 524288};
+    `booted`: a threading.Event, set once the server is up or the run is over (so that runs side
+    by side can boot one after another)."""
     assert jack.alive(), "jackd is not running"
     port = port or procs.free_udp_port()
     key, code_path = _script_files(code, name)
@@ -176,6 +178,8 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             deadline = time.monotonic() + timeout
             while proc.poll() is None and time.monotonic() < deadline:
                 known_children.update(procs.descendants(proc.pid))
+                if booted is not None and not booted.is_set() and "KF-SERVER-UP" in log_path.read_text(errors="replace"):
+                    booted.set()
                 time.sleep(0.1)
             if proc.poll() is None:
                 known_children.update(procs.descendants(proc.pid))
@@ -185,6 +189,8 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
                 procs.stop_pid(proc.pid, grace_s=2.0)
                 proc.wait()
             log.flush()
+            if booted is not None:
+                booted.set()
             output = log_path.read_text(errors="replace")
             m = re.search(r"^KF-SCSYNTH-PID (\d+)", output, re.M)
             if m:

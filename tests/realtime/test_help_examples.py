@@ -7,7 +7,8 @@ alone does not compile, the whole block runs as one piece.) Pieces run in order 
 short pause after each, and each piece's value is posted as "-> value", as the IDE does; a block
 gets ~1.5 s. Blocks of a file run in order, so later ones see the ~variables and synths of
 earlier ones; after the last block of a file, s.freeAll and every device slot is closed
-(FREE_EACH_BLOCK = True frees nodes after every block instead).
+(FREE_EACH_BLOCK = True frees nodes after every block instead). The files are shared out over
+SHARDS servers running side by side (shards_of), files naming one temp file in the same one.
 
 A block whose first line is a comment beginning "// needs " ("// needs a mouse") needs hardware
 this machine may not have: it is skipped (it still has to compile: tests/scenes/test_help.py).
@@ -38,7 +39,10 @@ test_broken_examples_are_reported shows that each rule fails a broken example.
 """
 import os
 import re
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import ExitStack
 from pathlib import Path
 
 from kfharness import paths, readers, sclang
@@ -51,6 +55,11 @@ BLOCK_TIME_S = 1.5
 # in one block is steered by the next ones), which s.freeAll after every block would break into
 # "/n_set Node not found". Devices are closed after each file too.
 FREE_EACH_BLOCK = False
+# The files run in this many servers side by side (each its own jackd, scsynth and sclang): a
+# run is mostly the examples' pauses, not work, so two halve its time on two cores.
+SHARDS = 3
+TEMP_NAME = re.compile(r'defaultTempDir\s*\+/\+\s*"([^"]+)"')
+CODE_BLOCK = re.compile(r"^code::\s*$", re.M)
 
 RUNNER = r"""
 var files = [%(files)s];
@@ -229,14 +238,17 @@ def check_written(text, temp_dir, since):
     return None
 
 
-def run_examples(files, jack, timeout=240):
-    """Runs every example of `files` on one server booted against `jack`. Returns (run, examples,
-    problems, notes): problems are the failures and unmet expectations, each naming its example."""
+def run_examples(files, jack, timeout=240, after=None, booted=None):
+    """Runs every example of `files` on one server booted against `jack`, once the Event `after`
+    (if any) is set; sets `booted` when its server is up. Returns (run, examples, problems, notes):
+    problems are the failures and unmet expectations, each naming its example."""
+    if after is not None:
+        after.wait()
     since = time.time()
     run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
                                                piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
                                                free_each_block=str(FREE_EACH_BLOCK).lower()),
-                                 jack, name="help", timeout=timeout)
+                                 jack, name="help", timeout=timeout, booted=booted)
     examples, in_file, current, notes, problems = [], [], None, [], []
     where, temp_dir, finished, in_stack = "(before the first example)", "/tmp", False, False
     for line in run.output.splitlines():
@@ -316,20 +328,62 @@ def run_examples(files, jack, timeout=240):
     return run, examples, problems, notes
 
 
+def shards_of(files, count):
+    """`files` in `count` lists to run side by side, each in the sorted order. Files naming the
+    same file in Platform.defaultTempDir (one writes what another reads, or both write it) stay in
+    one list, in order; the lists are balanced by their number of code blocks."""
+    groups = []  # [(temp names, files)]
+    for f in files:
+        text = f.read_text()
+        names = set(TEMP_NAME.findall(text))
+        joined = [g for g in groups if g[0] & names]
+        merged = (names.union(*(g[0] for g in joined)), [x for g in joined for x in g[1]] + [f])
+        groups = [g for g in groups if g not in joined] + [merged]
+    shards = [[] for _ in range(count)]
+    weight = [0] * count
+    for names, group in sorted(groups, key=lambda g: -sum(CODE_BLOCK.subn("", x.read_text())[1] for x in g[1])):
+        i = weight.index(min(weight))
+        shards[i] += group
+        weight[i] += sum(CODE_BLOCK.subn("", x.read_text())[1] for x in group)
+    return [sorted(shard) for shard in shards if shard]
+
+
+def test_help_shards_keep_files_sharing_a_temp_file_together():
+    files = sorted(HELP_DIR.rglob("*.schelp"))
+    shards = shards_of(files, SHARDS)
+    assert sorted(f for shard in shards for f in shard) == files
+    owner = {}
+    for i, shard in enumerate(shards):
+        for f in shard:
+            for name in TEMP_NAME.findall(f.read_text()):
+                assert owner.setdefault(name, i) == i, f"{name} is used by files in two shards"
+
+
 def test_every_help_example_runs_on_a_realtime_server():
     files = sorted(HELP_DIR.rglob("*.schelp"))
     assert files, "no help files"
-    with JackServer() as jack:
-        run, examples, problems, notes = run_examples(files, jack)
-        jack_alive = jack.alive()
+    shards = shards_of(files, SHARDS)
+    with ExitStack() as stack:
+        jacks = [stack.enter_context(JackServer()) for _ in shards]
+        # The servers boot one after another: scsynths opening their JACK clients at the same
+        # moment failed to ("Cannot open SuperCollider client") under the sanitizers.
+        booted = [threading.Event() for _ in shards]
+        with ThreadPoolExecutor(len(shards)) as pool:
+            results = list(pool.map(lambda i: run_examples(shards[i], jacks[i], after=booted[i - 1] if i else None,
+                                                           booted=booted[i]), range(len(shards))))
+        jacks_alive = all(jack.alive() for jack in jacks)
 
+    problems = [p for _, _, shard_problems, _ in results for p in shard_problems]
+    notes = [n for _, _, _, shard_notes in results for n in shard_notes]
+    examples = [e for _, shard_examples, _, _ in results for e in shard_examples]
     summary = paths.work_dir() / "help-examples-summary.txt"
     summary.write_text("\n".join(["PROBLEMS"] + problems + ["", "NOTES"] + notes) + "\n")
-    print(f"log {run.log_path}\nsummary {summary}")
+    print("\n".join(f"log {run.log_path}" for run, *_ in results) + f"\nsummary {summary}")
     print("\n".join(notes))
-    assert jack_alive, "jackd died during the examples"
-    for f in files:
-        assert f"KF-HELP-FILE-DONE {f}" in run.output, f"{f} did not run, log {run.log_path}"
+    assert jacks_alive, "jackd died during the examples"
+    for shard, (run, *_) in zip(shards, results):
+        for f in shard:
+            assert f"KF-HELP-FILE-DONE {f}" in run.output, f"{f} did not run, log {run.log_path}"
     assert not problems, "help examples with problems:\n" + "\n".join(problems)
     assert sum(len(e.expects) for e in examples) >= 10, "the help's output annotations were not read"
 
