@@ -152,10 +152,13 @@ FrictionDevice {
 	// The same figures as numbers: an Event (FrictionDevice.statusOf) passed to action, from the
 	// server's /kfStatus reply to the clients registered with /notify (sclang by default).
 	statusValues { |action|
+		var reply;
 		if(server.isNil) { ^this };
-		OSCFunc({ |msg| action.value(this.class.statusOf(msg[3..])) }, '/kfStatus', server.addr,
+		FrictionCheck.serverRunning(server, "FrictionDevice.statusValues");
+		reply = OSCFunc({ |msg| action.value(this.class.statusOf(msg[3..])) }, '/kfStatus', server.addr,
 			argTemplate: [nil, index]).oneShot;
-		this.status
+		// A refused or unanswered kfStatus sends no reply: its responder would wait for the next one.
+		this.prSendAnswered(\kfStatus, this.statusMsg, onFail: { reply.free })
 	}
 	// Thread priorities: -1 no such thread, 0 normal scheduling (realtime refused or not asked
 	// for), > 0 SCHED_FIFO. Durations in s, the force in N.

@@ -102,6 +102,12 @@ def test_every_malformed_command_gets_one_answer_and_the_server_renders_on(jack)
         try { dev.addBoard("NO-SUCH-BOARD") } { |e| "KF-RAISED addBoard %".format(e.errorString).postln };
         dev.close;
         s.sync;
+        // A refused statusValues leaves no responder awaiting a /kfStatus that will not come.
+        // kfStatus answers every slot, open or not, so the object is made to name slot 16.
+        dev.instVarPut(\index, 16);
+        try { dev.statusValues { "KF-STATUS-CAME".postln } } { |e| "KF-RAISED status %".format(e.errorString).postln };
+        "KF-STATUS-RESPONDERS %".format(OSCFunc.allFuncProxies.values.flatten.count { |f|
+            f.respondsTo(\path) and: { f.path == '/kfStatus' } }).postln;
     """, jack, name="answers", timeout=240))
     counts = {int(f[0]): int(f[1]) for f in run.lines("KF-ANSWERS ")}
     answers = {}
@@ -135,3 +141,5 @@ def test_every_malformed_command_gets_one_answer_and_the_server_renders_on(jack)
     assert "longer than" in raised.get("record", ""), raised
     assert "has no board" in raised.get("arm", ""), raised
     assert "kfBoardOpen" in raised.get("addBoard", "") and "no answer" not in raised["addBoard"], raised
+    assert "kfStatus" in raised.get("status", "") and "device" in raised["status"], raised
+    assert run.lines("KF-STATUS-RESPONDERS ") == [["0"]], run.output[-2000:]
