@@ -54,6 +54,10 @@ struct CloseAllAtExit {
 
 bool isValidSlot(int index) { return index >= 0 && index < kNumDeviceSlots; }
 
+uint32_t generationOfSlot(int index) {
+  return isValidSlot(index) ? gSlots[index].generation.load(std::memory_order_acquire) : 0;
+}
+
 Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation) {
   if (!isValidSlot(index)) return nullptr;
   Slot& slot = gSlots[index];

@@ -57,6 +57,9 @@ Device* peekSlot(int index);
 
 bool isValidSlot(int index);
 
+// Any thread: the generation of the slot's device (0 for an invalid slot).
+uint32_t generationOfSlot(int index);
+
 // Signal handlers (ExitSafety.cpp): Device::emergencyOff on every device in a slot and every
 // retired one (its close has not finished), taking the retired ones so that their NRT stage does
 // not delete them meanwhile. Atomic operations only, so async-signal-safe. A device whose NRT

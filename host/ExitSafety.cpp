@@ -6,7 +6,7 @@
 // thread aborts), SIGSYS, SIGTRAP. SIGXFSZ (a write past the file size limit) is ignored
 // instead: the write fails with EFBIG, the recording that made it stops with its message, and
 // the server and the magnet go on. Each handler drives the force backend of every open device, and of every device
-// whose close has not finished, off with async-signal-safe work only (atomic slot loads,
+// whose close has not finished, off, and every audio drive to 0 (haltAllDrives), with async-signal-safe work only (atomic slot loads,
 // stores, write(2) of an off record to a recording), then hands the signal on: to the handler
 // installed before ours if there was one, else the original disposition is restored and the
 // signal raised again, so the exit status is the signal's. A signal ignored when the plugin
@@ -19,6 +19,7 @@
 #include <atomic>
 
 #include "DeviceSlots.hpp"
+#include "SlotDrive.hpp"
 
 namespace {
 
@@ -32,7 +33,10 @@ std::atomic<bool> gDrivenOff{false};
 
 void onExitSignal(int signalNumber, siginfo_t* info, void* context) {
   // Once: a second signal (or a crash inside the first handler) goes straight on.
-  if (!gDrivenOff.exchange(true)) kf::sc::haltAllDevices();
+  if (!gDrivenOff.exchange(true)) {
+    kf::sc::haltAllDevices();
+    kf::sc::haltAllDrives();
+  }
   const struct sigaction& previous = gPrevious[signalNumber];
   if (previous.sa_flags & SA_SIGINFO) {
     if (previous.sa_sigaction != nullptr) return previous.sa_sigaction(signalNumber, info, context);

@@ -8,6 +8,7 @@ void SlotForce::reset(const DeviceSpec& spec) {
   arrived_ = 0;
   open_ = false;
   framedBlock_ = -1;
+  combinedBlock_[0] = combinedBlock_[1] = -1;
 }
 
 void SlotForce::begin(const BlockClock& clock) {

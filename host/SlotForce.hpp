@@ -57,6 +57,14 @@ class SlotForce {
   int64_t framedBlock() const { return framedBlock_; }
   float lastCommandedN() const { return framer_.lastCommandedN(); }
   int64_t framesEmitted() const { return framer_.framesEmitted(); }
+  // The combined force (N, per sample, before any limit) of `block` if it was framed and is one
+  // of the last two framed, else null; `numSamples` its length. FrictionDrive drives block b-1's
+  // in block b, whichever side of the writers it runs (ARCHITECTURE.md, the audio drive).
+  const float* combinedOf(int64_t block, int& numSamples) const {
+    const int slot = static_cast<int>(block & 1);
+    numSamples = combinedSamples_[slot];
+    return block >= 0 && combinedBlock_[slot] == block ? combined_[slot] : nullptr;
+  }
 
  private:
   template <class Sink>
@@ -72,7 +80,9 @@ class SlotForce {
   int64_t framedBlock_ = -1;
   double excessN_[kMaxBlockSamples] = {};  // sum over writers of max(0, force - minimum); double,
                                            // so that one writer's force comes back exactly
-  float combined_[kMaxBlockSamples] = {};
+  float combined_[2][kMaxBlockSamples] = {};  // by block parity: this block's and the previous
+  int64_t combinedBlock_[2] = {-1, -1};
+  int combinedSamples_[2] = {};
   float commanded_[kMaxBlockSamples] = {};
 };
 
@@ -108,12 +118,16 @@ void SlotForce::writerGone(const BlockClock& clock, Sink& sink) {
 template <class Sink>
 void SlotForce::frame(Sink& sink) {
   const int n = std::min(block_.numSamples, kMaxBlockSamples);
-  for (int i = 0; i < n; ++i) combined_[i] = static_cast<float>(minForceN_ + excessN_[i]);
+  const int slot = static_cast<int>(block_.block & 1);
+  float* combined = combined_[slot];
+  for (int i = 0; i < n; ++i) combined[i] = static_cast<float>(minForceN_ + excessN_[i]);
+  combinedBlock_[slot] = block_.block;
+  combinedSamples_[slot] = n;
   const double periodS = framer_.framePeriodS();
   auto emit = [this, &sink, periodS](double frameTimeS, float forceN) {
     framer_.showCommanded(sink(frameTimeS, forceN, frameTimeS + periodS));
   };
-  framer_.process(block_.startS, block_.sampleDurS, combined_, n, commanded_, emit);
+  framer_.process(block_.startS, block_.sampleDurS, combined, n, commanded_, emit);
   open_ = false;
   framedBlock_ = block_.block;
 }

@@ -96,6 +96,7 @@ bool wrappedStage3(World* world, void* raw) {  // RT
 
 bool wrappedStage4(World* world, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
+  if (data->extra != nullptr && data->failed) data->deleteExtra(data->extra);
   if (data->failed) {
     delete data->previous;                                                        // unpublished: nothing else holds it
     if (data->ownsDevice && data->previous != data->device) delete data->device;  // never published
@@ -164,6 +165,8 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   // the audio thread of a realtime server.
   if (world->mRealTime) kf::noteAudioThreadPriority(kf::currentThreadPriority());
   data->onEnd = nullptr;
+  data->extra = nullptr;
+  data->deleteExtra = nullptr;
   data->reason[0] = '\0';
   OscArgReader reader = readerOf(msg);
   char error[200];

@@ -37,6 +37,10 @@ struct CommandData {
   // RT, at the very end (success or not), before the command is freed: e.g. a reply with values.
   void (*onEnd)(World* world, CommandData* data);
   float replyValues[32];  // for onEnd (kfBoardStatus)
+  // A command's own object made in an NRT stage (kfDriveCalibrate: the drive chain), deleted in
+  // the last NRT stage by deleteExtra, also when the command failed.
+  void* extra;
+  void (*deleteExtra)(void* extra);
 };
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.

@@ -57,8 +57,10 @@ PluginLoad(KineticFriction) {
   registerLoudnessToFriction();
   registerFrictionMouseIn();
   registerFrictionOut();
+  registerFrictionDrive();
   registerDeviceCommands();
   registerBoardCommands();
   registerMouseCommands();
+  registerDriveCommands();
   installExitSafety();
 }

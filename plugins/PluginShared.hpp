@@ -78,6 +78,8 @@ void registerSpatialBufRd();
 void registerLoudnessToFriction();
 void registerFrictionMouseIn();
 void registerFrictionOut();
+void registerFrictionDrive();
 void registerDeviceCommands();
 void registerBoardCommands();
 void registerMouseCommands();
+void registerDriveCommands();

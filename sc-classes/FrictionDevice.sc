@@ -13,6 +13,8 @@ FrictionDevice {
 	// The board the device carries, opened with it (and again at a reboot): nil, or an Event of
 	// addBoard's arguments and the calibration (FrictionDeviceBoard.sc).
 	var <boardSetup;
+	// The audio drive (FrictionDeviceDrive.sc): (path:, circuitLatencyS:) once loaded, else nil.
+	var <driveSetup;
 
 	*initClass {
 		// The names specs had before every name carried its unit. A user may have typed them, so
@@ -99,8 +101,9 @@ FrictionDevice {
 
 	isOpen { ^state == \open }
 
-	// Audio is delayed by this much so that sound and touch arrive together (the paper: 1 ms).
-	audioDelay { ^specs[\tactileLatencyS] - specs[\audioLatencyS] }
+	// Audio is delayed by this much so that sound and touch arrive together: the paper's 1 ms, or
+	// with an audio drive loaded (FrictionDeviceDrive.sc) the drive's own latency.
+	audioDelay { ^this.driveLatency ?? { specs[\tactileLatencyS] - specs[\audioLatencyS] } }
 
 	// The plugin command that opens this kind of device.
 	openCommand { ^(sim: \kfOpenSim, replay: \kfOpenReplay, mouse: \kfOpenMouse)[kind] }
@@ -252,7 +255,7 @@ FrictionDevice {
 		^[[this.openCommand, this.openMsg]] ++ (boardSetup !? { |b|
 			[[\kfBoardOpen, this.addBoardMsg(b[\serial], b[\emulate], b[\inFlight])],
 				[\kfBoardCalibrate, this.calibrateMsg(b[\calibration])]]
-		} ? [])
+		} ? []) ++ (driveSetup !? { |d| [[\kfDriveCalibrate, this.loadDriveMsg(d[\path])]] } ? [])
 	}
 
 	// After step (of prOpenSteps) was refused: the device opened by the first is closed again (the

@@ -1,0 +1,48 @@
+// SlotDrive: a slot's audio drive (FrictionDrive): its chain (AudioDrive, for the device it was
+// loaded for) and the drive samples of the current block, computed once per block by the first
+// FrictionDrive that asks and copied by the others. In block b it drives block b-1's combined
+// force of the slot's FrictionOut (SlotForce::combinedOf): one block late whatever the node
+// order (ARCHITECTURE.md, the audio drive). A block that no writer framed (none left, Cmd-., a
+// paused writer) drives 0 at once, as the board goes off at once (Device::requestOff); a gap in
+// the blocks (no FrictionDrive ran) starts again from the magnet off, so the slew holds.
+// Audio thread, except publish (RT stage of kfDriveCalibrate) and haltAllDrives (signals).
+#pragma once
+
+#include <cstdint>
+
+#include "SlotForce.hpp"
+#include "core/force/AudioDrive.hpp"
+
+namespace kf::sc {
+
+class SlotDrive {
+ public:
+  static constexpr int kMaxBlockSamples = SlotForce::kMaxBlockSamples;
+
+  SlotDrive();
+
+  // Publishes `drive` (null: none) for the device of `generation`; returns the previous chain
+  // for an NRT stage to delete. The block computed so far is dropped.
+  AudioDrive* publish(AudioDrive* drive, uint32_t generation);
+  bool hasDrive() const { return drive_ != nullptr; }
+
+  // This block's drive samples (clock.numSamples of them, at most kMaxBlockSamples), or null:
+  // no chain, a chain loaded for another device than `generation`, or the drives halted.
+  const float* samples(const BlockClock& clock, uint32_t generation, const SlotForce& force);
+
+ private:
+  AudioDrive* drive_ = nullptr;
+  uint32_t generation_ = 0;
+  int64_t computedBlock_ = -1;
+  float samples_[kMaxBlockSamples] = {};
+};
+
+// Audio thread: the slot's drive, null for an invalid index.
+SlotDrive* driveOfSlot(int index);
+
+// Signal handlers (ExitSafety): every drive outputs 0 from the next block on, for good (the
+// process is on its way out; should a host's handler keep it alive, the drives stay at 0).
+// One atomic store: async-signal-safe.
+void haltAllDrives();
+
+}  // namespace kf::sc
