@@ -222,6 +222,10 @@ FrictionPilot {
 
 	server { ^FrictionDevice.serverOf(device) }
 
+	// The delay of the pilot's sound (s): the device's audioDelay, which an audio drive sets
+	// (FrictionDevice.loadDrive), else the paper's 1 ms.
+	audioDelay { ^this.class.prAudioDelay(device) }
+
 	play {
 		var server = this.server;
 		FrictionCheck.serverRunning(server, "FrictionPilot.play");
@@ -233,6 +237,10 @@ FrictionPilot {
 		// Cmd-. frees the synth (the buffer stays); a quit frees both: play starts again.
 		CmdPeriod.add(this);
 		quitAction ?? { quitAction = { synth = nil; buffer = nil }; ServerQuit.add(quitAction, server) };
+		"FrictionPilot: the sound is delayed by % ms (%)".format((this.audioDelay * 1000).round(0.001),
+			if(device.isKindOf(FrictionDevice) and: { device.driveSetup.notNil }) {
+				"the audio drive: one block + the current source + the coil"
+			} { "the tactile path's latency - the audio path's" }).postln;
 		forkIfNeeded {
 			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
