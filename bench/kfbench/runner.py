@@ -8,7 +8,7 @@ import time
 
 from kfharness import nrt
 
-from . import build, drift, goals, loudness, native, plots, provenance, realtime, report, report_rate, rtload, scores, \
+from . import build, drift, drive_path, goals, loudness, native, plots, provenance, realtime, report, report_rate, rtload, scores, \
     spatial, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import summary_lines
@@ -103,6 +103,10 @@ def run_parts(bench, args, parts):
         _print({"report_rate": results["report_rate"]})
     if ("e2e" in parts or "rtload" in parts or "scale" in parts) and not (bench.extension / "plugins").exists():
         raise SystemExit(f"no extension folder at {bench.extension}: run scripts/setup.sh (or --only build)")
+    if "drive" in parts:
+        log("drive: the audio drive's force path beside the board's frames (NRT)")
+        results["drive"] = drive_path.run(bench)
+        _print({"drive": results["drive"]})
     if "e2e" in parts:
         runs = []
         for i in range(args.e2e_runs):

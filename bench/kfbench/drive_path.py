@@ -1,0 +1,103 @@
+"""The drive part: the force path of the audio drive (FrictionDrive) beside the board's 1 ms frames
+(FrictionOut's commanded force, what the device's frames carry), on one NRT scene: force pulses of
+0.5 N above the minimum, 8 ms down to 0.0625 ms wide, each once on a frame border and once half a
+frame after it. Per path: the shortest pulse that reaches 90 % of its height at both phases (the
+shortest force feature it shows), and the delay of its rising edge behind the request. The sound
+is delayed by the device's audioDelay: the offset between sound and force is then the path's
+delay (measured here, plus what it declares beyond the digital path) less that audioDelay. The
+board's realtime frame latency (its jitter buffer) is not in an NRT render: the e2e part measures
+it, and the offset uses the paper's declared tactile latency for it."""
+import numpy as np
+import soundfile
+
+from kfharness import drive, nrt, profile
+
+SR = 48000
+BLOCK = 64
+WIDTHS_MS = [8, 4, 2, 1, 0.5, 0.25, 0.125, 0.0625]
+PHASES_MS = [0.0, 0.5]
+GAP_MS = 20
+HEIGHT_N = 0.5
+# A linear magnet and a 4 V channel: sample value = drive level = (force - 0.14 N) / 1.26 N.
+MAGNET = [(0.0, 0.14), (1.0, 1.4)]
+CIRCUIT = dict(drive.CIRCUIT, outputFullScaleV=4.0, outputSign=1.0, maxSafeCurrentA=2.0)
+
+
+def request():
+    """The requested force (N) and the pulses' (start sample, width in samples, width ms, phase ms)."""
+    floor = profile.device()["minForceN"]
+    force, pulses, t = [], [], 0
+    for width_ms in WIDTHS_MS:
+        for phase_ms in PHASES_MS:
+            start = t + round((GAP_MS + phase_ms) * SR / 1000)
+            width = round(width_ms * SR / 1000)
+            force += [floor] * (start - t) + [floor + HEIGHT_N] * width
+            pulses.append((start, width, width_ms, phase_ms))
+            t = start + width
+    force += [floor] * round(GAP_MS * SR / 1000)
+    return np.array(force, dtype=np.float32), pulses
+
+
+def _edge(x, floor, start):
+    """The first sample from `start` at half the pulse height or more."""
+    above = np.flatnonzero(x[start:] >= floor + HEIGHT_N / 2)
+    return start + int(above[0]) if len(above) else None
+
+
+def run(bench):
+    work = bench.work
+    drive_path = drive.write_files(work, circuit=CIRCUIT, magnet=MAGNET, name="bench-drive")
+    force, pulses = request()
+    force_path = work / "bench-drive-force.wav"
+    soundfile.write(str(force_path), force, SR, subtype="FLOAT")
+    data, _ = nrt.score_and_render("bench-drive", f"""
+        var dev = FrictionDevice.sim(nil, 0);
+        var def = SynthDef(\\benchdrive, {{ var f = PlayBuf.ar(1, 10);
+            Out.ar(0, [FrictionOut.ar(0, f), FrictionDrive.ar(0), f]) }});
+        score = Score([
+            [0.0, dev.openMsg], [0.0, dev.loadDriveMsg("{drive_path}")],
+            [0.0, ['/b_allocRead', 10, "{force_path}"]], [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\benchdrive, nil, 1000).newMsg(RootNode(Server.default), nil, \\addToTail)],
+            [{len(force) / SR + 0.01}, ['/c_set', 0, 0]]]);
+    """, sample_rate=SR, channels=3)
+    floor = profile.device()["minForceN"]
+    board = data[:, 0].astype(np.float64)
+    audio_drive = floor + 1.26 * data[:, 1].astype(np.float64)  # back to N through the linear table
+    requested = data[:, 2].astype(np.float64)
+    paths = {"board": board, "drive": audio_drive}
+    out = {"pulses": [], "sampleRateHz": SR, "blockSize": BLOCK, "heightN": HEIGHT_N}
+    for start, width, width_ms, phase_ms in pulses:
+        window = slice(start, start + width + round(0.004 * SR))  # the pulse and 4 ms after it
+        entry = {"widthMs": width_ms, "phaseMs": phase_ms}
+        for name, x in paths.items():
+            entry[name] = float((x[window].max() - floor) / HEIGHT_N)
+        out["pulses"].append(entry)
+    for name, x in paths.items():
+        shows = [w for w in WIDTHS_MS if all(p[name] >= 0.9 for p in out["pulses"] if p["widthMs"] == w)]
+        first = pulses[0][0]
+        out[name] = {"shortestFeatureMs": min(shows) if shows else None,
+                     "delayMs": (_edge(x, floor, first) - _edge(requested, floor, first)) * 1000 / SR}
+    dev = profile.device()
+    declared = CIRCUIT["currentSourceLatencyS"] + CIRCUIT["coilTimeConstantS"]
+    drive_audio_delay = BLOCK / SR + declared  # FrictionDevice.audioDelay with the drive loaded
+    out["drive"]["declaredMs"] = declared * 1000
+    out["drive"]["audioDelayMs"] = drive_audio_delay * 1000
+    out["drive"]["soundForceOffsetMs"] = out["drive"]["delayMs"] + declared * 1000 - drive_audio_delay * 1000
+    out["board"]["audioDelayMs"] = (dev["tactileLatencyS"] - dev["audioLatencyS"]) * 1000
+    out["board"]["declaredTactileLatencyMs"] = dev["tactileLatencyS"] * 1000
+    return out
+
+
+def summary_lines(d):
+    lines = [f"drive vs board (NRT, {d['sampleRateHz'] // 1000} kHz, block {d['blockSize']}, pulses of "
+             f"{d['heightN']} N at frame phases 0 and 0.5 ms):"]
+    b, a = d["board"], d["drive"]
+    lines.append(f"  board 1 ms frames: shortest feature {b['shortestFeatureMs']} ms, commanded force "
+                 f"{b['delayMs']:.3f} ms behind the request (plus the device's realtime frame latency; the paper "
+                 f"declares {b['declaredTactileLatencyMs']:.1f} ms tactile), sound delayed {b['audioDelayMs']:.2f} ms")
+    lines.append(f"  audio drive: shortest feature {a['shortestFeatureMs']} ms, drive {a['delayMs']:.3f} ms behind "
+                 f"the request + {a['declaredMs']:.2f} ms declared circuit; sound delayed {a['audioDelayMs']:.3f} ms: "
+                 f"offset sound-force {a['soundForceOffsetMs']:+.3f} ms")
+    lines.append("  peak reached (fraction of the pulse) by width ms/phase ms: " + ", ".join(
+        f"{p['widthMs']}/{p['phaseMs']}: board {p['board']:.2f} drive {p['drive']:.2f}" for p in d["pulses"]))
+    return lines
