@@ -11,6 +11,7 @@
 #include <string>
 
 #include "CommandRunner.hpp"
+#include "PluginShared.hpp"
 #include "DeviceSlots.hpp"
 #include "SlotDrive.hpp"
 #include "core/force/AudioDrive.hpp"

@@ -27,14 +27,14 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
     drive_path = drive.write_files(work, name="nrt-drive")
     force_path = work / "nrt-drive-force.wav"
     soundfile.write(str(force_path), force_script(), SR, subtype="FLOAT")
-    b_end_s = 0.2345  # writer B ends inside block 175 (11256 / 64 = 175.875)
+    b_dur_s = 0.0395  # writer B lasts 1896 samples from 4992: it ends at 6888, inside block 107
     data, log = nrt.score_and_render("nrtdrive", f"""
         var dev = FrictionDevice.sim(nil, 0);
         var root = RootNode(Server.default);
         var drive = SynthDef(\\nrtdrive, {{ |out| Out.ar(out, FrictionDrive.ar(0)) }});
         var a = SynthDef(\\nrtdriveA, {{ var f = PlayBuf.ar(1, 10); FrictionOut.ar(0, f); Out.ar(1, f) }});
         var b = SynthDef(\\nrtdriveB, {{
-            var f = DC.ar(0.6) * EnvGen.ar(Env([1, 1], [{b_end_s - 0.12}]), doneAction: 2);
+            var f = DC.ar(0.6) * EnvGen.ar(Env([1, 1], [{b_dur_s}]), doneAction: 2);
             FrictionOut.ar(0, f); Out.ar(2, f) }});
         score = Score([
             [0.0, dev.openMsg],
@@ -45,7 +45,7 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
             [0.0, Synth.basicNew(\\nrtdrive, nil, 1000).newMsg(root, [\\out, 0], \\addToHead)],
             [0.0, Synth.basicNew(\\nrtdriveA, nil, 1001).newMsg(root, nil, \\addToTail)],
             [0.0, Synth.basicNew(\\nrtdrive, nil, 1002).newMsg(root, [\\out, 3], \\addToTail)],
-            [0.12, Synth.basicNew(\\nrtdriveB, nil, 1003).newMsg(root, nil, \\addToHead)],
+            [0.105, Synth.basicNew(\\nrtdriveB, nil, 1003).newMsg(root, nil, \\addToHead)],
             [0.45, ['/n_free', 1001]],
             [0.5, ['/c_set', 0, 0]]]);
     """, sample_rate=SR, channels=4)
@@ -53,8 +53,8 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
     head, force_a, force_b, tail = (data[:, i] for i in range(4))
     # Channel 1 holds A's force as its synth read it (NaN included) until it was freed.
     a_freed = nrt.bundle_start_sample(0.45, SR, BLOCK)
-    b_start = nrt.bundle_start_sample(0.12, SR, BLOCK)
-    b_gone = (int(b_end_s * SR) // BLOCK + 1) * BLOCK  # freed after the block its envelope ended in
+    b_start = nrt.bundle_start_sample(0.105, SR, BLOCK)
+    b_gone = ((b_start + round(b_dur_s * SR)) // BLOCK + 1) * BLOCK  # freed after the block it ended in
     assert np.all(force_b[b_start:b_gone] == np.float32(0.6)) and np.all(force_b[b_gone:] == 0)
     combined = drive.combined_force([force_a, force_b])
     blocks = len(combined) // BLOCK + 1
@@ -68,12 +68,17 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
         print(f"KF-FIGURE nrt_drive_{name}_max_abs_error {error:.3g} at sample {worst}")
         assert error <= 3e-8, (name, worst, got[worst], expected[worst])
     # The hard cases seen in the output, not only through the reference:
-    full = -0.9 * 0.4  # the safe current (1.8 of 2 A) through 0.5 A/V of 10 V, inverted
+    # The safe current (1.8 of 2 A: drive 0.9) through 0.5 A/V of 10 V, inverted; the drive level
+    # is a float (ForceSafety::driveLevel), 0.9 rounded to float32 first.
+    full = np.float32(-float(np.float32(0.9)) * 2 / 0.5 / 10)
     assert np.all(head[:BLOCK] == 0) and np.all(head[BLOCK:2400 + BLOCK] == 0)  # the minimum: 0
-    step = np.diff(head[2400 + BLOCK:2400 + BLOCK + 40].astype(np.float64))
-    assert np.all(step < 0) and head[2400 + BLOCK + 40] == np.float32(full)  # slewed, then held safe
-    assert head.min() >= np.float32(full) and head.max() <= 0  # never past the safe range, one sign
-    assert b_start > 4800 + BLOCK + 200 and head[4800 + BLOCK + 200] == 0  # NaN alone: the minimum, 0
+    # The step to 1.4 N rises at 2000 N/s (0.0417 N a sample) until the safe drive 0.9, which the
+    # table gives at 0.72 + 0.8 * 0.68 = 1.264 N: (1.264 - 0.14) / 0.0417 = 26.98, the 27th sample.
+    ramp = head[2400 + BLOCK:2400 + BLOCK + 100].astype(np.float64)
+    at_full = int(np.argmax(ramp == full))
+    assert at_full == 26 and np.all(np.diff(ramp[:at_full + 1]) < 0) and np.all(ramp[at_full:] == full)
+    assert head.min() >= full and head.max() <= 0  # never past the safe range, one sign
+    assert b_start > 4800 + BLOCK + 100 and head[4800 + BLOCK + 100] == 0  # NaN alone: the minimum, 0
     assert head[7200 + BLOCK + 1000] == np.float32(-0.25 * 0.4)  # 0.41 N: the table's point 0.25
     assert head[9600 + BLOCK + 1000] == np.float32(-0.5 * 0.4)
     # Freed writer A: the block after its last one drives 0, at once.

@@ -167,7 +167,8 @@ TEST_CASE("inconsistent or broken kf-drive files are refused with the reason", "
     return text;
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"", "empty file"},
+      {"", "is empty"},
+      {replaced("kf-drive 1", "kf-calibration 1"), "expected the header \"kf-drive 1\""},
       {replaced("kf-drive 1", "kf-drive 2"), "version 2"},
       {replaced("outputSign -1", "outputSign 0.5"), "outputSign 0.5 is not 1 or -1"},
       {replaced("outputFullScaleV 10", "outputFullScaleV nan"), "expected \"outputFullScaleV <number>\""},
