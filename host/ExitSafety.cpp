@@ -5,9 +5,10 @@
 // SIGSTKFLT, and the crashes SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT (an exception escaping a
 // thread aborts), SIGSYS, SIGTRAP. SIGXFSZ (a write past the file size limit) is ignored
 // instead: the write fails with EFBIG, the recording that made it stops with its message, and
-// the server and the magnet go on. Each handler drives the force backend of every open device, and of every device
-// whose close has not finished, off, and every audio drive to 0 (haltAllDrives), with async-signal-safe work only (atomic slot loads,
-// stores, write(2) of an off record to a recording), then hands the signal on: to the handler
+// the server and the magnet go on. Each handler drives the force backend of every open device,
+// and of every device whose close has not finished, off, and every audio drive to 0
+// (haltAllDrives), with async-signal-safe work only (atomic slot loads, stores, write(2) of an
+// off record to a recording), then hands the signal on: to the handler
 // installed before ours if there was one, else the original disposition is restored and the
 // signal raised again, so the exit status is the signal's. A signal ignored when the plugin
 // loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be caught: the device thread dies with

@@ -78,8 +78,8 @@ class SlotForce {
   bool open_ = false;  // a block has arrivals that are not framed yet
   BlockClock block_;
   int64_t framedBlock_ = -1;
-  double excessN_[kMaxBlockSamples] = {};  // sum over writers of max(0, force - minimum); double,
-                                           // so that one writer's force comes back exactly
+  double excessN_[kMaxBlockSamples] = {};     // sum over writers of max(0, force - minimum); double,
+                                              // so that one writer's force comes back exactly
   float combined_[2][kMaxBlockSamples] = {};  // by block parity: this block's and the previous
   int64_t combinedBlock_[2] = {-1, -1};
   int combinedSamples_[2] = {};

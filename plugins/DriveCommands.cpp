@@ -11,8 +11,8 @@
 #include <string>
 
 #include "CommandRunner.hpp"
-#include "PluginShared.hpp"
 #include "DeviceSlots.hpp"
+#include "PluginShared.hpp"
 #include "SlotDrive.hpp"
 #include "core/force/AudioDrive.hpp"
 

@@ -25,8 +25,7 @@ class FrictionDrive : public SCUnit {
     const int index = kf::sc::slotIndexOf(in0(kDevice));
     const kf::sc::BlockClock clock = kf::sc::blockClockOf(mWorld);
     uint32_t generation = 0;
-    kf::Device* device =
-        kf::sc::deviceOfSlot(index, clock.startS + kf::sc::blockDurationS(mWorld), &generation);
+    kf::Device* device = kf::sc::deviceOfSlot(index, clock.startS + kf::sc::blockDurationS(mWorld), &generation);
     kf::sc::SlotForce* force = kf::sc::forceOfSlot(index);
     kf::sc::SlotDrive* drive = kf::sc::driveOfSlot(index);
     float* output = out(0);

@@ -51,8 +51,7 @@ double DriveCircuit::sampleForDrive(double driveLevel) const {
   return outputSign * std::clamp(volts / outputFullScaleV, 0.0, 1.0);
 }
 
-bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string& magnetTablePath,
-                         std::string& error) {
+bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string& magnetTablePath, std::string& error) {
   std::istringstream lines(text);
   std::string line;
   int lineNumber = 0;
@@ -81,17 +80,19 @@ bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string
     }
     if (key == "magnetTable") {
       if (!magnetTablePath.empty()) return fail("magnetTable is given twice");
-      if (!(fields >> magnetTablePath) || (fields >> rest)) return fail("expected \"magnetTable <kf-calibration file>\"");
+      if (!(fields >> magnetTablePath) || (fields >> rest))
+        return fail("expected \"magnetTable <kf-calibration file>\"");
       continue;
     }
-    const Field* field = std::find_if(std::begin(kFields), std::end(kFields),
-                                      [&](const Field& f) { return key == f.key; });
+    const Field* field =
+        std::find_if(std::begin(kFields), std::end(kFields), [&](const Field& f) { return key == f.key; });
     if (field == std::end(kFields)) return fail("unknown field \"" + key + "\"");
     const int index = static_cast<int>(field - kFields);
     if (seen[index]) return fail(key + " is given twice");
     double value = 0.0;
     if (!(fields >> value) || (fields >> rest)) return fail("expected \"" + key + " <number>\"");
-    const bool inRange = std::isfinite(value) && value <= field->hi && (field->loOpen ? value > field->lo : value >= field->lo);
+    const bool inRange =
+        std::isfinite(value) && value <= field->hi && (field->loOpen ? value > field->lo : value >= field->lo);
     const bool isSign = field->member != &DriveCircuit::outputSign || value == 1.0 || value == -1.0;
     if (!inRange || !isSign) {
       char message[200];
