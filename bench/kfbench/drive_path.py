@@ -26,10 +26,12 @@ CIRCUIT = dict(drive.CIRCUIT, outputFullScaleV=4.0, outputSign=1.0, maxSafeCurre
 def request():
     """The requested force (N) and the pulses' (start sample, width in samples, width ms, phase ms)."""
     floor = profile.device()["minForceN"]
+    frame = round(profile.device()["forceFramePeriodS"] * SR)  # 48 samples: the frame grid
     force, pulses, t = [], [], 0
     for width_ms in WIDTHS_MS:
         for phase_ms in PHASES_MS:
-            start = t + round((GAP_MS + phase_ms) * SR / 1000)
+            # On the frame grid (frames start at whole ms of audio time), then the phase.
+            start = -(-(t + round(GAP_MS * SR / 1000)) // frame) * frame + round(phase_ms * SR / 1000)
             width = round(width_ms * SR / 1000)
             force += [floor] * (start - t) + [floor + HEIGHT_N] * width
             pulses.append((start, width, width_ms, phase_ms))
@@ -38,9 +40,9 @@ def request():
     return np.array(force, dtype=np.float32), pulses
 
 
-def _edge(x, floor, start):
-    """The first sample from `start` at half the pulse height or more."""
-    above = np.flatnonzero(x[start:] >= floor + HEIGHT_N / 2)
+def _edge(x, floor, start, fraction):
+    """The first sample from `start` at `fraction` of the pulse height or more."""
+    above = np.flatnonzero(x[start:] >= floor + HEIGHT_N * fraction)
     return start + int(above[0]) if len(above) else None
 
 
@@ -75,14 +77,16 @@ def run(bench):
     for name, x in paths.items():
         shows = [w for w in WIDTHS_MS if all(p[name] >= 0.9 for p in out["pulses"] if p["widthMs"] == w)]
         first = pulses[0][0]
+        # Onset: the first sample 1 % up (the latency itself); half: 50 % up (with the rise).
         out[name] = {"shortestFeatureMs": min(shows) if shows else None,
-                     "delayMs": (_edge(x, floor, first) - _edge(requested, floor, first)) * 1000 / SR}
+                     **{f"{key}DelayMs": (_edge(x, floor, first, f) - _edge(requested, floor, first, f)) * 1000 / SR
+                        for key, f in (("onset", 0.01), ("half", 0.5))}}
     dev = profile.device()
     declared = CIRCUIT["currentSourceLatencyS"] + CIRCUIT["coilTimeConstantS"]
     drive_audio_delay = BLOCK / SR + declared  # FrictionDevice.audioDelay with the drive loaded
     out["drive"]["declaredMs"] = declared * 1000
     out["drive"]["audioDelayMs"] = drive_audio_delay * 1000
-    out["drive"]["soundForceOffsetMs"] = out["drive"]["delayMs"] + declared * 1000 - drive_audio_delay * 1000
+    out["drive"]["soundForceOffsetMs"] = out["drive"]["onsetDelayMs"] + declared * 1000 - drive_audio_delay * 1000
     out["board"]["audioDelayMs"] = (dev["tactileLatencyS"] - dev["audioLatencyS"]) * 1000
     out["board"]["declaredTactileLatencyMs"] = dev["tactileLatencyS"] * 1000
     return out
@@ -92,12 +96,13 @@ def summary_lines(d):
     lines = [f"drive vs board (NRT, {d['sampleRateHz'] // 1000} kHz, block {d['blockSize']}, pulses of "
              f"{d['heightN']} N at frame phases 0 and 0.5 ms):"]
     b, a = d["board"], d["drive"]
-    lines.append(f"  board 1 ms frames: shortest feature {b['shortestFeatureMs']} ms, commanded force "
-                 f"{b['delayMs']:.3f} ms behind the request (plus the device's realtime frame latency; the paper "
-                 f"declares {b['declaredTactileLatencyMs']:.1f} ms tactile), sound delayed {b['audioDelayMs']:.2f} ms")
-    lines.append(f"  audio drive: shortest feature {a['shortestFeatureMs']} ms, drive {a['delayMs']:.3f} ms behind "
-                 f"the request + {a['declaredMs']:.2f} ms declared circuit; sound delayed {a['audioDelayMs']:.3f} ms: "
-                 f"offset sound-force {a['soundForceOffsetMs']:+.3f} ms")
+    lines.append(f"  board 1 ms frames: shortest feature {b['shortestFeatureMs']} ms; commanded force onset "
+                 f"{b['onsetDelayMs']:.3f} ms (half height {b['halfDelayMs']:.3f} ms) behind the request, plus the "
+                 f"device's realtime frame latency (the paper declares {b['declaredTactileLatencyMs']:.1f} ms tactile); "
+                 f"sound delayed {b['audioDelayMs']:.2f} ms")
+    lines.append(f"  audio drive: shortest feature {a['shortestFeatureMs']} ms; drive onset {a['onsetDelayMs']:.3f} ms "
+                 f"(half height {a['halfDelayMs']:.3f} ms) behind the request, + {a['declaredMs']:.2f} ms declared "
+                 f"circuit; sound delayed {a['audioDelayMs']:.3f} ms: offset sound-force {a['soundForceOffsetMs']:+.3f} ms")
     lines.append("  peak reached (fraction of the pulse) by width ms/phase ms: " + ", ".join(
         f"{p['widthMs']}/{p['phaseMs']}: board {p['board']:.2f} drive {p['drive']:.2f}" for p in d["pulses"]))
     return lines
