@@ -1,0 +1,116 @@
+// SlotDrive: a slot's audio drive drives the previous block's combined force, the same whichever
+// side of the writers it runs, computes each block once, and is 0 at once when no writer framed
+// the previous block, for another device's chain, or without a chain.
+#include <catch2/catch.hpp>
+#include <memory>
+#include <vector>
+
+#include "SlotDrive.hpp"
+
+using kf::sc::BlockClock;
+using kf::sc::SlotDrive;
+using kf::sc::SlotForce;
+
+namespace {
+
+constexpr int kBlock = 64;
+
+BlockClock clockOf(int64_t block) { return BlockClock{block, block * kBlock / 48000.0, 1.0 / 48000.0, kBlock}; }
+
+struct NoDevice {
+  float operator()(double, float forceN, double) const { return forceN; }
+};
+
+kf::DriveCircuit circuit() {
+  kf::DriveCircuit c;
+  c.fullScaleCurrentA = 2.0;
+  c.transconductanceAPerV = 0.5;
+  c.outputFullScaleV = 4.0;  // drive level = sample value
+  c.maxSafeCurrentA = 2.0;
+  c.magnet = kf::CalibrationTable::linear(0.14, 1.4);
+  return c;
+}
+
+// A slot with one writer, its drive published for generation 7.
+struct Slot {
+  std::unique_ptr<SlotForce> force = std::make_unique<SlotForce>();
+  std::unique_ptr<SlotDrive> drive = std::make_unique<SlotDrive>();
+  NoDevice sink;
+  Slot() {
+    force->reset(kf::DeviceSpec{});
+    force->registerWriter();
+    REQUIRE(drive->publish(new kf::AudioDrive(kf::DeviceSpec{}, circuit(), 48000.0), 7) == nullptr);
+  }
+  ~Slot() { delete drive->publish(nullptr, 0); }
+  void write(int64_t block, float forceN) {
+    std::vector<float> f(kBlock, forceN);
+    force->write(clockOf(block), f.data(), kBlock, sink);
+  }
+  std::vector<float> samples(int64_t block, uint32_t generation = 7) {
+    const float* s = drive->samples(clockOf(block), generation, *force);
+    return s == nullptr ? std::vector<float>{} : std::vector<float>(s, s + kBlock);
+  }
+};
+
+// What AudioDrive gives for `blocks` of constant forces from the magnet off.
+std::vector<float> expected(const std::vector<float>& forces) {
+  kf::AudioDrive drive(kf::DeviceSpec{}, circuit(), 48000.0);
+  std::vector<float> out;
+  for (float f : forces) {
+    std::vector<float> in(kBlock, f), block(kBlock);
+    drive.process(in.data(), kBlock, block.data());
+    out.insert(out.end(), block.begin(), block.end());
+  }
+  return out;
+}
+
+std::vector<float> slice(const std::vector<float>& v, int block) {
+  return std::vector<float>(v.begin() + block * kBlock, v.begin() + (block + 1) * kBlock);
+}
+
+}  // namespace
+
+TEST_CASE("the drive is the previous block's force, whichever side of the writer it runs", "[slot-drive]") {
+  Slot slot;
+  slot.write(0, 1.0f);
+  const std::vector<float> after = slot.samples(1);  // before the writer of block 1
+  slot.write(1, 0.5f);
+  CHECK(slot.samples(1) == after);  // computed once per block: the same after the writer
+  const std::vector<float> want = expected({1.0f, 0.5f});
+  CHECK(after == slice(want, 0));
+  slot.write(2, 0.5f);
+  CHECK(slot.samples(2) == slice(want, 1));  // after the writer of block 2: still block 1's force
+  CHECK(after.back() > 0.0f);
+}
+
+TEST_CASE("no writer framed the previous block: 0 at once, then up from the magnet off", "[slot-drive]") {
+  Slot slot;
+  CHECK(slot.samples(0) == std::vector<float>(kBlock, 0.0f));  // nothing framed before block 0
+  slot.write(0, 1.4f);
+  slot.write(1, 1.4f);
+  CHECK(slot.samples(1).back() > 0.0f);
+  slot.write(2, 1.4f);
+  CHECK(slot.samples(2).back() > 0.0f);
+  CHECK(slot.samples(4) == std::vector<float>(kBlock, 0.0f));  // block 3 framed by nobody
+  slot.write(4, 1.4f);
+  CHECK(slot.samples(5) == slice(expected({1.4f}), 0));  // slewed up again from 0
+}
+
+TEST_CASE("a gap in the blocks starts the slew again from the magnet off", "[slot-drive]") {
+  Slot slot;
+  slot.write(0, 1.4f);
+  slot.write(1, 1.4f);
+  CHECK(slot.samples(1) == slice(expected({1.4f}), 0));
+  slot.write(2, 1.4f);
+  slot.write(3, 1.4f);
+  CHECK(slot.samples(3) == slice(expected({1.4f}), 0));  // block 2 was not driven
+}
+
+TEST_CASE("another device's chain, or none, drives nothing", "[slot-drive]") {
+  Slot slot;
+  slot.write(0, 1.0f);
+  CHECK(slot.samples(1, 8).empty());
+  delete slot.drive->publish(nullptr, 7);
+  CHECK(slot.samples(1).empty());
+  CHECK_FALSE(slot.drive->hasDrive());
+}
