@@ -31,6 +31,15 @@ namespace {
 using namespace kf::rules;
 using Ms = std::chrono::milliseconds;
 
+// A kf-drive file and its magnet table (docs/drive-format.md) in `folder`; the drive file's path.
+std::string writeDriveFiles(const std::string& folder) {
+  std::ofstream(folder + "/drive-magnet.txt") << "kf-calibration 1\n0 0.14\n1 1.4\n";
+  std::ofstream(folder + "/drive.txt") << "kf-drive 1\nmagnetTable drive-magnet.txt\nfullScaleCurrentA 2\n"
+                                          "transconductanceAPerV 0.5\noutputFullScaleV 10\noutputSign -1\n"
+                                          "maxSafeCurrentA 2\ncurrentSourceLatencyS 0\ncoilTimeConstantS 0\n";
+  return folder + "/drive.txt";
+}
+
 struct Options {
   std::string plugin, replay, scratch;
   std::vector<std::string> expectedViolations;  // "function:UGen or command"
@@ -110,7 +119,7 @@ void Scenario::expectAnswer(const OscMessage& message) {
 }
 
 void Scenario::run() {
-  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "LoudnessToFriction", "FrictionOut"})
+  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "LoudnessToFriction", "FrictionOut", "FrictionDrive"})
     check(server_.unitDef(name).ctor != nullptr, std::string("the plugin defines ") + name);
   const std::string recording = options_.scratch + "/recording.txt";
   server_.start();
@@ -121,6 +130,7 @@ void Scenario::run() {
   Synth* readers = server_.play(readersSynth(server_));
   Synth* loudness = server_.play(loudnessSynth(server_));
   Synth* writers = server_.play(writersSynth(server_));
+  Synth* drives = server_.play(drivesSynth(server_, chain_));
   runFor(200);
 
   phase("2 simulated device opened on slot 0 while the UGens run");
@@ -152,6 +162,13 @@ void Scenario::run() {
   expectDone(OscMessage("kfBoardStatus").i(0));
   runFor(200);
   expectDone(OscMessage("kfBoardClose").i(0));
+
+  phase("6b the audio drive loaded on slot 0, a bad file refused, removed");
+  expectDone(OscMessage("kfDriveCalibrate").i(0).s(writeDriveFiles(options_.scratch)));
+  runFor(200);
+  expectFailure(OscMessage("kfDriveCalibrate").i(0).s(options_.scratch + "/no-such-drive.txt"));
+  expectFailure(OscMessage("kfDriveCalibrate").i(3).s(""));  // no device there: fails in stage 2 (NRT)
+  runFor(50);
 
   phase("7 slot 0 handed over to a new device while the UGens run");
   expectDone(openSim(true));
@@ -190,6 +207,7 @@ void Scenario::run() {
   server_.free(readers);
   server_.free(loudness);
   server_.free(slot1);
+  server_.free(drives);
   server_.serveUntil([&] { return server_.numSynths() == 0; }, Ms(5000));
   runFor(50);
   server_.stop();
@@ -198,6 +216,7 @@ void Scenario::run() {
   phase_ = "end";
   check(server_.numSynths() == 0, "every synth freed");
   check(chain_.largestForceN.load() > 0.f, "FrictionOut commanded a force");
+  check(chain_.largestDrive.load() > 0.f, "FrictionDrive drove the slot's force");
   bool noDeviceWarned = false;
   for (const std::string& post : server_.posts())
     noDeviceWarned = noDeviceWarned || post.find("FrictionMouseIn: no device is open at index 0") != std::string::npos;

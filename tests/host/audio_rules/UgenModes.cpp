@@ -161,6 +161,21 @@ std::unique_ptr<Synth> writersSynth(FakeServer& server) {
   return synth;
 }
 
+// FrictionDrive: slot 0 (its output watched), slot 1 and bad device inputs.
+std::unique_ptr<Synth> drivesSynth(FakeServer& server, ChainWatch& watch) {
+  auto synth = server.newSynth("drives");
+  const auto& drive = server.unitDef("FrictionDrive");
+  Unit* slot0 = synth->add(drive, ar, {c(0)}, 1, "device 0");
+  synth->add(drive, ar, {c(0)}, 1, "device 0, a second one");
+  synth->add(drive, ar, {alternating(0, 1)}, 1, "device moving between 0 and 1");
+  synth->add(drive, ar, {c(kNaN)}, 1, "device NaN");
+  const float* out = synth->out(slot0, 0)->mBuffer;
+  synth->watch([&watch, out] {
+    watch.largestDrive.store(std::max(watch.largestDrive.load(), std::fabs(out[FakeServer::kBlockSamples - 1])));
+  });
+  return synth;
+}
+
 // The replay device's slot: a reader and a writer.
 std::unique_ptr<Synth> slot1Synth(FakeServer& server) {
   auto synth = server.newSynth("slot 1");

@@ -15,6 +15,7 @@ namespace kf::rules {
 struct ChainWatch {
   std::atomic<float> largestXMm{0.f};     // FrictionMouseIn's x
   std::atomic<float> largestForceN{0.f};  // FrictionOut's output
+  std::atomic<float> largestDrive{0.f};   // |FrictionDrive's output| (drivesSynth)
 };
 
 // FrictionMouseIn -> SpatialBufRd -> LoudnessToFriction -> FrictionOut on slot 0.
@@ -27,6 +28,8 @@ std::unique_ptr<Synth> readersSynth(FakeServer& server);
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server);
 // FrictionOut: more writers of slot 0, force at both rates, bad forces and devices.
 std::unique_ptr<Synth> writersSynth(FakeServer& server);
+// FrictionDrive of slot 0 (watched), of slot 1 and of bad device inputs.
+std::unique_ptr<Synth> drivesSynth(FakeServer& server, ChainWatch& watch);
 // A reader and a writer of slot 1.
 std::unique_ptr<Synth> slot1Synth(FakeServer& server);
 // Units whose constructors run while slot 0 has a device.
