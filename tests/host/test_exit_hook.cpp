@@ -18,6 +18,7 @@
 
 #include "DeviceSlots.hpp"
 #include "ExitSafety.hpp"
+#include "SlotDrive.hpp"
 #include "recordings/ReplayBackend.hpp"
 
 namespace {
@@ -140,4 +141,35 @@ TEST_CASE("a file size limit does not end the process: SIGXFSZ is ignored, the w
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 42);
   CHECK(offs.empty());
+}
+
+TEST_CASE("a signal zeroes every audio drive, also when the host's handler keeps the process alive", "[safety]") {
+  const auto [written, status] = offsWrittenBy([](int fd) {
+    // The host handles SIGUSR1 and lives on: our handler runs first, then hands it on.
+    signal(SIGUSR1, [](int) {});
+    installExitSafety();
+    kf::sc::SlotForce force;
+    force.reset(kf::DeviceSpec{});
+    force.registerWriter();
+    kf::DriveCircuit circuit;
+    circuit.fullScaleCurrentA = circuit.maxSafeCurrentA = 2.0;
+    circuit.transconductanceAPerV = 0.5;
+    circuit.outputFullScaleV = 10.0;
+    circuit.magnet = kf::CalibrationTable::linear(0.14, 1.4);
+    kf::sc::SlotDrive* drive = kf::sc::driveOfSlot(2);
+    drive->publish(new kf::AudioDrive(kf::DeviceSpec{}, circuit, 48000.0), 1);
+    auto sink = [](double, float forceN, double) { return forceN; };
+    const float forceN[1] = {1.0f};
+    auto clock = [](int64_t block) { return kf::sc::BlockClock{block, block * 64 / 48000.0, 1.0 / 48000.0, 64}; };
+    force.write(clock(0), forceN, 1, sink);
+    force.write(clock(1), forceN, 1, sink);
+    const float* before = drive->samples(clock(1), 1, force);
+    (void)!write(fd, before != nullptr && before[63] > 0.0f ? "d" : "-", 1);  // driving before
+    raise(SIGUSR1);
+    force.write(clock(2), forceN, 1, sink);
+    (void)!write(fd, drive->samples(clock(2), 1, force) == nullptr ? "0" : "-", 1);  // nothing after
+    std::_Exit(0);
+  });
+  CHECK(WIFEXITED(status));
+  CHECK(written == "d0");
 }
