@@ -40,14 +40,14 @@ def test_the_looped_drive_is_the_commanded_force_and_zero_after_free_cmd_period_
         "jack_connect SuperCollider:out_1 SuperCollider:in_1".systemCmd;
         start.value;
         s.sync;
-        rec = ("jack_rec -f " ++ {sclang.sc_string(wav)} ++ " -d 2.4 -b 32 "
+        rec = ("jack_rec -f " ++ {sclang.sc_string(wav)} ++ " -d 2.0 -b 32 "
             "SuperCollider:out_1 SuperCollider:out_2 SuperCollider:out_3").unixCmd;
         0.2.wait;
-        ~w = {WRITER}.play; 0.3.wait; ~w.free; 0.2.wait;
-        ~w = {WRITER}.play; 0.3.wait; CmdPeriod.run; 0.2.wait;
-        start.value; s.sync; ~w = {WRITER}.play; 0.3.wait;
+        ~w = {WRITER}.play; 0.2.wait; ~w.free; 0.15.wait;
+        ~w = {WRITER}.play; 0.2.wait; CmdPeriod.run; 0.15.wait;
+        start.value; s.sync; ~w = {WRITER}.play; 0.2.wait;
         s.quit;
-        1.2.wait;
+        1.0.wait;
         "KF-DONE".postln;
     """, jack, name="driveloop", server_options={"numOutputBusChannels": 3}))
     assert "KF-DONE" in run.output and "FrictionDrive:" not in run.output, run.output[-3000:]
