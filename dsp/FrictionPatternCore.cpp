@@ -1,0 +1,69 @@
+#include "FrictionPatternCore.hpp"
+
+namespace kf::patterns {
+
+ForceRange usableForceRange(double minN, double maxN) {
+  ForceRange r;
+  if (std::isfinite(minN)) r.minN = std::max(0.0, minN);
+  if (std::isfinite(maxN)) r.maxN = std::max(0.0, maxN);
+  return r;
+}
+
+FrictionPatternCore::FrictionPatternCore(PatternKind kind, double sampleRateHz, double framePeriodS)
+    : kind_(kind), sampleRateHz_(sampleRateHz) {
+  travel_.setSampleRate(sampleRateHz, framePeriodS);
+}
+
+void FrictionPatternCore::setParameters(double p1, double p2, double p3, float anchorMm) {
+  switch (kind_) {
+    case PatternKind::Grating:
+      return grating_.set(p1, p2, p3, anchorMm);
+    case PatternKind::Bumps:
+      return bumps_.set(p1, p2, p3 > 0.5, anchorMm);
+    case PatternKind::Detents:
+      return detents_.set(p1, p2, anchorMm);
+    case PatternKind::Texture:
+      return texture_.set(p1, p2, p3, sampleRateHz_);
+    case PatternKind::Viscous:
+      return viscous_.set(p1);
+    case PatternKind::StickSlip:
+      return stickSlip_.set(p1, p2);
+    case PatternKind::Slope:
+      return slope_.setFullSlope(p2);
+  }
+}
+
+double FrictionPatternCore::level(const Travel& travel) {
+  switch (kind_) {
+    case PatternKind::Grating:
+      return grating_.level(travel, antialias_);
+    case PatternKind::Bumps:
+      return bumps_.level(travel, antialias_);
+    case PatternKind::Detents:
+      return detents_.level(travel, antialias_);
+    case PatternKind::Texture:
+      return texture_.level(travel, antialias_);
+    case PatternKind::Viscous:
+      return viscous_.level(travel);
+    case PatternKind::StickSlip:
+      return stickSlip_.level(travel);
+    case PatternKind::Slope:
+      return slope_.level(travel, travel_.valueFrameAgo(), travel_.valueNow());
+  }
+  return 0.0;
+}
+
+void FrictionPatternCore::process(const float* positionMm, int positionStride, const float* height, int heightStride,
+                                  float* forceN, int numSamples) {
+  const bool withHeight = kind_ == PatternKind::Slope && height != nullptr;
+  const double span = range_.maxN - range_.minN;
+  for (int i = 0; i < numSamples; ++i) {
+    // Both inputs read before the output is written: forceN may alias either.
+    const float x = positionMm[i * positionStride];
+    const double h = withHeight ? static_cast<double>(height[i * heightStride]) : 0.0;
+    lastLevel_ = level(travel_.push(x, h));
+    forceN[i] = static_cast<float>(range_.minN + span * lastLevel_);
+  }
+}
+
+}  // namespace kf::patterns

@@ -1,0 +1,40 @@
+#include "GratingPattern.hpp"
+
+namespace kf::patterns {
+
+void GratingPattern::set(double periodMm, double duty, double edgeMm, double anchorMm) {
+  coordinate_.setPeriod(periodMm, anchorMm);
+  if (std::isfinite(duty)) duty_ = std::clamp(duty, 0.0, 1.0);
+  if (std::isfinite(edgeMm)) edgeMm_ = edgeMm;
+  edge_ = std::clamp(edgeMm_ / coordinate_.periodMm(), 0.0, std::min(duty_, 1.0 - duty_));
+}
+
+double GratingPattern::at(double f) const {
+  const double d = duty_, e = edge_;
+  if (f < e) return f / e;
+  if (f < d) return 1.0;
+  if (f < d + e) return 1.0 - (f - d) / e;
+  return 0.0;
+}
+
+double GratingPattern::integralTo(double f) const {
+  const double d = duty_, e = edge_;
+  if (f < e) return f * f / (2.0 * e);
+  if (f < d) return f - 0.5 * e;
+  if (f < d + e) {
+    const double g = f - d;
+    return d - 0.5 * e + g - g * g / (2.0 * e);
+  }
+  return d;
+}
+
+double GratingPattern::level(const Travel& travel, bool antialias) const {
+  const double u1 = coordinate_.cycles(travel.toMm);
+  if (!antialias) return at(fractionOf(u1));
+  const double boxed = periodicMean(
+      coordinate_.cycles(travel.fromMm), u1, duty_, [this](double f) { return integralTo(f); },
+      [this](double f) { return at(f); });
+  return clampLevel(bandLimited(boxed, duty_, travel, coordinate_.periodMm()));
+}
+
+}  // namespace kf::patterns

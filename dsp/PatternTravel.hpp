@@ -1,0 +1,105 @@
+// What every spatial friction pattern is given: the puck's travel over the last force frame
+// (1 ms), its direction and speed, and the tools the patterns share to band-limit themselves to
+// what 1 ms force frames can show (ARCHITECTURE.md, "Friction patterns").
+//
+// A pattern is a level g in [0, 1] (force = minForce + (maxForce - minForce) * g). A pattern of
+// position g(x) is rendered as its mean over the travel of the last frame, [x(t - T), x(t)]
+// (a box filter in space whose length follows the speed), computed in closed form from g's
+// integral; with anti-aliasing on, each periodic part is then faded out as its temporal
+// frequency speed / period rises from a quarter of the frame rate to half of it (the frames'
+// Nyquist frequency), above which only its mean is left. With anti-aliasing off, a pattern is
+// g at the current position (sampled per audio sample: what aliases in the frames).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace kf::patterns {
+
+// The puck's travel over the last frame: from fromMm (T ago) to toMm (now).
+struct Travel {
+  double fromMm = 0.0;
+  double toMm = 0.0;
+  int direction = 1;           // sign of toMm - fromMm; the last direction while it is 0
+  double speedMmPerS = 0.0;    // |toMm - fromMm| / framePeriodS
+  double framePeriodS = 1e-3;  // T: the frame in samples over the sample rate
+};
+
+// The last frame of positions (and of one value beside them, a height), kept in a fixed ring: no
+// allocation. T is round(sampleRate * framePeriodS) samples, 1..kMaxFrameSamples, so that the
+// travel is exact to the sample at every rate (44.1 kHz: 44 samples, T = 0.9977 ms).
+class FrameTravel {
+ public:
+  static constexpr int kMaxFrameSamples = 256;  // 1 ms up to 256 kHz
+
+  void setSampleRate(double sampleRateHz, double framePeriodS);
+  // Takes the next position (a non-finite one holds the last finite position, 0 before the
+  // first) and value; returns the travel over the frame that ends with it.
+  Travel push(float positionMm, double value = 0.0);
+  // The value pushed with the position at the start of the travel last returned.
+  double valueFrameAgo() const { return valueFrom_; }
+  double valueNow() const { return valueTo_; }
+  double framePeriodS() const { return frameSamples_ / sampleRateHz_; }
+
+ private:
+  double positions_[kMaxFrameSamples] = {};
+  double values_[kMaxFrameSamples] = {};
+  int frameSamples_ = 48;
+  double sampleRateHz_ = 48000.0;
+  int next_ = 0;
+  bool started_ = false;
+  double lastPositionMm_ = 0.0;
+  int direction_ = 1;
+  double valueFrom_ = 0.0;
+  double valueTo_ = 0.0;
+};
+
+// 1 up to a quarter of the frame rate, 0 from half of it on (the frames' Nyquist frequency), a
+// raised cosine between: how much of a periodic part of temporal frequency frequencyHz is kept.
+double bandLimitGain(double frequencyHz, double framePeriodS);
+
+// x - floor(x) in [0, 1).
+inline double fractionOf(double x) {
+  const double f = x - std::floor(x);
+  return f < 1.0 ? f : 0.0;
+}
+
+// A coordinate in cycles of a period (mm): u = x / period + phase. Changing the period keeps u
+// where the puck is (phase continuity, a zoom about the puck, as SpatialBufRd's keep); before any
+// change u = x / period, so the pattern starts its cycles at x = 0.
+class PeriodicCoordinate {
+ public:
+  // A period that is not finite and > 0 is ignored (the caller keeps the last good one).
+  void setPeriod(double periodMm, double anchorMm);
+  double cycles(double xMm) const { return xMm / periodMm_ + phase_; }
+  double periodMm() const { return periodMm_; }
+
+ private:
+  double periodMm_ = 1.0;
+  double phase_ = 0.0;
+  bool set_ = false;
+};
+
+// The mean over [u0, u1] (cycles, in either order) of a periodic function of period 1, from its
+// integral over one period and its partial integral partial(f) = integral of g over [0, f],
+// f in [0, 1); point(f) when the interval is shorter than tinyCycles (the limit of the mean).
+template <class Partial, class Point>
+double periodicMean(double u0, double u1, double perPeriod, Partial partial, Point point) {
+  if (u1 < u0) std::swap(u0, u1);
+  const double length = u1 - u0;
+  constexpr double kTinyCycles = 1e-9;
+  if (!(length >= kTinyCycles)) return point(fractionOf(u1));
+  const double whole0 = std::floor(u0), whole1 = std::floor(u1);
+  const double f0 = std::min(u0 - whole0, 1.0), f1 = std::min(u1 - whole1, 1.0);
+  return ((whole1 - whole0) * perPeriod + partial(f1) - partial(f0)) / length;
+}
+
+// A box-filtered level with its periodic part faded by bandLimitGain(speed / period):
+// mean + gain * (boxed - mean).
+inline double bandLimited(double boxed, double mean, const Travel& travel, double periodMm) {
+  return mean + bandLimitGain(travel.speedMmPerS / periodMm, travel.framePeriodS) * (boxed - mean);
+}
+
+inline double clampLevel(double g) { return g > 0.0 ? (g < 1.0 ? g : 1.0) : 0.0; }
+
+}  // namespace kf::patterns
