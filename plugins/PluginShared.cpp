@@ -55,6 +55,7 @@ PluginLoad(KineticFriction) {
   ft = inTable;
   registerSpatialBufRd();
   registerLoudnessToFriction();
+  registerFrictionPattern();
   registerFrictionMouseIn();
   registerFrictionOut();
   registerFrictionDrive();

@@ -76,6 +76,7 @@ class SlotFollower {
 // Registration hooks, one per UGen file, called from PluginLoad.
 void registerSpatialBufRd();
 void registerLoudnessToFriction();
+void registerFrictionPattern();
 void registerFrictionMouseIn();
 void registerFrictionOut();
 void registerFrictionDrive();

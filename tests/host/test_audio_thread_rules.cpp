@@ -119,7 +119,8 @@ void Scenario::expectAnswer(const OscMessage& message) {
 }
 
 void Scenario::run() {
-  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "LoudnessToFriction", "FrictionOut", "FrictionDrive"})
+  for (const char* name :
+       {"FrictionMouseIn", "SpatialBufRd", "LoudnessToFriction", "FrictionOut", "FrictionDrive", "FrictionPattern"})
     check(server_.unitDef(name).ctor != nullptr, std::string("the plugin defines ") + name);
   const std::string recording = options_.scratch + "/recording.txt";
   server_.start();
@@ -131,6 +132,7 @@ void Scenario::run() {
   Synth* loudness = server_.play(loudnessSynth(server_));
   Synth* writers = server_.play(writersSynth(server_));
   Synth* drives = server_.play(drivesSynth(server_, chain_));
+  Synth* patterns = server_.play(patternsSynth(server_));
   runFor(200);
 
   phase("2 simulated device opened on slot 0 while the UGens run");
@@ -206,6 +208,7 @@ void Scenario::run() {
   expectDone(OscMessage("kfClose").i(0));
   server_.free(readers);
   server_.free(loudness);
+  server_.free(patterns);
   server_.free(slot1);
   server_.free(drives);
   server_.serveUntil([&] { return server_.numSynths() == 0; }, Ms(5000));

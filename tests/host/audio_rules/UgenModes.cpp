@@ -144,6 +144,40 @@ std::unique_ptr<Synth> loudnessSynth(FakeServer& server) {
   return synth;
 }
 
+// Every kind of FrictionPattern fed by slot 0's puck, then by a sweep at both rates, with its
+// parameters moving every 20 blocks (phase-continuous changes, the texture's crossfade), bad
+// parameters and forces, an unknown kind, and its force into FrictionOut.
+std::unique_ptr<Synth> patternsSynth(FakeServer& server) {
+  auto synth = server.newSynth("patterns");
+  const auto& pattern = server.unitDef("FrictionPattern");
+  Unit* mouse = synth->add(server.unitDef("FrictionMouseIn"), ar, {c(0), c(0), c(1)}, 4, "device 0, linear");
+  const Input puck = Input::from(synth->out(mouse, 0));
+  const float kinds[][3] = {{1, 0.5f, 0.1f}, {4, 2, 0}, {3, 0.5f, 0}, {0.5f, 3, 7}, {100, 0, 0}, {5, 2, 0}};
+  for (int kind = 0; kind < 6; ++kind) {
+    const auto* p = kinds[kind];
+    const std::string k = "kind " + std::to_string(kind);
+    synth->add(pattern, ar, {c(kind), puck, c(0.14f), c(0.5f), c(1), c(p[0]), c(p[1]), c(p[2])}, 1,
+               k + ", at the puck");
+    synth->add(pattern, ar,
+               {c(kind), sweepAr(), c(0.14f), c(0.5f), alternating(0, 1), alternating(p[0], 2 * p[0] + 0.1f),
+                alternating(p[1], p[1] + 1), alternating(p[2], p[2] + 1)},
+               1, k + ", parameters moving");
+    synth->add(pattern, kr, {c(kind), sweepKr(), c(0.14f), c(0.5f), c(1), c(p[0]), c(p[1]), c(p[2])}, 1,
+               k + ", control rate");
+    synth->add(pattern, ar, {c(kind), sweepAr(), c(kNaN), c(-1), c(1), c(kNaN), c(kInf), c(-kInf)}, 1,
+               k + ", bad parameters and forces");
+  }
+  synth->add(pattern, ar, {c(6), sweepAr(), c(0.14f), c(0.5f), c(0), toneAr(), c(1), c(0)}, 1, "slope of a tone");
+  synth->add(pattern, ar, {c(6), sweepAr(), c(0.14f), c(0.5f), c(0), sweepKr(), c(kNaN), c(0)}, 1,
+             "slope, height kr, fullSlope NaN");
+  synth->add(pattern, ar, {c(kNaN), puck, c(0.14f), c(0.5f), c(1), c(1), c(0.5f), c(0.1f)}, 1, "kind NaN");
+  Unit* grating = synth->add(pattern, ar, {c(0), puck, c(0.14f), c(0.5f), c(1), c(0.2f), c(0.5f), c(0.02f)}, 1,
+                             "a grating under the puck");
+  synth->add(server.unitDef("FrictionOut"), ar, {c(0), Input::from(synth->out(grating, 0))}, 1,
+             "device 0, force from FrictionPattern");
+  return synth;
+}
+
 // More writers of slot 0 (with the chain's, four): force at audio and control rate, bad forces,
 // bad device inputs, and one moving between slots 0 and 1.
 std::unique_ptr<Synth> writersSynth(FakeServer& server) {

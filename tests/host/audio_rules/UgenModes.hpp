@@ -26,6 +26,8 @@ std::unique_ptr<Synth> mouseModesSynth(FakeServer& server);
 std::unique_ptr<Synth> readersSynth(FakeServer& server);
 // LoudnessToFriction: every window, maxWindow and mapping mode, both rates.
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server);
+// FrictionPattern: every kind, parameters moving and bad, position at both rates, fed by the puck.
+std::unique_ptr<Synth> patternsSynth(FakeServer& server);
 // FrictionOut: more writers of slot 0, force at both rates, bad forces and devices.
 std::unique_ptr<Synth> writersSynth(FakeServer& server);
 // FrictionDrive of slot 0 (watched), of slot 1 and of bad device inputs.

@@ -1,0 +1,175 @@
+"""The friction patterns of FrictionPattern (dsp/*Pattern*, SpeedFriction) defined again in numpy,
+from the positions a render read: the references the scene tests and the gallery compare with.
+
+Every pattern is a level in [0, 1] (force = min + (max - min) * level) of the travel over the last
+frame of n = round(rate * 1 ms) samples: from = x[i - n] (x[0] before the start), to = x[i]."""
+import numpy as np
+
+FRAME_S = 0.001
+TEXTURE_COMPONENTS = 16
+_MASK = (1 << 64) - 1
+
+
+def frame_samples(rate):
+    return int(max(1, min(256, round(rate * FRAME_S))))
+
+
+def travel(x, rate):
+    """(from, to, direction, speed mm/s, frame period s) per sample of positions x (mm)."""
+    x = np.asarray(x, dtype=np.float64)
+    n = frame_samples(rate)
+    start = np.concatenate([np.full(n, x[0]), x[:-n]]) if len(x) > n else np.full(len(x), x[0])
+    d = x - start
+    # The direction holds while the travel is 0 (+1 before the first move).
+    sign = np.sign(d)
+    idx = np.where(sign != 0, np.arange(len(d)), 0)
+    np.maximum.accumulate(idx, out=idx)
+    direction = np.where(sign[idx] != 0, sign[idx], 1.0)
+    period = n / rate
+    return start, x, direction, np.abs(d) / period, period
+
+
+def fade(frequency_hz, period_s):
+    """1 up to a quarter of the frame rate, 0 from half of it, a raised cosine between."""
+    stop = 0.5 / period_s
+    passed = 0.5 * stop
+    f = np.asarray(frequency_hz, dtype=np.float64)
+    g = 0.5 * (1 + np.cos(np.pi * (f - passed) / (stop - passed)))
+    return np.where(f <= passed, 1.0, np.where(f >= stop, 0.0, g))
+
+
+def _periodic_mean(u0, u1, per_period, partial, point):
+    lo, hi = np.minimum(u0, u1), np.maximum(u0, u1)
+    length = hi - lo
+    w0, w1 = np.floor(lo), np.floor(hi)
+    boxed = ((w1 - w0) * per_period + partial(hi - w1) - partial(lo - w0)) / np.where(length > 0, length, 1)
+    return np.where(length >= 1e-9, boxed, point(hi - np.floor(hi)))
+
+
+def grating(x, rate, period, duty, edge, antialias=True):
+    start, to, _, speed, t = travel(x, rate)
+    d = np.clip(duty, 0, 1)
+    e = np.clip(edge / period, 0, min(d, 1 - d))
+
+    def at(f):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(f < e, f / e, np.where(f < d, 1.0, np.where(f < d + e, 1 - (f - d) / e, 0.0)))
+
+    def partial(f):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = f - d
+            return np.where(f < e, f * f / (2 * e), np.where(f < d, f - e / 2, np.where(
+                f < d + e, d - e / 2 + g - g * g / (2 * e), d)))
+
+    u0, u1 = start / period, to / period
+    if not antialias:
+        return at(u1 - np.floor(u1))
+    boxed = _periodic_mean(u0, u1, d, partial, at)
+    return np.clip(d + fade(speed / period, t) * (boxed - d), 0, 1)
+
+
+def bumps(x, rate, period, width, valleys=False, antialias=True):
+    start, to, direction, speed, t = travel(x, rate)
+    omega = np.clip(width / period, 1e-6, 1)
+    sgn = -1.0 if valleys else 1.0
+
+    def bump(f):
+        return np.where(f < omega, 0.5 * (1 - np.cos(2 * np.pi * f / omega)), 0.0)
+
+    def at(f):
+        return np.where(f < omega, np.maximum(0, direction * sgn * np.sin(2 * np.pi * f / omega)), 0.0)
+
+    def climb(f):
+        first = (direction > 0) != valleys
+        half = omega / 2
+        up = np.where(f < half, bump(f), 1.0)
+        down = np.where(f < half, 0.0, np.where(f < omega, 1 - bump(f), 1.0))
+        return np.where(first, up, down)
+
+    u0, u1 = start / period, to / period
+    if not antialias:
+        return at(u1 - np.floor(u1))
+    scale = omega / np.pi
+    boxed = _periodic_mean(u0, u1, scale, lambda f: scale * climb(f), at)
+    return np.clip(scale + fade(speed / period, t) * (boxed - scale), 0, 1)
+
+
+def detents(x, rate, spacing, crest, antialias=True):
+    start, to, direction, speed, t = travel(x, rate)
+    c = np.clip(crest, 1e-6, 1)
+    u0, u1 = direction * start / spacing, direction * to / spacing
+
+    def along(g):
+        return np.where(g < c, g / c, 0.0)
+
+    if not antialias:
+        return along(u1 - np.floor(u1))
+    boxed = _periodic_mean(u0, u1, c / 2, lambda g: np.where(g < c, g * g / (2 * c), c / 2), along)
+    return np.clip(c / 2 + fade(speed / spacing, t) * (boxed - c / 2), 0, 1)
+
+
+def _splitmix(state):
+    state = (state + 0x9E3779B97F4A7C15) & _MASK
+    z = state
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return state, (z ^ (z >> 31)) & _MASK
+
+
+def texture_components(lo, hi, seed):
+    lo, hi = min(lo, hi), max(lo, hi)
+    state, freqs, phases = int(seed) & _MASK, [], []
+    for _ in range(TEXTURE_COMPONENTS):
+        state, a = _splitmix(state)
+        state, b = _splitmix(state)
+        freqs.append(lo + (hi - lo) * ((a >> 11) * 2.0 ** -53))
+        phases.append(2 * np.pi * ((b >> 11) * 2.0 ** -53))
+    return np.array(freqs), np.array(phases)
+
+
+def texture(x, rate, lo, hi, seed, antialias=True):
+    start, to, _, speed, t = travel(x, rate)
+    freqs, phases = texture_components(lo, hi, seed)
+    amplitude = 1 / (6 * np.sqrt(TEXTURE_COMPONENTS / 2))
+    total = np.zeros(len(to))
+    for f, phi in zip(freqs, phases):
+        w = 2 * np.pi * f
+        if not antialias:
+            total += np.sin(w * to + phi)
+            continue
+        half = 0.5 * w * (to - start)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sinc = np.where(np.abs(half) < 1e-8, 1.0, np.sin(half) / half)
+        total += fade(speed * f, t) * sinc * np.sin(w * 0.5 * (start + to) + phi)
+    return np.clip(0.5 + amplitude * total, 0, 1)
+
+
+def viscous(x, rate, full_speed):
+    return np.clip(travel(x, rate)[3] / full_speed, 0, 1)
+
+
+def stick_slip(x, rate, slip_speed, stick_speed):
+    speed = travel(x, rate)[3]
+    stick = min(stick_speed, slip_speed)
+    out, sliding = np.empty(len(speed)), False
+    for i, v in enumerate(speed):
+        if not sliding and v > slip_speed:
+            sliding = True
+        elif sliding and v < stick:
+            sliding = False
+        out[i] = 0.0 if sliding else 1.0
+    return out
+
+
+def slope(x, height, rate, full_slope):
+    start, to, _, _, _ = travel(x, rate)
+    h = np.asarray(height, dtype=np.float64)
+    n = frame_samples(rate)
+    h0 = np.concatenate([np.full(n, h[0]), h[:-n]])
+    moved = np.abs(to - start)
+    out, held = np.empty(len(h)), 0.0
+    for i in range(len(h)):
+        if moved[i] >= 1e-4:
+            held = min(max((h[i] - h0[i]) / moved[i] / full_slope, 0.0), 1.0)
+        out[i] = held
+    return out

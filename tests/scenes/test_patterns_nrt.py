@@ -1,0 +1,60 @@
+"""FrictionPattern rendered by scsynth -N on the simulated device (a FrictionHand moving the puck
+out fast and back slowly), every pattern against its definition recomputed in numpy from the
+position FrictionMouseIn gave it (kfharness.patterns)."""
+import numpy as np
+import pytest
+
+from kfharness import nrt, patterns
+
+LO, HI = 0.14, 0.5
+# name, FrictionPattern code on x (and h, a height signal), reference level from (x, h, rate)
+KINDS = [
+    ("grating", "FrictionPattern.grating(x, 0.8, 0.4, 0.1)", lambda x, h, r: patterns.grating(x, r, 0.8, 0.4, 0.1)),
+    ("grating raw", "FrictionPattern.grating(x, 0.8, 0.4, 0.1, antialias: 0)",
+     lambda x, h, r: patterns.grating(x, r, 0.8, 0.4, 0.1, antialias=False)),
+    ("bumps", "FrictionPattern.bumps(x, 4, 2)", lambda x, h, r: patterns.bumps(x, r, 4, 2)),
+    ("valleys", "FrictionPattern.bumps(x, 5, 3, 1)", lambda x, h, r: patterns.bumps(x, r, 5, 3, valleys=True)),
+    ("detents", "FrictionPattern.detents(x, 3, 0.6)", lambda x, h, r: patterns.detents(x, r, 3, 0.6)),
+    ("texture", "FrictionPattern.texture(x, 0.5, 3, 11)", lambda x, h, r: patterns.texture(x, r, 0.5, 3, 11)),
+    ("viscous", "FrictionPattern.viscous(x, 150)", lambda x, h, r: patterns.viscous(x, r, 150)),
+    ("stick-slip", "FrictionPattern.stickSlip(x, 30, 10)", lambda x, h, r: patterns.stick_slip(x, r, 30, 10)),
+    ("slope of a height", "FrictionPattern.slope(x, h, 0.5)", lambda x, h, r: patterns.slope(x, h, r, 0.5)),
+]
+
+
+def render(rate, seconds):
+    outs = ", ".join(code for _, code, _ in KINDS)
+    data, log = nrt.score_and_render(f"patterns{rate}", f"""
+        var dev = FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.25, 40], [0.35, 40], [{seconds}, 20]]));
+        var def = SynthDef(\\patterns, {{
+            var x = FrictionMouseIn.ar(0)[0], h = sin(x * 0.5);
+            Out.ar(0, [x, h, {outs}])
+        }});
+        score = Score([
+            [0.0, dev.openMsg],
+            [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\patterns, nil, 1000).newMsg],
+            [{seconds}, dev.closeMsg],
+            [{seconds} + 0.01, ['/c_set', 0, 0]]]);
+    """, sample_rate=rate, channels=2 + len(KINDS))
+    return data, log
+
+
+@pytest.mark.parametrize("rate", [44100, 192000])
+def test_every_pattern_on_the_simulated_device_is_its_definition(rate):
+    seconds = 1.2
+    data, log = render(rate, seconds)
+    n = int(seconds * rate) - 64  # the synth's last block, before it is freed
+    x, h = data[:n, 0], data[:n, 1]
+    speed = np.abs(np.diff(x)) * rate
+    assert x.max() > 30 and speed.max() > 150 and (np.diff(x) < 0).any(), "out fast and back"
+    for i, (name, _, reference) in enumerate(KINDS):
+        force = data[:n, 2 + i].astype(np.float64)
+        want = LO + (HI - LO) * reference(x, h, rate)
+        err = np.abs(force - want)
+        # float32 output of a double computation: 0.5 N * 2^-24 = 3e-8 N; positions are the same
+        # float32 values in both. A raw (unfiltered) pattern's level at a sharp corner may differ
+        # by its slope times a rounding of the position (0.1 mm edge: 1e-6 N), hence 1e-5.
+        assert err.max() < 1e-5, f"{name}: worst {err.max()} N at sample {err.argmax()} (x {x[err.argmax()]})"
+        assert force.max() - force.min() > 0.05, f"{name} moved the force"
+    assert "FrictionPattern" not in log, log
