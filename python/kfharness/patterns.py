@@ -10,6 +10,11 @@ TEXTURE_COMPONENTS = 16
 _MASK = (1 << 64) - 1
 
 
+def _f32(*values):
+    """Parameters as the UGen gets them: float inputs (0.2 is 0.20000000298...)."""
+    return [float(np.float32(v)) for v in values]
+
+
 def frame_samples(rate):
     return int(max(1, min(256, round(rate * FRAME_S))))
 
@@ -48,6 +53,7 @@ def _periodic_mean(u0, u1, per_period, partial, point):
 
 def grating(x, rate, period, duty, edge, antialias=True):
     start, to, _, speed, t = travel(x, rate)
+    period, duty, edge = _f32(period, duty, edge)
     d = np.clip(duty, 0, 1)
     e = np.clip(edge / period, 0, min(d, 1 - d))
 
@@ -70,6 +76,7 @@ def grating(x, rate, period, duty, edge, antialias=True):
 
 def bumps(x, rate, period, width, valleys=False, antialias=True):
     start, to, direction, speed, t = travel(x, rate)
+    period, width = _f32(period, width)
     omega = np.clip(width / period, 1e-6, 1)
     sgn = -1.0 if valleys else 1.0
 
@@ -96,6 +103,7 @@ def bumps(x, rate, period, width, valleys=False, antialias=True):
 
 def detents(x, rate, spacing, crest, antialias=True):
     start, to, direction, speed, t = travel(x, rate)
+    spacing, crest = _f32(spacing, crest)
     c = np.clip(crest, 1e-6, 1)
     u0, u1 = direction * start / spacing, direction * to / spacing
 
@@ -117,7 +125,7 @@ def _splitmix(state):
 
 
 def texture_components(lo, hi, seed):
-    lo, hi = min(lo, hi), max(lo, hi)
+    lo, hi = _f32(min(lo, hi), max(lo, hi))
     state, freqs, phases = int(seed) & _MASK, [], []
     for _ in range(TEXTURE_COMPONENTS):
         state, a = _splitmix(state)
@@ -145,11 +153,12 @@ def texture(x, rate, lo, hi, seed, antialias=True):
 
 
 def viscous(x, rate, full_speed):
-    return np.clip(travel(x, rate)[3] / full_speed, 0, 1)
+    return np.clip(travel(x, rate)[3] / _f32(full_speed)[0], 0, 1)
 
 
 def stick_slip(x, rate, slip_speed, stick_speed):
     speed = travel(x, rate)[3]
+    slip_speed, stick_speed = _f32(slip_speed, stick_speed)
     stick = min(stick_speed, slip_speed)
     out, sliding = np.empty(len(speed)), False
     for i, v in enumerate(speed):
@@ -163,6 +172,7 @@ def stick_slip(x, rate, slip_speed, stick_speed):
 
 def slope(x, height, rate, full_slope):
     start, to, _, _, _ = travel(x, rate)
+    full_slope = _f32(full_slope)[0]
     h = np.asarray(height, dtype=np.float64)
     n = frame_samples(rate)
     h0 = np.concatenate([np.full(n, h[0]), h[:-n]])

@@ -38,8 +38,12 @@ PATTERNS = [
     ("pilot-bumps-height-rule", f"FrictionPattern.slope(x, pilot, 2pi / {PILOT_CYCLE_MM})", None),
     ("pilot-loudness-rule", "LoudnessToFriction.ar(pilot)", None),
 ]
+# A firm hand (0.25 mm of lag at 0.5 N, damping ratio 0.71): the puck keeps near the target speed,
+# where the default hand (20 N/m) needs 25 mm of lag before 0.5 N lets the puck move at all.
+HAND = "(handStiffnessNPerM: 2000, handDampingNSPerM: 20)"
 # name, target speed (mm/s), seconds
 SPEEDS = [("slow", 5.0, 5.0), ("fast", 300.0, 1.0)]
+ZOOM_MM = 2.0
 CHANNELS_PER_PATTERN = 4  # position, speed, requested force, commanded force (FrictionOut)
 
 
@@ -48,7 +52,7 @@ def log(msg):
 
 
 def score_code(speed, seconds):
-    devices = "\n".join(f"        dev{i} = FrictionDevice.sim(nil, {i}, hand);" for i in range(len(PATTERNS)))
+    devices = "\n".join(f"        dev{i} = FrictionDevice.sim(nil, {i}, hand, {HAND});" for i in range(len(PATTERNS)))
     names = ", ".join(f"dev{i}" for i in range(len(PATTERNS)))
     outs = ",\n".join(f"""                {{ var m = FrictionMouseIn.ar({i}), x = m[0];
                    var pilot = SpatialBufRd.ar(1, 0, x, {PILOT_SPM});
@@ -74,7 +78,8 @@ def score_code(speed, seconds):
 
 def render(speed_name, speed, seconds, rate):
     data, _ = nrt.score_and_render(f"gallery-{speed_name}", score_code(speed, seconds), sample_rate=rate,
-                                   channels=CHANNELS_PER_PATTERN * len(PATTERNS), memory_kb=262144)
+                                   channels=CHANNELS_PER_PATTERN * len(PATTERNS), memory_kb=262144,
+                                   extra_args=("-w", "1024"))  # wires: 11 patterns in one SynthDef
     # Only while the synth ran: after it, the outputs are silence (no all-zero row in the CSVs).
     n = min(len(data), int(seconds * rate) - 64)
     return data[:n].astype(np.float64)
@@ -105,16 +110,22 @@ def write_pattern(out_dir, name, speed_name, cols, rate, reference):
         for i in range(0, len(x), step):
             ref = f"{reference[i]:.6f}" if reference is not None else ""
             w.writerow([f"{t[i]:.4f}", f"{x[i]:.5f}", f"{v[i]:.3f}", f"{requested[i]:.6f}", f"{commanded[i]:.6f}", ref])
-    fig, ax = plt.subplots(2, 1, figsize=(9, 5.5), gridspec_kw=dict(height_ratios=[3, 1]))
-    ax[0].plot(x, requested, lw=0.6, label="requested (FrictionPattern)")
-    ax[0].plot(x, commanded, lw=0.6, alpha=0.8, label="commanded (FrictionOut, 1 ms frames)")
+    fig, ax = plt.subplots(3, 1, figsize=(9, 7.5), gridspec_kw=dict(height_ratios=[3, 2, 1]))
+    # A 2 mm window from where the puck was at 60 % of the run: fine patterns made readable.
+    x0 = x[int(0.6 * len(x))]
+    zoom = (x >= x0) & (x <= x0 + ZOOM_MM)
+    for a, sel in ((ax[0], slice(None)), (ax[1], zoom)):
+        a.plot(x[sel], requested[sel], lw=0.6, label="requested (FrictionPattern)")
+        a.plot(x[sel], commanded[sel], lw=0.6, alpha=0.8, label="commanded (FrictionOut, 1 ms frames)")
+        a.set_ylabel("force (N)")
+        a.set_ylim(0, 0.6)
     ax[0].set_xlabel("position (mm)")
-    ax[0].set_ylabel("force (N)")
-    ax[0].set_ylim(0, 0.6)
+    ax[0].axvspan(x0, x0 + ZOOM_MM, color="0.9", zorder=0)
     ax[0].legend(loc="upper right", fontsize=8)
-    ax[1].plot(t, v, lw=0.6)
-    ax[1].set_xlabel("time (s)")
-    ax[1].set_ylabel("speed (mm/s)")
+    ax[1].set_xlabel(f"position (mm): the {ZOOM_MM:g} mm shaded above")
+    ax[2].plot(t, v, lw=0.6)
+    ax[2].set_xlabel("time (s)")
+    ax[2].set_ylabel("speed (mm/s)")
     fig.suptitle(f"{name}, hand at {speed_name} speed")
     fig.tight_layout()
     fig.savefig(out_dir / f"{name}-{speed_name}.png", dpi=100)
@@ -172,7 +183,8 @@ def main():
 def write_summary(out_dir, rows, figures, rate, elapsed):
     L = ["# KineticFriction pattern gallery: rendered on the simulated device\n",
          f"Rendered with scsynth -N at **{rate} Hz**: each pattern on its own `FrictionDevice.sim` slot "
-         "(paper profile: 0.021 mm counts at 125 Hz, 0.14..1.4 N), the hand a `FrictionHand.speeds` script at "
+         f"(paper profile: 0.021 mm counts at 125 Hz, 0.14..1.4 N; a firm hand, `{HAND}`: 0.25 mm of lag at 0.5 N), "
+         "the hand a `FrictionHand.speeds` script at "
          + ", ".join(f"{s} mm/s ({n}, {d} s)" for n, s, d in SPEEDS) +
          " from x = 0, the force of the pattern (0.14..0.5 N) sent to the device by `FrictionOut`, so each "
          f"pattern also slows its own puck. Total time {elapsed:.1f} s.\n",
@@ -206,7 +218,7 @@ def write_summary(out_dir, rows, figures, rate, elapsed):
     L += ["\n## Files\n",
           "Per pattern and speed: `<pattern>-<slow|fast>.csv` (every 1 ms while the synth ran: time, position, "
           "speed, requested and commanded force, the definition's force) and `.png` (force against position, "
-          "speed against time).\n"]
+          f"the same in a {ZOOM_MM:g} mm window, speed against time).\n"]
     (out_dir / "summary.md").write_text("\n".join(L) + "\n")
 
 
