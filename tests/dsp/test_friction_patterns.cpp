@@ -137,7 +137,7 @@ TEST_CASE("grating: integral of one period is the duty, the level is periodic an
   }
 }
 
-TEST_CASE("anti-aliasing: 300 mm/s over a 0.2 mm grating has no alias in the force frames; 5 mm/s renders it") {
+TEST_CASE("anti-aliasing: 300 mm/s over a 0.2 mm grating has no alias in the force frames and 5 mm/s renders it") {
   // 300 mm/s over 0.2 mm is 1500 Hz, three times the frames' 500 Hz Nyquist frequency: the
   // band-limited grating is its mean (duty 0.5: 0.32 N) and the frames are constant but for
   // float rounding of the level (0.36 N * 2^-24 ~ 2e-8 N): the stated level is 1e-6 N. Without
@@ -167,7 +167,7 @@ TEST_CASE("the fade is 1 up to a quarter of the frame rate, 0 from half of it, a
   CHECK(bandLimitGain(250.001, 1e-3) > 1 - 1e-9);
 }
 
-TEST_CASE("bumps: resist going up, free going down, from either side; the box filter is the mean of the definition") {
+TEST_CASE("bumps: resist going up, free going down, from either side and the box filter is the mean of the definition") {
   const double period = 4.0, width = 2.0, omega = width / period;
   for (bool valleys : {false, true}) {
     for (int dir : {1, -1}) {
@@ -287,7 +287,7 @@ TEST_CASE("grating: a change of period keeps the phase under the puck") {
   CHECK(p.level(further, false) == Approx(before).margin(1e-9));
 }
 
-TEST_CASE("viscous rises linearly with speed to full; stick-slip breaks away above the sliding level with hysteresis") {
+TEST_CASE("viscous rises linearly with speed to full and stick-slip breaks away above the sliding level with hysteresis") {
   auto v = core(PatternKind::Viscous);
   const auto f = run(v, ramp(0, 40.0, 0.1, 48000), 100.0, 0, 0);
   CHECK(level(f.back()) == Approx(0.4).margin(1e-4));
