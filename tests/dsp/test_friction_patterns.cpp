@@ -167,7 +167,8 @@ TEST_CASE("the fade is 1 up to a quarter of the frame rate, 0 from half of it, a
   CHECK(bandLimitGain(250.001, 1e-3) > 1 - 1e-9);
 }
 
-TEST_CASE("bumps: resist going up, free going down, from either side and the box filter is the mean of the definition") {
+TEST_CASE(
+    "bumps: resist going up, free going down, from either side and the box filter is the mean of the definition") {
   const double period = 4.0, width = 2.0, omega = width / period;
   for (bool valleys : {false, true}) {
     for (int dir : {1, -1}) {
@@ -287,7 +288,8 @@ TEST_CASE("grating: a change of period keeps the phase under the puck") {
   CHECK(p.level(further, false) == Approx(before).margin(1e-9));
 }
 
-TEST_CASE("viscous rises linearly with speed to full and stick-slip breaks away above the sliding level with hysteresis") {
+TEST_CASE(
+    "viscous rises linearly with speed to full and stick-slip breaks away above the sliding level with hysteresis") {
   auto v = core(PatternKind::Viscous);
   const auto f = run(v, ramp(0, 40.0, 0.1, 48000), 100.0, 0, 0);
   CHECK(level(f.back()) == Approx(0.4).margin(1e-4));
