@@ -356,6 +356,11 @@ TEST_CASE("extreme parameters and positions: tiny and huge periods, far from the
     // A period far finer than the travel of a frame reads as its mean.
     if (period == 1e-9) CHECK(level(f.back()) == Approx(0.5).margin(1e-6));
   }
+  // A period change where cycles overflow (1e38 mm over 1e-300 mm) does not leave a NaN phase behind.
+  GratingPattern q;
+  q.set(1e-300, 0.5, 0.0, 0.0);
+  q.set(1.0, 0.5, 0.0, 1e38);
+  CHECK(q.level(Travel{0.25, 0.25, 1, 0, 1e-3}, false) == 1.0);
   // A grating 1 km from the origin: 0.2 mm cells still exact (positions in double inside).
   GratingPattern p;
   p.set(0.2, 0.5, 0.0, 0.0);
