@@ -42,11 +42,8 @@ double bandLimitGain(double frequencyHz, double framePeriodS) {
 void PeriodicCoordinate::setPeriod(double periodMm, double anchorMm) {
   if (!(periodMm > 0.0) || !std::isfinite(periodMm)) return;
   if (set_ && periodMm == periodMm_) return;
-  if (set_ && std::isfinite(anchorMm)) {
-    // Beyond double's range (a huge position over a tiny period) the phase is lost, not NaN forever.
-    const double phase = fractionOf(cycles(anchorMm) - anchorMm / periodMm);
-    phase_ = phase >= 0.0 && phase < 1.0 ? phase : 0.0;
-  }
+  // Beyond double's range (a huge position over a tiny period) fractionOf gives 0, not NaN.
+  if (set_ && std::isfinite(anchorMm)) phase_ = fractionOf(cycles(anchorMm) - anchorMm / periodMm);
   periodMm_ = periodMm;
   set_ = true;
 }

@@ -58,7 +58,7 @@ class FrameTravel {
 // raised cosine between: how much of a periodic part of temporal frequency frequencyHz is kept.
 double bandLimitGain(double frequencyHz, double framePeriodS);
 
-// x - floor(x) in [0, 1).
+// x - floor(x) in [0, 1); 0 for NaN and +-inf (cycles beyond double's range).
 inline double fractionOf(double x) {
   const double f = x - std::floor(x);
   return f < 1.0 ? f : 0.0;

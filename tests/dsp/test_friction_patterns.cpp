@@ -356,7 +356,7 @@ TEST_CASE("extreme parameters and positions: tiny and huge periods, far from the
     // A period far finer than the travel of a frame reads as its mean.
     if (period == 1e-9) CHECK(level(f.back()) == Approx(0.5).margin(1e-6));
   }
-  // A period change where cycles overflow (1e38 mm over 1e-300 mm) does not leave a NaN phase behind.
+  // A period change where cycles overflow (1e38 mm over 1e-300 mm) leaves phase 0, not NaN for good.
   GratingPattern q;
   q.set(1e-300, 0.5, 0.0, 0.0);
   q.set(1.0, 0.5, 0.0, 1e38);
