@@ -28,6 +28,7 @@ VALID = {
     "kfBoardCalibrate": [0, ""],
     "kfBoardClose": [0],
     "kfBoardStatus": [0],
+    "kfDriveCalibrate": [0, ""],
 }
 TAKES_SETTINGS = {"kfOpenSim", "kfOpenReplay", "kfOpenMouse"}
 HAS_DEVICE = set(VALID) - {"kfListMice"}
@@ -52,7 +53,7 @@ def variants(cmd):
     yield "unknown setting", args + ["noSuchSetting", 1], True, "noSuchSetting" if cmd in TAKES_SETTINGS else ""
     yield "over-long string", with_strings(LONG), True, "longer than" if strings else "string"
     # An empty string is valid where "" means something (stop recording, the first board, both
-    # backends, linear calibration), refused elsewhere.
+    # backends, linear calibration, no audio drive), refused elsewhere.
     yield "empty string", with_strings(""), cmd in {"kfOpenReplay", "kfOpenSim"} or not strings, ""
 
 
