@@ -11,7 +11,12 @@ from kfharness.load import realtime_allowed
 REALTIME_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the device threads at 66
 
 
+def performer_jack():
+    """A JACK server as a performer runs it: realtime scheduling where this user may."""
+    return JackServer(realtime_priority=REALTIME_PRIORITY if realtime_allowed() else None)
+
+
 @pytest.fixture
 def jack():
-    with JackServer(realtime_priority=REALTIME_PRIORITY if realtime_allowed() else None) as server:
+    with performer_jack() as server:
         yield server
