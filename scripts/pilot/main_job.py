@@ -5,7 +5,6 @@ and writes audio, force, CSV, figures and a summary to out/pilot/.
 Usage: scripts/pilot/main_job.py [--rate 48000] [--out out/pilot] [--mappings mapping1 ...]
 """
 import argparse
-import csv
 import time
 from pathlib import Path
 
@@ -13,6 +12,7 @@ import numpy as np
 
 from kfharness import paths
 from kfharness import pilot as P
+from kfharness import trace_csv
 from view_shot import write_view_shot
 
 import matplotlib  # noqa: E402
@@ -30,13 +30,7 @@ def write_outputs(scene, r, out_dir):
     base = out_dir / scene.name
     soundfile.write(f"{base}-audio.wav", np.stack([r["out_left"], r["out_right"]], 1).astype(np.float32), sr, subtype="FLOAT")
     soundfile.write(f"{base}-force.wav", r["commanded_force"].astype(np.float32), sr, subtype="FLOAT")
-    step = max(1, int(round(sr * 0.001)))  # every 1 ms
-    with open(f"{base}.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["time_s", "position_mm", "speed_mm_per_s", "audio", "delayed_audio", "force_requested_n", "force_commanded_n"])
-        for i in range(0, len(r["t"]), step):
-            w.writerow([f"{r['t'][i]:.4f}", f"{r['position'][i]:.4f}", f"{r['speed'][i]:.3f}", f"{r['audio'][i]:.5f}",
-                        f"{r['delayed_audio'][i]:.5f}", f"{r['force'][i]:.5f}", f"{r['commanded_force'][i]:.5f}"])
+    trace_csv.write(f"{base}.csv", r, scene.duration_s)
     # Figures 2 and 3: speed, audio, friction against time.
     fig, ax = plt.subplots(3, 1, sharex=True, figsize=(9, 6.5))
     t = r["t"]
