@@ -54,6 +54,7 @@ void postFromRt(World* world, const char* format, ...) {
 PluginLoad(KineticFriction) {
   ft = inTable;
   registerSpatialBufRd();
+  registerSpatialBufRd2D();
   registerLoudnessToFriction();
   registerFrictionPattern();
   registerFrictionMouseIn();

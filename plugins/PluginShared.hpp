@@ -75,6 +75,7 @@ class SlotFollower {
 
 // Registration hooks, one per UGen file, called from PluginLoad.
 void registerSpatialBufRd();
+void registerSpatialBufRd2D();
 void registerLoudnessToFriction();
 void registerFrictionPattern();
 void registerFrictionMouseIn();

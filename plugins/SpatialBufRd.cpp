@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "AudioClock.hpp"
+#include "BufferLookup.hpp"
 #include "PluginShared.hpp"
 #include "PostLimiter.hpp"
 #include "SpatialReader.hpp"
@@ -34,8 +35,8 @@ class SpatialBufRd : public SCUnit {
     // Before the buffer checks, so that the last good values are followed whatever the buffer.
     const double samplesPerMm = usableSamplesPerMm();
     const double inputOriginMm = usableOriginMm();
-    const SndBuf* buf = lookupBuffer();
-    if (mBadBufnum) return silence(BufferProblem::BadBufnum, buf, numSamples);
+    const SndBuf* buf = mBuffer.find(mWorld, mParent, in0(kBufnum));
+    if (mBuffer.isBad()) return silence(BufferProblem::BadBufnum, buf, numSamples);
     if (buf == nullptr) return silence(BufferProblem::NotAllocated, buf, numSamples);
     // Held for the block, as GET_BUF_SHARED does: under supernova another thread may reallocate
     // the buffer meanwhile (no-op in scsynth).
@@ -109,26 +110,6 @@ class SpatialBufRd : public SCUnit {
     return mLayoutOriginMm;
   }
 
-  // The buffer for the bufnum input, global or local to the synth, or nullptr. As GET_BUF
-  // does, the SndBuf is found again only when bufnum changes: its slot stays put, and a freed or
-  // reallocated buffer shows in its fields at once.
-  const SndBuf* lookupBuffer() {
-    const float fbufnum = in0(kBufnum);
-    if (fbufnum == mBufnumIn) return mBuf;
-    mBufnumIn = fbufnum;
-    mBuf = nullptr;
-    // Checked as a float first: 2^32, 1e30, inf and NaN are no buffer (a cast to an integer
-    // would be undefined, and read buffer 0).
-    const double numBufs = static_cast<double>(mWorld->mNumSndBufs) + mParent->localBufNum;
-    mBadBufnum = !(fbufnum >= 0.f) || !(static_cast<double>(fbufnum) < numBufs);
-    if (mBadBufnum) return nullptr;
-    const auto bufnum = static_cast<uint32>(fbufnum);
-    mBufnum = static_cast<int>(bufnum);
-    mBuf = bufnum < mWorld->mNumSndBufs ? mWorld->mSndBufs + bufnum
-                                        : mParent->mLocalSndBufs + (bufnum - mWorld->mNumSndBufs);
-    return mBuf;
-  }
-
   // One message per change of problem, and per kind of problem at most one a second: a buffer
   // reallocated 300 times a second posts a line, not hundreds. None when the server runs quiet
   // (verbosity -2 and below, as for SC's own buffer UGens).
@@ -142,21 +123,18 @@ class SpatialBufRd : public SCUnit {
     if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
     if (problem == BufferProblem::BadBufnum)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
-                         kf::sc::shownValue(mBufnumIn),
+                         kf::sc::shownValue(mBuffer.input()),
                          static_cast<int>(mWorld->mNumSndBufs) + mParent->localBufNum - 1, more);
     else if (problem == BufferProblem::NotAllocated)
-      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.%s\n", mBufnum,
-                         more);
+      kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d is not allocated or empty; output is silent.%s\n",
+                         mBuffer.bufnum(), more);
     else if (problem == BufferProblem::ChannelMismatch)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: buffer %d has %d channels but numChannels is %d; output is silent.%s\n",
-                         mBufnum, buf->channels, static_cast<int>(mNumOutputs), more);
+                         mBuffer.bufnum(), buf->channels, static_cast<int>(mNumOutputs), more);
   }
 
   BufferProblem mProblem = BufferProblem::None;
-  float mBufnumIn = -1e9f;  // the bufnum input mBuf was found for
-  const SndBuf* mBuf = nullptr;
-  int mBufnum = -1;
-  bool mBadBufnum = false;
+  kf::sc::BufferLookup mBuffer;
   kf::sc::PostLimiter mLimits[4];
   kf::sc::FirstTimeOnly mBadInputs;
   double mGoodSamplesPerMm = 0.0;  // the last good samplesPerMm, 0 before the first

@@ -115,6 +115,38 @@ std::unique_ptr<Synth> readersSynth(FakeServer& server) {
   return synth;
 }
 
+// SpatialBufRd2D: every interpolation, positions at both rates (a path crossing the matrix's
+// borders), the layout moving, every kind of buffer and the bad inputs. Buffer 0 (48000 mono
+// frames) is read as 240 rows of 200.
+std::unique_ptr<Synth> surfacesSynth(FakeServer& server) {
+  auto synth = server.newSynth("surfaces");
+  const auto& surface = server.unitDef("SpatialBufRd2D");
+  auto add = [&](int rate, Input bufnum, Input x, Input y, Input width, Input spmX, Input spmY, Input originX,
+                 Input originY, float interpolation, const std::string& what) {
+    synth->add(surface, rate, {bufnum, x, y, width, spmX, spmY, originX, originY, c(interpolation)}, 1, what);
+  };
+  for (int interpolation : {1, 2, 4}) {
+    const std::string mode = "interpolation " + std::to_string(interpolation);
+    const auto code = static_cast<float>(interpolation);
+    add(ar, c(0), sweepAr(), sweepAr(), c(200), c(2), c(2.4f), c(-5), c(-5), code, mode + ", x and y ar");
+    add(kr, c(0), sweepKr(), sweepKr(), c(200), c(2), c(2.4f), c(-5), c(-5), code, mode + ", x and y kr");
+    add(ar, c(0), sweepAr(), c(10), alternating(200, 100), alternating(2, 5), alternating(1, 3), alternating(0, 9),
+        alternating(0, -3), code, mode + ", layout moving");
+  }
+  add(ar, c(FakeServer::kNumBuffers), sweepAr(), sweepAr(), c(10), c(2), c(2), c(0), c(0), 4, "local buffer");
+  add(ar, c(1), sweepAr(), sweepAr(), c(200), c(2), c(2), c(0), c(0), 4, "stereo buffer");
+  add(ar, c(2), sweepAr(), sweepAr(), c(200), c(2), c(2), c(0), c(0), 4, "buffer not allocated");
+  add(ar, alternating(0, 3), sweepAr(), sweepAr(), c(64), c(2), c(2), c(0), c(0), 4, "buffer changing");
+  add(ar, c(kNaN), sweepAr(), sweepAr(), c(200), c(2), c(2), c(0), c(0), 4, "bufnum NaN");
+  add(ar, c(0), sweepAr(), sweepAr(), alternating(0, 1e9f), c(2), c(2), c(0), c(0), 4, "width 0 and too large");
+  add(ar, c(0), sweepAr(), sweepAr(), c(kNaN), c(2), c(2), c(0), c(0), 4, "width NaN");
+  add(ar, c(0), sweepAr(), sweepAr(), c(200), alternating(kNaN, 2), c(-1), c(kInf), alternating(0, kNaN), 4,
+      "samplesPerMm and origins bad");
+  add(ar, c(0), Input::audio([](int64_t sample) { return sample % 100 < 50 ? kNaN : 10.f; }), sweepAr(), c(200), c(2),
+      c(2), c(0), c(0), 2, "x NaN at times");
+  return synth;
+}
+
 // The window and maxWindow modes (paper's, moving, bad, beyond the limit: the history's
 // allocation fails), the mapping moving every block and bad, and control rate.
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server) {

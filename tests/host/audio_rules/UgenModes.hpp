@@ -24,6 +24,8 @@ std::unique_ptr<Synth> chainSynth(FakeServer& server, ChainWatch& watch);
 std::unique_ptr<Synth> mouseModesSynth(FakeServer& server);
 // SpatialBufRd: every interpolation, position at both rates, keep, every kind of buffer.
 std::unique_ptr<Synth> readersSynth(FakeServer& server);
+// SpatialBufRd2D: every interpolation, both rates, the layout moving, every kind of buffer.
+std::unique_ptr<Synth> surfacesSynth(FakeServer& server);
 // LoudnessToFriction: every window, maxWindow and mapping mode, both rates.
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server);
 // FrictionPattern: every kind, parameters moving and bad, position at both rates, fed by the puck.
