@@ -43,3 +43,36 @@ def zero_crossing_frequency(x, sample_rate):
     crossings = rising_crossings(x)
     assert len(crossings) >= 3, "too few zero crossings"
     return sample_rate * (len(crossings) - 1) / (crossings[-1] - crossings[0])
+
+
+def _tap_weights(t, mode):
+    """Weights of the taps at whole part - 1 .. + 2 for fractions t (SpatialBufRd2D's modes:
+    1 none, 2 linear, 4 cubic Catmull-Rom in its matrix form)."""
+    z = np.zeros_like(t)
+    if mode == 1:
+        return [z, z + 1, z, z]
+    if mode == 2:
+        return [z, 1 - t, t, z]
+    return [0.5 * (-t + 2 * t**2 - t**3), 0.5 * (2 - 5 * t**2 + 3 * t**3), 0.5 * (t + 4 * t**2 - 3 * t**3),
+            0.5 * (-t**2 + t**3)]
+
+
+def surface(matrix, column, row, mode=4):
+    """SpatialBufRd2D's definition in double: the matrix (rows x columns) zero outside its samples,
+    read at fractional column and row indices; exactly 0 outside (-1, size) in either axis and for
+    NaN/Inf."""
+    matrix = np.asarray(matrix, dtype=np.float64)
+    height, width = matrix.shape
+    column, row = np.asarray(column, dtype=np.float64), np.asarray(row, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        inside = (column > -1) & (column < width) & (row > -1) & (row < height)
+    c = np.where(inside, column, 0.0)
+    r = np.where(inside, row, 0.0)
+    i, j = np.floor(c).astype(np.int64), np.floor(r).astype(np.int64)
+    padded = np.pad(matrix, 3)  # taps reach two beyond any inside index
+    wx, wy = _tap_weights(c - i, mode), _tap_weights(r - j, mode)
+    out = np.zeros_like(c)
+    for b in range(4):
+        for a in range(4):
+            out += wy[b] * wx[a] * padded[j - 1 + b + 3, i - 1 + a + 3]
+    return np.where(inside, out, 0.0)
