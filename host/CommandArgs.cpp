@@ -288,8 +288,10 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
     case CommandShape::kOpenSim: {
       double kind = 0.0, count = 0.0;
       if (!args.readNumber(kind)) return fail(error, errorSize, "hand script kind: %s", describe(args));
-      if (!isWholeIn(kind, -1.0, 2.0))
-        return fail(error, errorSize, "hand script kind %g is not -1 (none), 0 (path), 1 (speeds) or 2 (force)",
+      if (!isWholeIn(kind, -1.0, 6.0))
+        return fail(error, errorSize,
+                    "hand script kind %g is not -1 (none), 0 (path), 1 (speeds), 2 (force), 3 (path2D), 4 (line), "
+                    "5 (circle) or 6 (raster)",
                     shown(kind));
       if (!args.readNumber(count)) return fail(error, errorSize, "hand script value count: %s", describe(args));
       if (!isWholeIn(count, 0.0, kMaxHandValues))
@@ -301,6 +303,12 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
       if (out.kind == -1 && wanted != 0) return fail(error, errorSize, "no hand script (kind -1) takes no values");
       if (out.kind == 2 && wanted != 1)
         return fail(error, errorSize, "a force hand script takes 1 value, not %d", wanted);
+      if (out.kind == 3 && wanted % 3 != 0)
+        return fail(error, errorSize, "a path2D hand script of %d values: triples expected", wanted);
+      if ((out.kind == 4 || out.kind == 5) && wanted != 5)
+        return fail(error, errorSize, "a line or circle hand script takes 5 values, not %d", wanted);
+      if (out.kind == 6 && wanted != 6)
+        return fail(error, errorSize, "a raster hand script takes 6 values, not %d", wanted);
       if (wanted > 0) {
         out.values = storage(storageContext, wanted);
         if (out.values == nullptr) return fail(error, errorSize, "RT memory allocation failed for the hand script");

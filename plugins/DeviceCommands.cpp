@@ -3,7 +3,9 @@
 // slot pointers; everything that allocates, blocks or does I/O runs in the NRT stages.
 //
 //   kfOpenSim    index kind numValues values... [key value]...   kind: -1 none, 0 path
-//                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N)
+//                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N), 3 path2D
+//                (timeS, xMm, yMm triples), 4 line (x0, y0, angleDeg, lengthMm, speed), 5 circle
+//                (cx, cy, radiusMm, speed, turns), 6 raster (x0, y0, widthMm, heightMm, rows, speed)
 //   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry and replies /kfStatus with its figures as
@@ -18,6 +20,7 @@
 // posted. The open commands refuse a slot that holds a device unless given the setting
 // `replace 1`. `/sync` works after all. Real mice: MouseCommands.cpp; the board: BoardCommands.cpp.
 #include <algorithm>
+#include <array>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
@@ -84,6 +87,19 @@ kf::HandScript handScriptOf(const CommandData* data) {
       return kf::HandScript::speeds(std::move(pairs));
     case 2:
       return kf::HandScript::constantForce(args.numValues > 0 ? args.values[0] : 0.0);
+    case 3: {
+      std::vector<std::array<double, 3>> triples;
+      for (int i = 0; i + 2 < args.numValues; i += 3)
+        triples.push_back({args.values[i], args.values[i + 1], args.values[i + 2]});
+      return kf::HandScript::path2D(std::move(triples));
+    }
+    case 4:  // the value counts are checked by CommandArgs
+      return kf::HandScript::line(args.values[0], args.values[1], args.values[2], args.values[3], args.values[4]);
+    case 5:
+      return kf::HandScript::circle(args.values[0], args.values[1], args.values[2], args.values[3], args.values[4]);
+    case 6:
+      return kf::HandScript::raster(args.values[0], args.values[1], args.values[2], args.values[3], args.values[4],
+                                    args.values[5]);
     default:
       return kf::HandScript::none();
   }

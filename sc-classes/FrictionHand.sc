@@ -1,5 +1,7 @@
-// A script for the simulated hand along x: target positions over time, speed segments, or
-// (for tests) a constant push. The simulator pulls the puck towards the target through a
+// A script for the simulated hand: target positions over time along x or on the surface (x, y),
+// speed segments along x, the 2D scripts (a line at an angle, a circle, a raster), or (for tests)
+// a constant push along x. The 2D scripts are made into (time, x, y) paths by the server
+// (device/sim/HandScript), at a constant speed from t = 0. The simulator pulls the puck towards the target through a
 // spring-damper with a force limit, so friction slows it as the paper's subjects reported.
 FrictionHand {
 	var <kind, <points, <forceN;
@@ -18,6 +20,26 @@ FrictionHand {
 		^this.newCopyArgs(1, pairs)
 	}
 
+	// [[timeS, xMm, yMm], ...]: target positions on the surface, linear in between, held after the last.
+	*path2D { |timeXYMm|
+		^this.newCopyArgs(3, this.prCheckTuples(timeXYMm, "path2D", "[timeS, xMm, yMm]", 3, true))
+	}
+
+	// From (x0, y0) mm for lengthMm at angleDeg (counter-clockwise from +x), at speedMmPerS.
+	*line { |angleDeg = 0, lengthMm = 50, speedMmPerS = 50, x0 = 0, y0 = 0|
+		^this.newCopyArgs(4, this.prCheckParams([x0, y0, angleDeg, lengthMm, speedMmPerS], "line", 4))
+	}
+
+	// turns turns (up to 1000) counter-clockwise around (cx, cy) mm from (cx + radiusMm, cy).
+	*circle { |radiusMm = 10, speedMmPerS = 50, turns = 1, cx = 0, cy = 0|
+		^this.newCopyArgs(5, this.prCheckParams([cx, cy, radiusMm, speedMmPerS, turns], "circle", 3))
+	}
+
+	// rows rows (whole, 1..1000) of widthMm, +x then -x, spread over heightMm along y, from (x0, y0).
+	*raster { |widthMm = 20, heightMm = 20, rows = 5, speedMmPerS = 50, x0 = 0, y0 = 0|
+		^this.newCopyArgs(6, this.prCheckParams([x0, y0, widthMm, heightMm, rows, speedMmPerS], "raster", 5))
+	}
+
 	// A constant push of forceN along x (tests of the puck's dynamics).
 	*force { |forceN|
 		^this.newCopyArgs(2, [], FrictionCheck.finite(forceN, "forceN", "FrictionHand.force"))
@@ -25,25 +47,34 @@ FrictionHand {
 
 	// The arguments of the kfOpenSim command: kind, count, values...
 	asCommandArgs {
-		var values = if(kind == 2) { [forceN] } { points.flatten(1) };
+		var values = case { kind == 2 } { [forceN] } { kind >= 4 } { points } { points.flatten(1) };
 		^[kind, values.size] ++ values
 	}
 
 	// How long the script runs, in s (0 for a constant force).
 	duration {
-		^switch(kind, 0, { points.last[0] }, 1, { points.sum { |p| p[1] } }, { 0 })
+		var p = points;
+		^switch(kind,
+			0, { p.last[0] }, 1, { p.sum { |q| q[1] } }, 3, { p.last[0] },
+			4, { p[3] / p[4] },
+			5, { 2pi * p[2] * p[4] / p[3] },
+			6, { (p[2].abs * p[4] + if(p[4] > 1) { p[3].abs } { 0 }) / p[5] },
+			{ 0 })
 	}
 
-	printOn { |stream| stream << this.class.name << "(" << [\path, \speeds, \force][kind] << ")" }
+	printOn { |stream|
+		stream << this.class.name << "(" << [\path, \speeds, \force, \path2D, \line, \circle, \raster][kind] << ")"
+	}
 
-	*prCheckPairs { |pairs, method, shape, ascending|
+	*prCheckTuples { |tuples, method, shape, size, ascending|
 		var last = -inf;
-		if(pairs.isSequenceableCollection.not or: { pairs.isEmpty }) {
-			Error("FrictionHand.%: expects a non-empty array of % pairs".format(method, shape)).throw
+		if(tuples.isSequenceableCollection.not or: { tuples.isEmpty }) {
+			Error("FrictionHand.%: expects a non-empty array of % %".format(method, shape,
+				if(size == 2) { "pairs" } { "triples" })).throw
 		};
-		pairs.do { |p|
+		tuples.do { |p|
 			var finite = { |v| v.isNumber and: { v.isNaN.not and: { v.abs != inf } } };
-			if(p.isSequenceableCollection.not or: { p.size != 2 } or: { p.every(finite).not }) {
+			if(p.isSequenceableCollection.not or: { p.size != size } or: { p.every(finite).not }) {
 				Error("FrictionHand.%: each entry must be % with finite numbers, got %".format(method, shape, p)).throw
 			};
 			if(ascending) {
@@ -53,6 +84,19 @@ FrictionHand {
 				last = p[0];
 			};
 		};
-		^pairs.collect { |p| p.collect(_.asFloat) }
+		^tuples.collect { |p| p.collect(_.asFloat) }
 	}
+
+	// The 2D scripts' numbers: finite, a speed > 0; the server checks the rest (counts, bounds).
+	*prCheckParams { |values, method, speedIndex|
+		values.do { |v|
+			if(v.isNumber.not or: { v.isNaN } or: { v.abs == inf }) {
+				Error("FrictionHand.%: arguments must be finite numbers, got %".format(method, values)).throw
+			}
+		};
+		if(values[speedIndex] <= 0) { Error("FrictionHand.%: speedMmPerS must be > 0".format(method)).throw };
+		^values.collect(_.asFloat)
+	}
+
+	*prCheckPairs { |pairs, method, shape, ascending| ^this.prCheckTuples(pairs, method, shape, 2, ascending) }
 }

@@ -21,7 +21,9 @@ class MouseSensorModel {
 
   // Takes the report due at nextReportTimeS() from the true position then. Returns false when
   // that report is dropped (its counts go into the next delivered one, flagged kAfterLoss).
-  bool takeReport(double positionMm, MouseReport& out);
+  bool takeReport(double positionMm, MouseReport& out) { return takeReport(positionMm, 0.0, out); }
+  // The same on the surface: counts along x and y, each axis floor-quantised and clipped alone.
+  bool takeReport(double xMm, double yMm, MouseReport& out);
 
   uint64_t droppedReports() const { return droppedReports_; }
 
@@ -34,8 +36,10 @@ class MouseSensorModel {
   DeterministicRandom random_;
   int64_t reportIndex_ = 0;  // of the report due at nextReportTimeS_
   double nextReportTimeS_ = 0.0;
-  int64_t lastQuantumCounts_;  // floor(position / countMm) at the last report
+  int64_t lastQuantumCounts_;       // floor(position / countMm) at the last report
+  int64_t lastQuantumYCounts_ = 0;  // the same along y (the puck starts at y = 0)
   int32_t pendingDxCounts_ = 0;
+  int32_t pendingDyCounts_ = 0;
   uint32_t pendingFlags_ = 0;
   uint64_t droppedReports_ = 0;
 };

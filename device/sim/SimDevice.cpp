@@ -14,32 +14,41 @@ SimDevice::SimDevice(const DeviceSpec& spec, const SimParams& params, const Hand
       sensor_(spec, params, 0.0),
       buffer_(kReportBufferCapacity) {}
 
-double SimDevice::handPushN(double timeS) const {
-  if (hand_.isIdle()) return 0.0;
-  if (hand_.isForce()) return hand_.constantForceN();
-  // A spring-damper between hand and puck, limited to what a fingertip pushes.
+SimDevice::Push SimDevice::handPush(double timeS) const {
+  if (hand_.isIdle()) return {};
+  if (hand_.isForce()) return {hand_.constantForceN(), 0.0};
+  // A spring-damper between hand and puck on each axis, the push limited in magnitude to what a
+  // fingertip pushes (along x alone: clamped to +-handMaxForceN, as before there was a y).
   const HandTarget target = hand_.at(timeS);
-  const double errorM = (target.positionMm - positionMm()) * 1e-3;
-  const double speedErrorMPerS = (target.speedMmPerS - speedMmPerS()) * 1e-3;
-  const double pushN = params_.handStiffnessNPerM * errorM + params_.handDampingNSPerM * speedErrorMPerS;
-  return std::clamp(pushN, -params_.handMaxForceN, params_.handMaxForceN);
+  auto spring = [&](double targetMm, double puckMm, double targetMmPerS, double puckMmPerS) {
+    return params_.handStiffnessNPerM * (targetMm - puckMm) * 1e-3 +
+           params_.handDampingNSPerM * (targetMmPerS - puckMmPerS) * 1e-3;
+  };
+  const double x = spring(target.positionMm, positionMm(), target.speedMmPerS, speedMmPerS());
+  const double y = spring(target.yMm, positionYMm(), target.speedYMmPerS, speedYMmPerS());
+  if (y == 0.0) return {std::clamp(x, -params_.handMaxForceN, params_.handMaxForceN), 0.0};
+  const double magnitude = std::hypot(x, y);
+  const double scale = magnitude > params_.handMaxForceN ? params_.handMaxForceN / magnitude : 1.0;
+  return {x * scale, y * scale};
 }
 
 void SimDevice::step() {
   const double startS = timeS();
-  const double startMm = positionMm();
-  handForceN_ = handPushN(startS);
-  puck_.step(params_.stepS, handForceN_, magnet_.forceN());
+  const double startMm = positionMm(), startYMm = positionYMm();
+  const Push push = handPush(startS);
+  handForceN_ = push.xN;
+  handForceYN_ = push.yN;
+  puck_.step(params_.stepS, push.xN, push.yN, magnet_.forceN());
   magnet_.step();
   ++stepIndex_;
   const double endS = timeS();
-  const double endMm = positionMm();
+  const double endMm = positionMm(), endYMm = positionYMm();
   while (sensor_.nextReportTimeS() <= endS) {
     // Position at the report instant, linear within the step.
-    const double fraction = (sensor_.nextReportTimeS() - startS) / params_.stepS;
-    const double atMm = startMm + (endMm - startMm) * std::clamp(fraction, 0.0, 1.0);
+    const double fraction = std::clamp((sensor_.nextReportTimeS() - startS) / params_.stepS, 0.0, 1.0);
     MouseReport report;
-    if (sensor_.takeReport(atMm, report)) storeReport(report);
+    if (sensor_.takeReport(startMm + (endMm - startMm) * fraction, startYMm + (endYMm - startYMm) * fraction, report))
+      storeReport(report);
   }
 }
 

@@ -1,4 +1,5 @@
-// SimDevice: a whole simulated friction device — scripted hand, puck with Coulomb friction,
+// SimDevice: a whole simulated friction device — scripted hand (along x or on the surface), puck
+// with Coulomb friction,
 // lagging magnet and mouse sensor — stepped with a fixed step by advanceTo(). It is both the
 // mouse backend and the force backend. Deterministic: the same calls give the same reports
 // bit for bit; advanceTo() never allocates. Not thread-safe: drive it from one thread (the
@@ -39,7 +40,10 @@ class SimDevice : public MouseBackend, public ForceBackend {
   double speedMmPerS() const { return puck_.speedMPerS() * 1000.0; }
   double frictionN() const { return magnet_.forceN(); }  // the magnet's actual force
   double commandedForceN() const { return magnet_.commandedN(); }
-  double handForceN() const { return handForceN_; }  // last push on the puck
+  double positionYMm() const { return puck_.positionYM() * 1000.0; }
+  double speedYMmPerS() const { return puck_.speedYMPerS() * 1000.0; }
+  double handForceN() const { return handForceN_; }    // last push on the puck (along x)
+  double handForceYN() const { return handForceYN_; }  // and along y
   HandTarget handTarget() const { return hand_.at(timeS()); }
   uint64_t droppedReports() const { return sensor_.droppedReports(); }
   uint64_t bufferOverflows() const { return bufferOverflows_; }  // reports nobody polled
@@ -48,7 +52,10 @@ class SimDevice : public MouseBackend, public ForceBackend {
 
  private:
   void step();
-  double handPushN(double timeS) const;
+  struct Push {
+    double xN = 0.0, yN = 0.0;
+  };
+  Push handPush(double timeS) const;
   void storeReport(const MouseReport& report);
 
   DeviceSpec spec_;
@@ -59,6 +66,7 @@ class SimDevice : public MouseBackend, public ForceBackend {
   MouseSensorModel sensor_;
   int64_t stepIndex_ = 0;
   double handForceN_ = 0.0;
+  double handForceYN_ = 0.0;
   // Reports made but not yet polled; deviceTimeS order.
   std::vector<MouseReport> buffer_;
   int bufferHead_ = 0;
