@@ -55,6 +55,7 @@ PluginLoad(KineticFriction) {
   ft = inTable;
   registerSpatialBufRd();
   registerSpatialBufRd2D();
+  registerSpeedGovernor();
   registerLoudnessToFriction();
   registerFrictionPattern();
   registerFrictionMouseIn();

@@ -76,6 +76,7 @@ class SlotFollower {
 // Registration hooks, one per UGen file, called from PluginLoad.
 void registerSpatialBufRd();
 void registerSpatialBufRd2D();
+void registerSpeedGovernor();
 void registerLoudnessToFriction();
 void registerFrictionPattern();
 void registerFrictionMouseIn();

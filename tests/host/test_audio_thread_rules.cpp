@@ -119,8 +119,8 @@ void Scenario::expectAnswer(const OscMessage& message) {
 }
 
 void Scenario::run() {
-  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "SpatialBufRd2D", "LoudnessToFriction", "FrictionOut",
-                           "FrictionDrive", "FrictionPattern"})
+  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "SpatialBufRd2D", "SpeedGovernor", "LoudnessToFriction",
+                           "FrictionOut", "FrictionDrive", "FrictionPattern"})
     check(server_.unitDef(name).ctor != nullptr, std::string("the plugin defines ") + name);
   const std::string recording = options_.scratch + "/recording.txt";
   server_.start();
@@ -130,6 +130,7 @@ void Scenario::run() {
   Synth* mouseModes = server_.play(mouseModesSynth(server_));
   Synth* readers = server_.play(readersSynth(server_));
   Synth* surfaces = server_.play(surfacesSynth(server_));
+  Synth* governors = server_.play(governorsSynth(server_));
   Synth* loudness = server_.play(loudnessSynth(server_));
   Synth* writers = server_.play(writersSynth(server_));
   Synth* drives = server_.play(drivesSynth(server_, chain_));
@@ -209,6 +210,7 @@ void Scenario::run() {
   expectDone(OscMessage("kfClose").i(0));
   server_.free(readers);
   server_.free(surfaces);
+  server_.free(governors);
   server_.free(loudness);
   server_.free(patterns);
   server_.free(slot1);

@@ -147,6 +147,21 @@ std::unique_ptr<Synth> surfacesSynth(FakeServer& server) {
   return synth;
 }
 
+// SpeedGovernor: speeds at both rates, settings moving and bad.
+std::unique_ptr<Synth> governorsSynth(FakeServer& server) {
+  auto synth = server.newSynth("governors");
+  const auto& governor = server.unitDef("SpeedGovernor");
+  auto speedAr = Input::audio([](int64_t sample) { return static_cast<float>(sample % 4800) * 0.05f; });
+  synth->add(governor, ar, {speedAr, speedAr, c(80), c(0.01f), c(0.14f), c(1.4f)}, 1, "speeds ar");
+  synth->add(governor, kr, {sweepKr(), sweepKr(), c(80), c(0.01f), c(0.14f), c(1.4f)}, 1, "speeds kr");
+  synth->add(governor, ar,
+             {speedAr, c(0), alternating(20, 200), alternating(0.001f, 0.1f), alternating(0.1f, 0.3f),
+              alternating(1.4f, 0.05f)},
+             1, "settings moving, hiForce below loForce at times");
+  synth->add(governor, ar, {speedAr, c(kNaN), alternating(kNaN, -1), c(kInf), c(kNaN), c(-kInf)}, 1, "bad inputs");
+  return synth;
+}
+
 // The window and maxWindow modes (paper's, moving, bad, beyond the limit: the history's
 // allocation fails), the mapping moving every block and bad, and control rate.
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server) {

@@ -26,6 +26,8 @@ std::unique_ptr<Synth> mouseModesSynth(FakeServer& server);
 std::unique_ptr<Synth> readersSynth(FakeServer& server);
 // SpatialBufRd2D: every interpolation, both rates, the layout moving, every kind of buffer.
 std::unique_ptr<Synth> surfacesSynth(FakeServer& server);
+// SpeedGovernor: both rates, settings moving and bad.
+std::unique_ptr<Synth> governorsSynth(FakeServer& server);
 // LoudnessToFriction: every window, maxWindow and mapping mode, both rates.
 std::unique_ptr<Synth> loudnessSynth(FakeServer& server);
 // FrictionPattern: every kind, parameters moving and bad, position at both rates, fed by the puck.
