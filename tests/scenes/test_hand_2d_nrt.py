@@ -17,33 +17,40 @@ SCRIPTS = {  # name: (FrictionHand, seconds)
 }
 
 
-def render(name):
+def render():
+    """One render, each script on a slot of its own: per script (matrix, x, y, read) while it ran."""
     m = np.random.default_rng(11).uniform(-1, 1, (SIZE, SIZE))
     path = paths.work_dir() / "hand2d-surface.wav"
     soundfile.write(str(path), m.ravel().astype(np.float32), SR, subtype="FLOAT")
-    hand, seconds = SCRIPTS[name]
-    data, _ = nrt.score_and_render(f"hand2d-{name}", f"""
-        var dev = FrictionDevice.sim(nil, 0, {hand});
-        var def = SynthDef(\\hand2d, {{
-            var mouse = FrictionMouseIn.ar(0, 0, 1);
-            Out.ar(0, [mouse[0], mouse[1], SpatialBufRd2D.ar(1, mouse[0], mouse[1], {SIZE}, 1, 1, -30, -30, 4)])
-        }});
-        score = Score([
-            [0.0, dev.openMsg],
+    opens, outs = [], []
+    for slot, (hand, seconds) in enumerate(SCRIPTS.values()):
+        opens.append(f"[0.0, FrictionDevice.sim(nil, {slot}, {hand}).openMsg]")
+        outs.append(f"{{ var m = FrictionMouseIn.ar({slot}, 0, 1); "
+                    f"[m[0], m[1], SpatialBufRd2D.ar(1, m[0], m[1], {SIZE}, 1, 1, -30, -30, 4)] }}.value")
+    longest = max(seconds for _, seconds in SCRIPTS.values())
+    data, _ = nrt.score_and_render("hand2d", f"""
+        var def = SynthDef(\\hand2d, {{ Out.ar(0, [{", ".join(outs)}].flat) }});
+        score = Score([{", ".join(opens)},
             [0.0, ['/b_allocRead', 1, "{path}"]],
             [0.0, ['/d_recv', def.asBytes]],
             [0.0, Synth.basicNew(\\hand2d, nil, 1000).newMsg],
-            [{seconds}, ['/n_free', 1000]],
-            [{seconds}, dev.closeMsg]]);
-    """, channels=3)
-    ran = slice(0, nrt.bundle_start_sample(seconds, SR))
-    x, y, got = (data[ran, i].astype(np.float64) for i in range(3))
-    return m, x, y, got
+            [{longest}, ['/n_free', 1000]]]);
+    """, channels=3 * len(SCRIPTS))
+    out = {}
+    for k, (name, (_, seconds)) in enumerate(SCRIPTS.items()):
+        ran = slice(0, nrt.bundle_start_sample(seconds, SR))
+        out[name] = (m, *(data[ran, 3 * k + i].astype(np.float64) for i in range(3)))
+    return out
+
+
+@pytest.fixture(scope="module")
+def renders():
+    return render()
 
 
 @pytest.mark.parametrize("name", list(SCRIPTS))
-def test_the_2d_scripts_move_the_puck_and_the_surface_is_read_along_them(name):
-    m, x, y, got = render(name)
+def test_the_2d_scripts_move_the_puck_and_the_surface_is_read_along_them(renders, name):
+    m, x, y, got = renders[name]
     # The surface under the puck: as the definition at the positions FrictionMouseIn gave (float
     # kernels against double: 5.7e-7 at worst in tests/dsp, values in [-1, 1]).
     want = reference.surface(m, x + 30, y + 30, 4)
