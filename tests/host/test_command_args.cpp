@@ -145,6 +145,14 @@ TEST_CASE("hand script counts must match the values sent", "[commands]") {
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(7).i(0).bytes()).error, "kind 7"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).f(NAN).i(0).bytes()).error, "kind nan"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(2).i(2).f(1).f(1).bytes()).error, "takes 1 value"));
+  // The 2D scripts: path2D in triples, line and circle 5 values, raster 6.
+  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(3).i(4).f(0).f(0).f(0).f(1).bytes()).error, "triples"));
+  CHECK(parse(CommandShape::kOpenSim, Message().i(0).i(3).i(3).f(0).f(1).f(2).bytes()).ok);
+  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(4).i(4).f(0).f(0).f(0).f(1).bytes()).error,
+                 "takes 5 values"));
+  CHECK(parse(CommandShape::kOpenSim, Message().i(0).i(5).i(5).f(0).f(0).f(10).f(50).f(1).bytes()).ok);
+  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(6).i(5).f(0).f(0).f(10).f(5).f(2).bytes()).error,
+                 "takes 6 values"));
 }
 
 TEST_CASE("settings: at most 32, each a name with a number", "[commands]") {
