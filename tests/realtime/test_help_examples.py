@@ -365,9 +365,7 @@ def test_every_help_example_runs_on_a_realtime_server():
     assert files, "no help files"
     shards = shards_of(files, SHARDS)
     with ExitStack() as stack:
-        # As the other realtime tests run (conftest): without realtime scheduling, a machine
-        # busy with three sanitized servers starved the device threads until their watchdog
-        # turned the force off, and an example polled 0.14 N where its text says 0.56 N.
+        # Run as the other realtime tests run (conftest.performer_jack).
         jacks = [stack.enter_context(performer_jack()) for _ in shards]
         # The servers boot one after another: scsynths opening their JACK clients at the same
         # moment failed to ("Cannot open SuperCollider client") under the sanitizers.
