@@ -32,10 +32,14 @@ AudioDrive* SlotDrive::publish(AudioDrive* drive, uint32_t generation) {
   return previous;
 }
 
-const float* SlotDrive::samples(const BlockClock& clock, uint32_t generation, const SlotForce& force) {
+const float* SlotDrive::samples(const BlockClock& clock, uint32_t generation, const SlotForce& force, bool& another) {
+  another = false;
   if (drive_ == nullptr || generation != generation_ || gDrivesHalted.load(std::memory_order_relaxed)) return nullptr;
   const int n = std::min(clock.numSamples, kMaxBlockSamples);
-  if (computedBlock_ == clock.block) return samples_;
+  if (computedBlock_ == clock.block) {  // a second FrictionDrive of the slot in this block: 0
+    another = true;
+    return nullptr;
+  }
   // A gap (no FrictionDrive ran last block): the slew starts again from the magnet off.
   if (computedBlock_ != clock.block - 1) drive_->off();
   computedBlock_ = clock.block;

@@ -1,6 +1,8 @@
 // SlotDrive: a slot's audio drive (FrictionDrive): its chain (AudioDrive, for the device it was
-// loaded for) and the drive samples of the current block, computed once per block by the first
-// FrictionDrive that asks and copied by the others. In block b it drives block b-1's combined
+// loaded for) and the drive samples of the current block, computed once per block for the first
+// FrictionDrive of the slot that asks. Every other FrictionDrive of the slot in that block gets
+// none (outputs 0): a slot has one drive, so two FrictionDrive summed into one channel (a guide
+// block run twice) never give more than the safe level. In block b it drives block b-1's combined
 // force of the slot's FrictionOut (SlotForce::combinedOf): one block late whatever the node
 // order (ARCHITECTURE.md, the audio drive). A block that no writer framed (none left, Cmd-., a
 // paused writer) drives 0 at once, as the board goes off at once (Device::requestOff); a gap in
@@ -26,9 +28,10 @@ class SlotDrive {
   AudioDrive* publish(AudioDrive* drive, uint32_t generation);
   bool hasDrive() const { return drive_ != nullptr; }
 
-  // This block's drive samples (clock.numSamples of them, at most kMaxBlockSamples), or null:
-  // no chain, a chain loaded for another device than `generation`, or the drives halted.
-  const float* samples(const BlockClock& clock, uint32_t generation, const SlotForce& force);
+  // This block's drive samples (clock.numSamples of them, at most kMaxBlockSamples) for the
+  // first caller of the block, or null: no chain, a chain loaded for another device than
+  // `generation`, the drives halted, or (`another` true) another caller had this block's drive.
+  const float* samples(const BlockClock& clock, uint32_t generation, const SlotForce& force, bool& another);
 
  private:
   AudioDrive* drive_ = nullptr;

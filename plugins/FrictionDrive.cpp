@@ -2,8 +2,9 @@
 // (ARCHITECTURE.md, the audio drive): the slot's one force (every FrictionOut of it together)
 // through the safety path and the drive calibration (kfDriveCalibrate), sample by sample, one
 // block late. 0 while no calibration is loaded for the slot's device, no writer framed the
-// previous block, or an exit signal came. Input: device (slot index). Output: sample values for
-// Out.ar to the interface's channel.
+// previous block, or an exit signal came; 0 also from every FrictionDrive of the slot but the
+// first to run in a block (a slot has one drive: two summed into one channel stay safe).
+// Input: device (slot index). Output: sample values for Out.ar to the interface's channel.
 #include "AudioClock.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
@@ -38,9 +39,19 @@ class FrictionDrive : public SCUnit {
       return;
     }
     mSlot.isNew(generation);
-    const float* samples = drive->samples(clock, generation, *force);
+    bool another = false;
+    const float* samples = drive->samples(clock, generation, *force, another);
+    if (samples == nullptr && another) {
+      if (mNotes.first(kAnotherDrive))
+        kf::sc::postFromRt(mWorld,
+                           "FrictionDrive: the device at index %d has one drive, and another FrictionDrive of "
+                           "it ran first in this block; this one's output is 0.\n",
+                           index);
+      std::fill_n(output, numSamples, 0.0f);
+      return;
+    }
     if (samples == nullptr) {
-      if (mNoChain.first(0))
+      if (mNotes.first(kNoChain))
         kf::sc::postFromRt(mWorld,
                            "FrictionDrive: no drive calibration is loaded for the device at index %d "
                            "(FrictionDevice.loadDrive); its output is 0.\n",
@@ -54,7 +65,8 @@ class FrictionDrive : public SCUnit {
   }
 
   kf::sc::SlotFollower mSlot;
-  kf::sc::FirstTimeOnly mNoChain;
+  enum Note { kNoChain, kAnotherDrive };
+  kf::sc::FirstTimeOnly mNotes;
 };
 
 }  // namespace

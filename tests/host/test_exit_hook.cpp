@@ -163,11 +163,12 @@ TEST_CASE("a signal zeroes every audio drive, also when the host's handler keeps
     auto clock = [](int64_t block) { return kf::sc::BlockClock{block, block * 64 / 48000.0, 1.0 / 48000.0, 64}; };
     force.write(clock(0), forceN, 1, sink);
     force.write(clock(1), forceN, 1, sink);
-    const float* before = drive->samples(clock(1), 1, force);
+    bool another = false;
+    const float* before = drive->samples(clock(1), 1, force, another);
     (void)!write(fd, before != nullptr && before[63] > 0.0f ? "d" : "-", 1);  // driving before
     raise(SIGUSR1);
     force.write(clock(2), forceN, 1, sink);
-    (void)!write(fd, drive->samples(clock(2), 1, force) == nullptr ? "0" : "-", 1);  // nothing after
+    (void)!write(fd, drive->samples(clock(2), 1, force, another) == nullptr ? "0" : "-", 1);  // nothing after
     std::_Exit(0);
   });
   CHECK(WIFEXITED(status));

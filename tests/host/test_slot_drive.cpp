@@ -1,6 +1,7 @@
 // SlotDrive: a slot's audio drive drives the previous block's combined force, the same whichever
-// side of the writers it runs, computes each block once, and is 0 at once when no writer framed
-// the previous block, for another device's chain, or without a chain.
+// side of the writers it runs, for the first caller of a block only (a slot has one drive), and is
+// 0 at once when no writer framed the previous block, for another device's chain, or without a
+// chain.
 #include <catch2/catch.hpp>
 #include <memory>
 #include <vector>
@@ -46,8 +47,11 @@ struct Slot {
     std::vector<float> f(kBlock, forceN);
     force->write(clockOf(block), f.data(), kBlock, sink);
   }
+  // What a FrictionDrive outputs: the drive, or 0 for a second caller in a block (empty: no chain).
   std::vector<float> samples(int64_t block, uint32_t generation = 7) {
-    const float* s = drive->samples(clockOf(block), generation, *force);
+    bool another = false;
+    const float* s = drive->samples(clockOf(block), generation, *force, another);
+    if (another) return std::vector<float>(kBlock, 0.0f);
     return s == nullptr ? std::vector<float>{} : std::vector<float>(s, s + kBlock);
   }
 };
@@ -73,14 +77,26 @@ std::vector<float> slice(const std::vector<float>& v, int block) {
 TEST_CASE("the drive is the previous block's force, whichever side of the writer it runs", "[slot-drive]") {
   Slot slot;
   slot.write(0, 1.0f);
-  const std::vector<float> after = slot.samples(1);  // before the writer of block 1
+  const std::vector<float> before = slot.samples(1);  // before the writer of block 1
   slot.write(1, 0.5f);
-  CHECK(slot.samples(1) == after);  // computed once per block: the same after the writer
   const std::vector<float> want = expected({1.0f, 0.5f});
-  CHECK(after == slice(want, 0));
+  CHECK(before == slice(want, 0));
   slot.write(2, 0.5f);
   CHECK(slot.samples(2) == slice(want, 1));  // after the writer of block 2: still block 1's force
-  CHECK(after.back() > 0.0f);
+  CHECK(before.back() > 0.0f);
+}
+
+TEST_CASE("a second FrictionDrive of the slot in the same block gets zeros: a slot has one drive", "[slot-drive]") {
+  Slot slot;
+  slot.write(0, 1.4f);
+  const std::vector<float> first = slot.samples(1);
+  CHECK(first.back() > 0.0f);
+  CHECK(slot.samples(1) == std::vector<float>(kBlock, 0.0f));  // the second caller, before the writer
+  slot.write(1, 1.4f);
+  CHECK(slot.samples(1) == std::vector<float>(kBlock, 0.0f));  // and after it
+  // The first caller's drive goes on as if alone (the second took nothing from its slew).
+  slot.write(2, 1.4f);
+  CHECK(slot.samples(2) == slice(expected({1.4f, 1.4f}), 1));
 }
 
 TEST_CASE("no writer framed the previous block: 0 at once, then up from the magnet off", "[slot-drive]") {
