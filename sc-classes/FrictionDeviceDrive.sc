@@ -20,19 +20,20 @@
 
 	// The audio drive's latency beside the audio path (both leave through the interface): one
 	// server block (FrictionDrive drives the previous block's force) plus the current source's
-	// and the coil's declared latencies, in s; nil without a drive.
+	// and the magnet's declared delays, in s; nil without a drive.
 	driveLatency {
 		^driveSetup !? { |d|
 			server.options.blockSize / (server.sampleRate ? server.options.sampleRate ? 48000) + d[\circuitLatencyS]
 		}
 	}
 
-	// currentSourceLatencyS + coilTimeConstantS of a kf-drive file (the server checked it).
+	// currentSourceLatencyS + magnetLagS of a kf-drive file (the server checked it). Fields are
+	// split at any white space (spaces, tabs, CR), as the server's reader (DriveCircuit.cpp) does.
 	*driveCircuitLatencyOf { |path|
 		var sum = 0;
 		File.readAllString(path).split($\n).do { |line|
-			var fields = line.split($#).first.split($ ).reject(_.isEmpty);
-			if(fields.size == 2 and: { [\currentSourceLatencyS, \coilTimeConstantS].includes(fields[0].asSymbol) }) {
+			var fields = line.split($#).first.collect { |c| if(c.isSpace) { $  } { c } }.split($ ).reject(_.isEmpty);
+			if(fields.size == 2 and: { [\currentSourceLatencyS, \magnetLagS].includes(fields[0].asSymbol) }) {
 				sum = sum + fields[1].asFloat
 			}
 		};

@@ -82,7 +82,7 @@ def run(bench):
                      **{f"{key}DelayMs": (_edge(x, floor, first, f) - _edge(requested, floor, first, f)) * 1000 / SR
                         for key, f in (("onset", 0.01), ("half", 0.5))}}
     dev = profile.device()
-    declared = CIRCUIT["currentSourceLatencyS"] + CIRCUIT["coilTimeConstantS"]
+    declared = CIRCUIT["currentSourceLatencyS"] + CIRCUIT["magnetLagS"]
     drive_audio_delay = BLOCK / SR + declared  # FrictionDevice.audioDelay with the drive loaded
     out["drive"]["declaredMs"] = declared * 1000
     out["drive"]["audioDelayMs"] = drive_audio_delay * 1000

@@ -11,15 +11,16 @@ from . import profile
 MAGNET = [(0.0, 0.14), (0.25, 0.41), (0.5, 0.72), (1.0, 1.4)]
 # 2 A full scale through 0.5 A/V: 4 V of a 10 V channel, inverted; safe to 1.8 A (drive 0.9).
 CIRCUIT = dict(fullScaleCurrentA=2.0, transconductanceAPerV=0.5, outputFullScaleV=10.0, outputSign=-1.0,
-               maxSafeCurrentA=1.8, currentSourceLatencyS=0.00002, coilTimeConstantS=0.0004)
+               maxSafeCurrentA=1.8, currentSourceLatencyS=0.00002, magnetLagS=0.0004)
 
 
-def write_files(folder, circuit=CIRCUIT, magnet=MAGNET, name="drive"):
-    """Writes <name>.kfdrive and its magnet table <name>-magnet.kfcal in folder; the drive's path."""
+def write_files(folder, circuit=CIRCUIT, magnet=MAGNET, name="drive", separator=" "):
+    """Writes <name>.kfdrive (its fields separated by `separator`) and its magnet table
+    <name>-magnet.kfcal in folder; the drive's path."""
     table = folder / f"{name}-magnet.kfcal"
     table.write_text("kf-calibration 1\n" + "".join(f"{d!r} {f!r}\n" for d, f in magnet))
     path = folder / f"{name}.kfdrive"
-    path.write_text(f"kf-drive 1\nmagnetTable {table.name}\n" + "".join(f"{k} {v!r}\n" for k, v in circuit.items()))
+    path.write_text(f"kf-drive 1\nmagnetTable {table.name}\n" + "".join(f"{k}{separator}{v!r}\n" for k, v in circuit.items()))
     return path
 
 

@@ -36,7 +36,7 @@ std::string writeDriveFiles(const std::string& folder) {
   std::ofstream(folder + "/drive-magnet.txt") << "kf-calibration 1\n0 0.14\n1 1.4\n";
   std::ofstream(folder + "/drive.txt") << "kf-drive 1\nmagnetTable drive-magnet.txt\nfullScaleCurrentA 2\n"
                                           "transconductanceAPerV 0.5\noutputFullScaleV 10\noutputSign -1\n"
-                                          "maxSafeCurrentA 2\ncurrentSourceLatencyS 0\ncoilTimeConstantS 0\n";
+                                          "maxSafeCurrentA 2\ncurrentSourceLatencyS 0\nmagnetLagS 0\n";
   return folder + "/drive.txt";
 }
 

@@ -27,6 +27,10 @@ def force_script():
 def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_sample():
     work = paths.work_dir()
     drive_path = drive.write_files(work, name="nrt-drive")
+    # The same circuit with tabs between names and values: the server reads that one (tabs are
+    # white space to it), and sclang must take the same audio delay from either.
+    tab_path = drive.write_files(work, name="nrt-drive-tab", separator="\t")
+    declared_s = drive.CIRCUIT["currentSourceLatencyS"] + drive.CIRCUIT["magnetLagS"]
     force_path = work / "nrt-drive-force.wav"
     soundfile.write(str(force_path), force_script(), SR, subtype="FLOAT")
     b_dur_s = 0.0395  # writer B lasts 1896 samples from 4992: it ends at 6888, inside block 107
@@ -37,12 +41,18 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
         // Each drive on its own channel and on channel 4, which sums them.
         var drive = SynthDef(\\nrtdrive, {{ |out| var d = FrictionDrive.ar(0); Out.ar(out, d); Out.ar(4, d) }});
         var a = SynthDef(\\nrtdriveA, {{ var f = PlayBuf.ar(1, 10); FrictionOut.ar(0, f); Out.ar(1, f) }});
+        var spaced = FrictionDevice.driveCircuitLatencyOf("{drive_path}");
+        var tabbed = FrictionDevice.driveCircuitLatencyOf("{tab_path}");
         var b = SynthDef(\\nrtdriveB, {{
             var f = DC.ar(0.6) * EnvGen.ar(Env([1, 1], [{b_dur_s}]), doneAction: 2);
             FrictionOut.ar(0, f); Out.ar(2, f) }});
+        // sclang's reader splits fields as the server's does: both files, the declared delays.
+        if((spaced - {declared_s!r}).abs > 1e-12 or: {{ tabbed != spaced }}) {{
+            Error("driveCircuitLatencyOf: % with spaces, % with tabs, declared {declared_s!r}".format(spaced, tabbed)).throw
+        }};
         score = Score([
             [0.0, dev.openMsg],
-            [0.0, dev.loadDriveMsg("{drive_path}")],
+            [0.0, dev.loadDriveMsg("{tab_path}")],
             [0.0, ['/b_allocRead', 10, "{force_path}"]],
             [0.0, ['/d_recv', drive.asBytes]], [0.0, ['/d_recv', a.asBytes]], [0.0, ['/d_recv', b.asBytes]],
             // One FrictionDrive before the writers in node order (channel 0), one after (3).

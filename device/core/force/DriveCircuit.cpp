@@ -32,7 +32,7 @@ constexpr Field kFields[] = {
     {"outputSign", &DriveCircuit::outputSign, -1.0, 1.0, false},
     {"maxSafeCurrentA", &DriveCircuit::maxSafeCurrentA, 0.0, 100.0, true},
     {"currentSourceLatencyS", &DriveCircuit::currentSourceLatencyS, 0.0, 0.1, false},
-    {"coilTimeConstantS", &DriveCircuit::coilTimeConstantS, 0.0, 0.1, false},
+    {"magnetLagS", &DriveCircuit::magnetLagS, 0.0, 0.1, false},
 };
 constexpr int kNumFields = sizeof kFields / sizeof kFields[0];
 
@@ -86,6 +86,10 @@ bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string
     }
     const Field* field =
         std::find_if(std::begin(kFields), std::end(kFields), [&](const Field& f) { return key == f.key; });
+    if (key == "coilTimeConstantS")  // an early field: L/R is no delay with a current source
+      return fail(
+          "coilTimeConstantS is no longer a field: declare magnetLagS, the force's delay behind the current "
+          "measured with a force gauge (docs/drive-format.md)");
     if (field == std::end(kFields)) return fail("unknown field \"" + key + "\"");
     const int index = static_cast<int>(field - kFields);
     if (seen[index]) return fail(key + " is given twice");

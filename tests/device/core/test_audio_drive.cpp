@@ -54,7 +54,7 @@ const char* kGoodDrive =
     "kf-drive 1\n"
     "magnetTable drive-magnet.txt\n"
     "fullScaleCurrentA 2\ntransconductanceAPerV 0.5\noutputFullScaleV 10\noutputSign -1\n"
-    "maxSafeCurrentA 1.5\ncurrentSourceLatencyS 0.00002\ncoilTimeConstantS 0.0004\n";
+    "maxSafeCurrentA 1.5\ncurrentSourceLatencyS 0.00002\nmagnetLagS 0.0004\n";
 
 }  // namespace
 
@@ -174,7 +174,9 @@ TEST_CASE("inconsistent or broken kf-drive files are refused with the reason", "
       {replaced("outputFullScaleV 10", "outputFullScaleV nan"), "expected \"outputFullScaleV <number>\""},
       {replaced("outputFullScaleV 10", "outputFullScaleV 0"), "outputFullScaleV 0 is not in (0, 100]"},
       {replaced("maxSafeCurrentA 1.5", "maxSafeCurrentA -1"), "maxSafeCurrentA -1 is not in"},
-      {replaced("coilTimeConstantS 0.0004\n", ""), "coilTimeConstantS is missing"},
+      {replaced("magnetLagS 0.0004\n", ""), "magnetLagS is missing"},
+      // The coil's L/R was once declared as if it were a delay: refused, saying what to declare.
+      {replaced("magnetLagS", "coilTimeConstantS"), "coilTimeConstantS is no longer a field: declare magnetLagS"},
       {replaced("outputSign -1", "outputSign -1\noutputSign 1"), "outputSign is given twice"},
       {replaced("outputSign -1", "outputGain 2"), "unknown field \"outputGain\""},
       {replaced("magnetTable drive-magnet.txt\n", ""), "magnetTable is missing"},
