@@ -26,9 +26,13 @@ SlotDrive::SlotDrive() = default;
 
 AudioDrive* SlotDrive::publish(AudioDrive* drive, uint32_t generation) {
   AudioDrive* previous = drive_;
+  const bool sameDevice = previous != nullptr && drive != nullptr && generation == generation_;
+  if (sameDevice)
+    drive->continueFrom(*previous);
+  else
+    computedBlock_ = -1;  // another device: its drive starts from the magnet off
   drive_ = drive;
   generation_ = generation;
-  computedBlock_ = -1;
   return previous;
 }
 

@@ -24,7 +24,9 @@ class SlotDrive {
   SlotDrive();
 
   // Publishes `drive` (null: none) for the device of `generation`; returns the previous chain
-  // for an NRT stage to delete. The block computed so far is dropped.
+  // for an NRT stage to delete. A chain for the same device (a reload) goes on from the
+  // previous one's heat and slew, in the same run of blocks; for another device it starts
+  // from the magnet off.
   AudioDrive* publish(AudioDrive* drive, uint32_t generation);
   bool hasDrive() const { return drive_ != nullptr; }
 

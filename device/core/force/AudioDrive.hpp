@@ -22,6 +22,11 @@ class AudioDrive {
   void process(const float* forceN, int numSamples, float* sampleOut);
   // The magnet off (no writer, a gap in the blocks): the next sample slews up from the minimum.
   void off() { safety_.resetToOff(); }
+  // This chain replaces `previous` on the same coil (a reload): it goes on from its heat and
+  // slew, so a reload neither cools the coil nor restarts the slew. No allocation (RT stage).
+  void continueFrom(const AudioDrive& previous) {
+    safety_.continueFrom(previous.safety_, previous.circuit_.fullScaleCurrentA / circuit_.fullScaleCurrentA);
+  }
 
   // The force the last sample commands (after the limits) and its drive level.
   float commandedForceN() const { return safety_.commandedForceN(); }

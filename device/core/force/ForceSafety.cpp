@@ -74,6 +74,17 @@ bool ForceSafety::checkWatchdog(double nowS) {
   return true;
 }
 
+void ForceSafety::continueFrom(const ForceSafety& previous, double driveScale) {
+  heat_ = previous.heat_ * driveScale * driveScale;
+  driveLevel_ = static_cast<float>(std::clamp(previous.driveLevel_ * driveScale, 0.0, 1.0));
+  slewedN_ = previous.slewedN_;
+  commandedForceN_ = previous.commandedForceN_;
+  lastFrameTimeS_ = previous.lastFrameTimeS_;
+  lastArrivalS_ = previous.lastArrivalS_;
+  haveFrame_ = previous.haveFrame_;
+  watchdogArmed_ = previous.watchdogArmed_;
+}
+
 void ForceSafety::resetToOff() {
   commandedForceN_ = static_cast<float>(spec_.minForceN);
   slewedN_ = spec_.minForceN;

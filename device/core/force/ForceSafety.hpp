@@ -31,6 +31,11 @@ class ForceSafety {
 
   // The magnet was driven off (close, trip): the next frame slews up from minForceN.
   void resetToOff();
+  // Goes on from `previous`, the path this one replaces on the same coil (a reloaded
+  // calibration): its heat, its slew and its last drive. `driveScale` turns the previous drive
+  // levels into this one's (the ratio of their full-scale currents), so the heat stays the
+  // coil's mean current squared.
+  void continueFrom(const ForceSafety& previous, double driveScale);
 
   // Replaces the calibration (default: linear from minForceN at drive 0 to maxForceN at 1).
   // Allocates: not from the audio thread.
