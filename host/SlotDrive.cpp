@@ -63,6 +63,16 @@ const float* SlotDrive::samples(const BlockClock& clock, uint32_t generation, co
 
 SlotDrive* driveOfSlot(int index) { return isValidSlot(index) ? &gDrives[index] : nullptr; }
 
+bool publishDriveIfSameDevice(int index, uint32_t generation, const Device* device, AudioDrive*& drive) {
+  // The generation names the device wherever and whenever it was opened: a device opened at the
+  // address of a closed one has another. The pointer as well: the NRT stage's two reads are not
+  // one, and an exchange between them (generation first, then device) pairs the new generation
+  // with the old device, which the pointer tells apart.
+  if (!isValidSlot(index) || generationOfSlot(index) != generation || peekSlot(index) != device) return false;
+  drive = gDrives[index].publish(drive, generation);
+  return true;
+}
+
 void haltAllDrives() { gDrivesHalted.store(true, std::memory_order_relaxed); }
 
 }  // namespace kf::sc

@@ -15,6 +15,10 @@
 #include "SlotForce.hpp"
 #include "core/force/AudioDrive.hpp"
 
+namespace kf {
+class Device;
+}
+
 namespace kf::sc {
 
 class SlotDrive {
@@ -44,6 +48,12 @@ class SlotDrive {
 
 // Audio thread: the slot's drive, null for an invalid index.
 SlotDrive* driveOfSlot(int index);
+
+// RT stage of kfDriveCalibrate: publishes `drive` in slot `index` if the slot still holds the
+// device the NRT stage built it for, `generation` and `device` as that stage read them (in that
+// order), and hands back the chain it replaced in `drive`. False when the slot's device changed
+// meanwhile (closed, replaced, even by a new device at the same address): `drive` is untouched.
+bool publishDriveIfSameDevice(int index, uint32_t generation, const Device* device, AudioDrive*& drive);
 
 // Signal handlers (ExitSafety): every drive outputs 0 from the next block on, for good (the
 // process is on its way out; should a host's handler keep it alive, the drives stay at 0).

@@ -159,6 +159,7 @@ CommandData* newCommand(World* world, const char* name, CommandShape shape, sc_m
   }
   data->name = name;
   data->device = data->previous = nullptr;
+  data->generation = 0;
   data->replace = data->failed = data->ownsDevice = false;
   data->threadPriority = kf::kAutoPriority;
   // The audio thread's priority, for the device threads' own (ThreadScheduling): commands run in

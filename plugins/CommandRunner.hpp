@@ -27,6 +27,7 @@ struct CommandData {
   const char* name;
   CommandArgs args;      // args.values: the hand script (kfOpenSim only), RTAlloc'd to its size
   kf::Device* device;    // opened by stage 2, or the target of record/status
+  uint32_t generation;   // kfDriveCalibrate: the slot's generation stage 2 built the chain for
   kf::Device* previous;  // swapped out of the slot, deleted in an NRT stage
   bool replace;          // open commands: a device in the slot is closed, not refused
   int threadPriority;    // open commands: the device's threads (ThreadScheduling), kAutoPriority

@@ -24,6 +24,8 @@ void deleteDrive(void* drive) { delete static_cast<kf::AudioDrive*>(drive); }
 
 bool buildStage(World* world, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
+  // The generation first: the RT stage compares both (publishDriveIfSameDevice).
+  data->generation = generationOfSlot(data->args.index);
   data->device = peekSlot(data->args.index);
   if (data->device == nullptr) {
     failWith(data, "kfDriveCalibrate: no device is open at index %d", data->args.index);
@@ -44,13 +46,13 @@ bool buildStage(World* world, void* raw) {  // NRT
 bool publishDriveStage(World*, void* raw) {  // RT
   auto* data = static_cast<CommandData*>(raw);
   // The chain was made for the device stage 2 saw; another one (closed, replaced) is refused.
-  if (peekSlot(data->args.index) != data->device) {
+  auto* chain = static_cast<kf::AudioDrive*>(data->extra);
+  if (!publishDriveIfSameDevice(data->args.index, data->generation, data->device, chain)) {
     failWith(data, "kfDriveCalibrate: the device at index %d changed while the file was read; load it again",
              data->args.index);
     return true;  // stage 4 still runs, and deletes the chain
   }
-  SlotDrive* drive = driveOfSlot(data->args.index);
-  data->extra = drive->publish(static_cast<kf::AudioDrive*>(data->extra), generationOfSlot(data->args.index));
+  data->extra = chain;  // the chain it replaced, for stage 4
   data->deleteExtra = deleteDrive;
   return true;
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "DeviceSlots.hpp"
 #include "SlotDrive.hpp"
 
 using kf::sc::BlockClock;
@@ -169,4 +170,31 @@ TEST_CASE("a reloaded drive of the same device goes on hot and slewed: its first
   REQUIRE(cold != nullptr);
   CHECK(cold[0] < 0.1f);
   delete drive->publish(nullptr, 0);
+}
+
+TEST_CASE("a drive is published only for the device its NRT stage saw, told by generation", "[slot-drive]") {
+  using kf::sc::exchangeSlot;
+  using kf::sc::generationOfSlot;
+  using kf::sc::peekSlot;
+  using kf::sc::publishDriveIfSameDevice;
+  constexpr int kIndex = 9;                              // no other test of this executable uses it
+  const uint32_t generation = generationOfSlot(kIndex);  // stage 2: the generation, then the device
+  const kf::Device* device = peekSlot(kIndex);
+  // Between the stages the slot's device is replaced by one at the same address (here null, the
+  // slot closed again: the pointer alone cannot tell): refused, the chain left to the caller.
+  CHECK(exchangeSlot(kIndex, nullptr) == nullptr);
+  kf::AudioDrive* const built = new kf::AudioDrive(kf::DeviceSpec{}, circuit(), 48000.0);
+  kf::AudioDrive* chain = built;
+  CHECK_FALSE(publishDriveIfSameDevice(kIndex, generation, device, chain));
+  CHECK(chain == built);
+  CHECK_FALSE(kf::sc::driveOfSlot(kIndex)->hasDrive());
+  // A new generation read with the old device (an exchange between stage 2's two reads): refused.
+  int elsewhere = 0;
+  CHECK_FALSE(publishDriveIfSameDevice(kIndex, generationOfSlot(kIndex),
+                                       reinterpret_cast<const kf::Device*>(&elsewhere), chain));
+  // The slot unchanged since stage 2: published, the replaced chain (none) handed back.
+  CHECK(publishDriveIfSameDevice(kIndex, generationOfSlot(kIndex), peekSlot(kIndex), chain));
+  CHECK(chain == nullptr);
+  CHECK(kf::sc::driveOfSlot(kIndex)->publish(nullptr, 0) == built);
+  delete built;
 }
