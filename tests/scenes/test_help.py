@@ -1,4 +1,6 @@
 """Every .schelp file parses with SCDoc, and every code example in it compiles."""
+import re
+
 from kfharness import paths, sclang
 
 HELP_DIR = paths.REPO_DIR / "HelpSource"
@@ -42,3 +44,12 @@ def test_every_class_has_a_help_file():
     assert classes
     missing = [c for c in classes if not (HELP_DIR / "Classes" / f"{c}.schelp").exists()]
     assert not missing, f"classes without a help file: {missing}"
+
+
+def test_no_help_example_sends_the_drive_to_a_numbered_hardware_channel():
+    """The drive is a DC level: a help example that sends FrictionDrive to a bare channel number
+    (0: usually speakers) pushes a speaker's cone out and holds it. Examples use a private bus, or
+    a variable named for the hardware channel of the current source."""
+    numbered = re.compile(r"Out\.ar\(\s*\d+\s*,\s*FrictionDrive")
+    found = [f"{f.name}: {m.group(0)}" for f in sorted(HELP_DIR.rglob("*.schelp")) for m in numbered.finditer(f.read_text())]
+    assert not found, found
