@@ -2,11 +2,17 @@
 (FrictionOut's commanded force, what the device's frames carry), on one NRT scene: force pulses of
 0.5 N above the minimum, 8 ms down to 0.0625 ms wide, each once on a frame border and once half a
 frame after it. Per path: the shortest pulse that reaches 90 % of its height at both phases (the
-shortest force feature it shows), and the delay of its rising edge behind the request. The sound
-is delayed by the device's audioDelay: the offset between sound and force is then the path's
-delay (measured here, plus what it declares beyond the digital path) less that audioDelay. The
-board's realtime frame latency (its jitter buffer) is not in an NRT render: the e2e part measures
-it, and the offset uses the paper's declared tactile latency for it."""
+shortest force feature it shows), and the delay of its rising edge behind the request.
+
+The offset between sound and force, for the audio drive, in the same render: the request played
+as sound through a DelayL by the drive's audio delay as sclang computes it for the pilot (one
+block + FrictionDevice.driveCircuitLatencyOf the drive file, FrictionDevice.driveLatency's sum),
+against the drive output's onset, to which the circuit's declared delays are added (no current
+source or magnet is in a render: their delays are the file's). So it measures whether the sound
+delay the pilot uses puts the sound where the force reaches the magnet: the file read by
+sclang, the block FrictionDrive waits, and the delay line's own rounding. The board's realtime
+frame latency (its jitter buffer) is not in an NRT render: the e2e part measures it; its sound
+delay is the paper's declared tactile - audio latency."""
 import numpy as np
 import soundfile
 
@@ -54,18 +60,21 @@ def run(bench):
     soundfile.write(str(force_path), force, SR, subtype="FLOAT")
     data, _ = nrt.score_and_render("bench-drive", f"""
         var dev = FrictionDevice.sim(nil, 0);
+        // The pilot's sound delay with this drive (FrictionDevice.driveLatency, in NRT: no server).
+        var delay = {BLOCK} / {SR} + FrictionDevice.driveCircuitLatencyOf("{drive_path}");
         var def = SynthDef(\\benchdrive, {{ var f = PlayBuf.ar(1, 10);
-            Out.ar(0, [FrictionOut.ar(0, f), FrictionDrive.ar(0), f]) }});
+            Out.ar(0, [FrictionOut.ar(0, f), FrictionDrive.ar(0), f, DelayL.ar(f, 0.05, delay)]) }});
         score = Score([
             [0.0, dev.openMsg], [0.0, dev.loadDriveMsg("{drive_path}")],
             [0.0, ['/b_allocRead', 10, "{force_path}"]], [0.0, ['/d_recv', def.asBytes]],
             [0.0, Synth.basicNew(\\benchdrive, nil, 1000).newMsg(RootNode(Server.default), nil, \\addToTail)],
             [{len(force) / SR + 0.01}, ['/c_set', 0, 0]]]);
-    """, sample_rate=SR, channels=3)
+    """, sample_rate=SR, channels=4)
     floor = profile.device()["minForceN"]
     board = data[:, 0].astype(np.float64)
     audio_drive = floor + 1.26 * data[:, 1].astype(np.float64)  # back to N through the linear table
     requested = data[:, 2].astype(np.float64)
+    sound = data[:, 3].astype(np.float64)  # the request as sound, delayed as the pilot would
     paths = {"board": board, "drive": audio_drive}
     out = {"pulses": [], "sampleRateHz": SR, "blockSize": BLOCK, "heightN": HEIGHT_N}
     for start, width, width_ms, phase_ms in pulses:
@@ -74,19 +83,21 @@ def run(bench):
         for name, x in paths.items():
             entry[name] = float((x[window].max() - floor) / HEIGHT_N)
         out["pulses"].append(entry)
+    first = pulses[0][0]
     for name, x in paths.items():
         shows = [w for w in WIDTHS_MS if all(p[name] >= 0.9 for p in out["pulses"] if p["widthMs"] == w)]
-        first = pulses[0][0]
         # Onset: the first sample 1 % up (the latency itself); half: 50 % up (with the rise).
         out[name] = {"shortestFeatureMs": min(shows) if shows else None,
                      **{f"{key}DelayMs": (_edge(x, floor, first, f) - _edge(requested, floor, first, f)) * 1000 / SR
                         for key, f in (("onset", 0.01), ("half", 0.5))}}
     dev = profile.device()
     declared = CIRCUIT["currentSourceLatencyS"] + CIRCUIT["magnetLagS"]
-    drive_audio_delay = BLOCK / SR + declared  # FrictionDevice.audioDelay with the drive loaded
+    # Onsets (1 % up), as the drive's: where the sound starts and where the force starts to rise.
+    sound_onset_ms = (_edge(sound, floor, first, 0.01) - _edge(requested, floor, first, 0.01)) * 1000 / SR
     out["drive"]["declaredMs"] = declared * 1000
-    out["drive"]["audioDelayMs"] = drive_audio_delay * 1000
-    out["drive"]["soundForceOffsetMs"] = out["drive"]["onsetDelayMs"] + declared * 1000 - drive_audio_delay * 1000
+    out["drive"]["soundDelayMs"] = sound_onset_ms
+    # At the magnet: the drive's output plus the circuit's declared delays; positive: force late.
+    out["drive"]["soundForceOffsetMs"] = out["drive"]["onsetDelayMs"] + declared * 1000 - sound_onset_ms
     out["board"]["audioDelayMs"] = (dev["tactileLatencyS"] - dev["audioLatencyS"]) * 1000
     out["board"]["declaredTactileLatencyMs"] = dev["tactileLatencyS"] * 1000
     return out
@@ -102,7 +113,24 @@ def summary_lines(d):
                  f"sound delayed {b['audioDelayMs']:.2f} ms")
     lines.append(f"  audio drive: shortest feature {a['shortestFeatureMs']} ms; drive onset {a['onsetDelayMs']:.3f} ms "
                  f"(half height {a['halfDelayMs']:.3f} ms) behind the request, + {a['declaredMs']:.2f} ms declared "
-                 f"circuit; sound delayed {a['audioDelayMs']:.3f} ms: offset sound-force {a['soundForceOffsetMs']:+.3f} ms")
+                 f"circuit delays; the pilot's sound delay measured in the render {a['soundDelayMs']:.3f} ms: "
+                 f"force - sound {a['soundForceOffsetMs']:+.3f} ms")
     lines.append("  peak reached (fraction of the pulse) by width ms/phase ms: " + ", ".join(
         f"{p['widthMs']}/{p['phaseMs']}: board {p['board']:.2f} drive {p['drive']:.2f}" for p in d["pulses"]))
     return lines
+
+
+def report_tables(d, table):
+    """REPORT.md's tables (report.py's `table`): the two paths side by side, and each pulse."""
+    b, a = d["board"], d["drive"]
+    rows = [("board, 1 ms frames", b["shortestFeatureMs"], f"{b['onsetDelayMs']:.3f}", f"{b['halfDelayMs']:.3f}",
+             f"the realtime frame latency (paper: {b['declaredTactileLatencyMs']:.1f} ms tactile)",
+             f"{b['audioDelayMs']:.3f} (declared)", "-"),
+            ("audio drive", a["shortestFeatureMs"], f"{a['onsetDelayMs']:.3f}", f"{a['halfDelayMs']:.3f}",
+             f"{a['declaredMs']:.3f} (the circuit's declared delays)", f"{a['soundDelayMs']:.3f} (measured)",
+             f"{a['soundForceOffsetMs']:+.3f}")]
+    paths = table(["path", "shortest feature (ms)", "force onset behind request (ms)", "half height (ms)",
+                   "added outside the render (ms)", "sound delay (ms)", "force - sound (ms)"], rows)
+    pulses = table(["width (ms)", "phase (ms)", "board peak", "drive peak"],
+                   [(p["widthMs"], p["phaseMs"], f"{p['board']:.2f}", f"{p['drive']:.2f}") for p in d["pulses"]])
+    return paths, pulses

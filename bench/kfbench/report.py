@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import goals, realtime, report_rate, spatial, timing
+from . import drive_path, goals, realtime, report_rate, spatial, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -163,6 +163,12 @@ def report_rate_section(rr, build_dir):
                   recordings=report_rate.recordings_table(rr, table), simulated=report_rate.simulated_table(rr, table))
 
 
+def drive_section(dr):
+    paths, pulses = drive_path.report_tables(dr, table)
+    return render("drive", cmd=CMD, rate_khz=dr["sampleRateHz"] // 1000, block=dr["blockSize"],
+                  height_n=dr["heightN"], paths=paths, pulses=pulses)
+
+
 def e2e_section(e2e):
     runs = e2e["runs"]
     rows = [(i + 1, key, f"{r[key]['p50_ms']:.3f}", f"{r[key]['p99_ms']:.3f}", f"{r[key]['max_ms']:.3f}", r[key]["n"])
@@ -240,6 +246,7 @@ def write(results, path, build_dir="build"):
                       ("drift_test", lambda: drift_test_section(get("drift_test"))),
                       ("reconstruction", lambda: reconstruction_section(get("reconstruction"), build_dir)),
                       ("report_rate", lambda: report_rate_section(get("report_rate"), build_dir)),
+                      ("drive", lambda: drive_section(get("drive"))),
                       ("e2e", lambda: e2e_section(get("e2e"))),
                       ("rtload", lambda: rtload_section(get("rtload"))),
                       ("scale", lambda: scale_section(get("scale"))),
