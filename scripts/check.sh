@@ -68,7 +68,8 @@ check_sanitize_plugin() {
   configure_and_build build-asan-plugin -DKF_SANITIZE=address,undefined -DKF_SUPERNOVA=OFF -- --target KineticFriction
   # A finding aborts scsynth, which fails its test; the reports also go to files, so that one in
   # a server whose test did not notice (at exit, say) fails the check too. The leak check stays
-  # off in the server: scsynth does not free its own allocations at exit.
+  # off in the server: scsynth does not free its own allocations at exit. The scene tests run
+  # two at a time; the realtime ones alone (RUN_SERIAL).
   local logs=$PWD/build-asan-plugin/sanitizer-logs rc=0
   rm -rf "$logs" && mkdir -p "$logs"
   # The runtimes of the compiler that built the plugin.
@@ -77,7 +78,7 @@ check_sanitize_plugin() {
   KF_SERVER_PRELOAD="$("$cxx" -print-file-name=libasan.so) $("$cxx" -print-file-name=libubsan.so)" \
     ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:log_path=$logs/asan \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$logs/ubsan \
-    ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j 1 \
+    ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(nproc)" \
     -R "${KF_SANITIZED_TESTS:-scenes/|realtime/}" || rc=$?
   # The reports went to files only: show them whether or not a test noticed.
   if compgen -G "$logs/*" >/dev/null; then
