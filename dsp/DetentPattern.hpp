@@ -5,7 +5,9 @@
 // detent behind the puck in the direction it moves (u' = u moving +, 1 - u moving -), so
 // turning back towards the detent just left is free:
 //   level(u') = u' / c on [0, c),  0 on [c, 1)
-// Rendered as its mean over the frame's travel (closed form), band-limited to the speed.
+// Rendered as its mean over the frame's travel (closed form), band-limited to the speed. Its
+// harmonics in u' (a = 2 pi k): C_k = (1/c) integral of u' e^(-i a u') over [0, c)
+//   = i e^(-i a c) / a + (e^(-i a c) - 1) / (a^2 c).
 #pragma once
 
 #include "PatternTravel.hpp"
@@ -28,6 +30,8 @@ class DetentPattern {
   double integralAlongMotion(double g) const { return g < crest_ ? g * g / (2.0 * crest_) : 0.5 * crest_; }
   PeriodicCoordinate coordinate_;
   double crest_ = 0.5;
+  Harmonics harmonics_{};
+  double harmonicsCrest_ = -1.0;
 };
 
 }  // namespace kf::patterns

@@ -7,6 +7,13 @@ void GratingPattern::set(double periodMm, double duty, double edgeMm, double anc
   if (std::isfinite(duty)) duty_ = std::clamp(duty, 0.0, 1.0);
   if (std::isfinite(edgeMm)) edgeMm_ = edgeMm;
   edge_ = std::clamp(edgeMm_ / coordinate_.periodMm(), 0.0, std::min(duty_, 1.0 - duty_));
+  if (duty_ == harmonicsDuty_ && edge_ == harmonicsEdge_) return;
+  for (int k = 1; k <= kMaxHarmonics; ++k) {
+    const double e = M_PI * k * edge_, sincEdge = e > 0.0 ? std::sin(e) / e : 1.0;
+    harmonics_[k - 1] = std::polar(std::sin(M_PI * k * duty_) / (M_PI * k) * sincEdge, -M_PI * k * (duty_ + edge_));
+  }
+  harmonicsDuty_ = duty_;
+  harmonicsEdge_ = edge_;
 }
 
 double GratingPattern::at(double f) const {
@@ -31,10 +38,10 @@ double GratingPattern::integralTo(double f) const {
 double GratingPattern::level(const Travel& travel, bool antialias) const {
   const double u1 = coordinate_.cycles(travel.toMm);
   if (!antialias) return at(fractionOf(u1));
-  const double boxed = periodicMean(
-      coordinate_.cycles(travel.fromMm), u1, duty_, [this](double f) { return integralTo(f); },
-      [this](double f) { return at(f); });
-  return clampLevel(bandLimited(boxed, duty_, travel, coordinate_.periodMm()));
+  const double u0 = coordinate_.cycles(travel.fromMm);
+  const double boxed =
+      periodicMean(u0, u1, duty_, [this](double f) { return integralTo(f); }, [this](double f) { return at(f); });
+  return bandLimitedSeries(boxed, duty_, harmonics_, u0, u1, travel, coordinate_.periodMm());
 }
 
 }  // namespace kf::patterns

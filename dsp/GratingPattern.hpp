@@ -3,7 +3,9 @@
 // duty d is the high part measured at half height, so the level is
 //   u/e on [0, e),  1 on [e, d),  1 - (u - d)/e on [d, d + e),  0 on [d + e, 1)
 // with e (as a fraction of the period) at most min(d, 1 - d). Rendered as its mean over the
-// frame's travel (closed form), band-limited to the speed (PatternTravel.hpp).
+// frame's travel (closed form), band-limited to the speed (PatternTravel.hpp). Its harmonics: a
+// square wave of width d centred on (d + e) / 2, convolved with a box of width e:
+//   C_k = e^(-i pi k (d + e)) sin(pi k d) / (pi k) sinc(pi k e).
 #pragma once
 
 #include "PatternTravel.hpp"
@@ -27,6 +29,8 @@ class GratingPattern {
   double duty_ = 0.5;
   double edge_ = 0.0;  // in periods
   double edgeMm_ = 0.0;
+  Harmonics harmonics_{};
+  double harmonicsDuty_ = -1.0, harmonicsEdge_ = -1.0;  // what harmonics_ were computed for
 };
 
 }  // namespace kf::patterns

@@ -7,6 +7,22 @@ void BumpPattern::set(double periodMm, double widthMm, bool valleys, double anch
   if (widthMm > 0.0 && std::isfinite(widthMm)) widthMm_ = widthMm;
   omega_ = std::clamp(widthMm_ / coordinate_.periodMm(), 1e-6, 1.0);
   valleys_ = valleys;
+  if (omega_ == harmonicsOmega_ && valleys_ == harmonicsValleys_) return;
+  const double half = 0.5 * omega_, b = 2.0 * M_PI / omega_;
+  // E(q) = integral of e^(i q u) over [0, half] = half e^(i q half / 2) sinc(q half / 2).
+  auto E = [half](double q) {
+    const double x = 0.5 * q * half;
+    return std::polar(half * (x == 0.0 ? 1.0 : std::sin(x) / x), x);
+  };
+  for (int k = 1; k <= kMaxHarmonics; ++k) {
+    const double a = 2.0 * M_PI * k;
+    const std::complex<double> first = (E(b - a) - E(-b - a)) / std::complex<double>(0.0, 2.0);
+    const std::complex<double> second = std::polar(1.0, -a * omega_) * std::conj(first);
+    climbingUp_[k - 1] = valleys_ ? second : first;
+    climbingDown_[k - 1] = valleys_ ? first : second;
+  }
+  harmonicsOmega_ = omega_;
+  harmonicsValleys_ = valleys_;
 }
 
 double BumpPattern::height(double f) const {
@@ -37,10 +53,11 @@ double BumpPattern::level(const Travel& travel, bool antialias) const {
   if (!antialias) return at(fractionOf(u1), direction);
   // The climb per cycle of travel, over the steepest (pi / omega): the mean of at() over the travel.
   const double scale = omega_ / M_PI;
+  const double u0 = coordinate_.cycles(travel.fromMm);
   const double boxed = periodicMean(
-      coordinate_.cycles(travel.fromMm), u1, scale, [&](double f) { return scale * climbTo(f, direction); },
-      [&](double f) { return at(f, direction); });
-  return clampLevel(bandLimited(boxed, mean(), travel, coordinate_.periodMm()));
+      u0, u1, scale, [&](double f) { return scale * climbTo(f, direction); }, [&](double f) { return at(f, direction); });
+  return bandLimitedSeries(boxed, mean(), direction > 0 ? climbingUp_ : climbingDown_, u0, u1, travel,
+                           coordinate_.periodMm());
 }
 
 void SlopeOfHeight::setFullSlope(double fullSlope) {

@@ -8,7 +8,10 @@
 // (a valley is -h). Level = the climb in the direction of motion per unit travel, over the
 // steepest slope (pi / omega per period), so the steepest climb is 1. Rendered as its mean over
 // the frame's travel: the climb over the travel (closed form) over the travel, band-limited to
-// the speed.
+// the speed. Its harmonics, climbing along +1 (level sin(2 pi u / omega) on [0, omega / 2)), with
+// a = 2 pi k, b = 2 pi / omega, E(q) = integral of e^(i q u) over [0, omega / 2):
+//   C+_k = (E(b - a) - E(-b - a)) / 2i;  along -1 the mirror image about omega / 2:
+//   C-_k = e^(-i a omega) conj(C+_k); valleys climb where bumps descend (C+ and C- swap).
 //
 // SlopeOfHeight: the same rule on any height signal of the position (a buffer read by
 // SpatialBufRd): level = (height now - height one frame ago) / |travel| / fullSlope, within
@@ -36,6 +39,9 @@ class BumpPattern {
  private:
   double height(double f) const;
   PeriodicCoordinate coordinate_;
+  Harmonics climbingUp_{}, climbingDown_{};  // the level's harmonics moving +1 and -1
+  double harmonicsOmega_ = -1.0;
+  bool harmonicsValleys_ = false;
   double widthMm_ = 0.5;
   double omega_ = 0.5;
   bool valleys_ = false;

@@ -5,14 +5,16 @@
 // A pattern is a level g in [0, 1] (force = minForce + (maxForce - minForce) * g). A pattern of
 // position g(x) is rendered as its mean over the travel of the last frame, [x(t - T), x(t)]
 // (a box filter in space whose length follows the speed), computed in closed form from g's
-// integral; with anti-aliasing on, each periodic part is then faded out as its temporal
-// frequency speed / period rises from a quarter of the frame rate to half of it (the frames'
-// Nyquist frequency), above which only its mean is left. With anti-aliasing off, a pattern is
-// g at the current position (sampled per audio sample: what aliases in the frames).
+// integral; with anti-aliasing on, each harmonic k of a periodic pattern is then weighted on its
+// own temporal frequency k * speed / period, down to 0 at half the frame rate (the frames' Nyquist
+// frequency): the frames get no component they would fold (bandLimitedSeries). With anti-aliasing off, a pattern is g at the current position (sampled per
+// audio sample: what aliases in the frames).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <complex>
 
 namespace kf::patterns {
 
@@ -94,11 +96,27 @@ double periodicMean(double u0, double u1, double perPeriod, Partial partial, Poi
   return ((whole1 - whole0) * perPeriod + partial(f1) - partial(f0)) / length;
 }
 
-// A box-filtered level with its periodic part faded by bandLimitGain(speed / period):
-// mean + gain * (boxed - mean).
-inline double bandLimited(double boxed, double mean, const Travel& travel, double periodMm) {
-  return mean + bandLimitGain(travel.speedMmPerS / periodMm, travel.framePeriodS) * (boxed - mean);
-}
+// The complex Fourier coefficients C_1..C_kMaxHarmonics (index k - 1) of a periodic level of
+// period 1 cycle: g(u) = mean + sum_k 2 Re(C_k e^(i 2 pi k u)). Each pattern has them in closed form.
+constexpr int kMaxHarmonics = 64;
+using Harmonics = std::array<std::complex<double>, kMaxHarmonics>;
+
+// The gain of harmonic k in the band-limited series, r = k / kCut: the cubic B-spline
+// 1 - 6 r^2 + 6 |r|^3 up to |r| = 1/2, 2 (1 - |r|)^3 up to 1, 0 beyond. Its transform is sinc^4,
+// never negative: the series is the pattern smoothed by a kernel >= 0 of unit mass, so it stays
+// within the pattern's range (no ringing past 0 or 1), unlike a flat pass band.
+double splineGain(double r);
+
+// The level of a periodic pattern over the travel [u0, u1] (cycles), band-limited to the 1 ms
+// frames. kStop = (frame rate / 2) / (speed / period): the first harmonic at the frames' Nyquist
+// frequency. Up to kStop = kMaxHarmonics (from 500 * period / 64 mm/s up), the box-filtered
+// harmonics (mean over the travel of e^(i 2 pi k u): e^(i 2 pi k mid) sinc(pi k length)) weighted
+// by splineGain(k / kStop): no component at or above the Nyquist frequency is left (exact). From
+// kStop = 2 kMaxHarmonics down to rest: boxed, the closed-form mean over the travel (the full
+// rendering). Between, h boxed + (1 - h) series with the series cut at kMaxHarmonics and h rising
+// 0 -> 1 (raised cosine in kStop): only harmonics past kMaxHarmonics are left, with weight h.
+double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
+                         double periodMm);
 
 inline double clampLevel(double g) { return g > 0.0 ? (g < 1.0 ? g : 1.0) : 0.0; }
 

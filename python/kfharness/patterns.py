@@ -43,6 +43,63 @@ def fade(frequency_hz, period_s):
     return np.where(f <= passed, 1.0, np.where(f >= stop, 0.0, g))
 
 
+MAX_HARMONICS = 64
+
+
+def spline_gain(r):
+    """PatternTravel.hpp splineGain: the cubic B-spline, 1 at 0, 0 from |r| = 1 on."""
+    a = np.abs(r)
+    return np.where(a <= 0.5, 1 - 6 * a * a + 6 * a ** 3, np.where(a < 1, 2 * (1 - a) ** 3, 0.0))
+
+
+def band_limited_series(boxed, mean, harmonics, u0, u1, speed, period_mm, period_s):
+    """PatternTravel.cpp bandLimitedSeries: the box-filtered harmonics (coefficients harmonics[k - 1],
+    fixed or per sample) weighted by spline_gain(k / k_cut) where k_stop = 500 Hz / (speed / period)
+    is at most MAX_HARMONICS; the closed-form boxed level from twice that on; a crossfade between."""
+    f1 = np.asarray(speed, dtype=np.float64) / period_mm
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k_stop = np.where(f1 > 0, 0.5 / period_s / np.where(f1 > 0, f1, 1), np.inf)
+    h = np.where(k_stop <= MAX_HARMONICS, 0.0, np.where(
+        k_stop < 2 * MAX_HARMONICS, 0.5 * (1 - np.cos(np.pi * (k_stop - MAX_HARMONICS) / MAX_HARMONICS)), 1.0))
+    k_cut = np.minimum(k_stop, MAX_HARMONICS)
+    mid, length = 0.5 * (u0 + u1), np.abs(u1 - u0)
+    phase = 2 * np.pi * (mid - np.floor(mid))
+    series = np.full(np.shape(boxed), float(mean))
+    for k in range(1, MAX_HARMONICS):
+        x = np.pi * k * length
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sinc = np.where(x < 1e-9, 1.0, np.sin(x) / x)
+        line = 2 * np.real(harmonics[k - 1] * np.exp(1j * k * phase)) * sinc
+        series += np.where(k < k_cut, spline_gain(k / k_cut), 0.0) * line
+    return np.where(h >= 1, boxed, h * boxed + (1 - h) * series)
+
+
+def grating_harmonics(duty, edge):
+    """GratingPattern.hpp: C_k = e^(-i pi k (d + e)) sin(pi k d) / (pi k) sinc(pi k e)."""
+    k = np.arange(1, MAX_HARMONICS + 1)
+    return np.exp(-1j * np.pi * k * (duty + edge)) * np.sin(np.pi * k * duty) / (np.pi * k) * np.sinc(k * edge)
+
+
+def bump_harmonics(omega, valleys):
+    """HeightSlopePattern.hpp: (climbing moving +1, moving -1)."""
+    k = np.arange(1, MAX_HARMONICS + 1)
+    a, b, half = 2 * np.pi * k, 2 * np.pi / omega, omega / 2
+
+    def e(q):
+        return half * np.exp(0.5j * q * half) * np.sinc(q * half / (2 * np.pi))
+
+    first = (e(b - a) - e(-b - a)) / 2j
+    second = np.exp(-1j * a * omega) * np.conj(first)
+    return (second, first) if valleys else (first, second)
+
+
+def detent_harmonics(crest):
+    """DetentPattern.hpp: C_k = i e^(-i a c) / a + (e^(-i a c) - 1) / (a^2 c), a = 2 pi k."""
+    a = 2 * np.pi * np.arange(1, MAX_HARMONICS + 1)
+    e = np.exp(-1j * a * crest)
+    return 1j * e / a + (e - 1) / (a * a * crest)
+
+
 def _periodic_mean(u0, u1, per_period, partial, point):
     lo, hi = np.minimum(u0, u1), np.maximum(u0, u1)
     length = hi - lo
@@ -71,7 +128,7 @@ def grating(x, rate, period, duty, edge, antialias=True):
     if not antialias:
         return at(u1 - np.floor(u1))
     boxed = _periodic_mean(u0, u1, d, partial, at)
-    return np.clip(d + fade(speed / period, t) * (boxed - d), 0, 1)
+    return np.clip(band_limited_series(boxed, d, grating_harmonics(d, e), u0, u1, speed, period, t), 0, 1)
 
 
 def bumps(x, rate, period, width, valleys=False, antialias=True):
@@ -98,7 +155,9 @@ def bumps(x, rate, period, width, valleys=False, antialias=True):
         return at(u1 - np.floor(u1))
     scale = omega / np.pi
     boxed = _periodic_mean(u0, u1, scale, lambda f: scale * climb(f), at)
-    return np.clip(scale + fade(speed / period, t) * (boxed - scale), 0, 1)
+    up, down = bump_harmonics(omega, valleys)
+    harmonics = np.where(direction[None, :] > 0, up[:, None], down[:, None])
+    return np.clip(band_limited_series(boxed, scale, harmonics, u0, u1, speed, period, t), 0, 1)
 
 
 def detents(x, rate, spacing, crest, antialias=True):
@@ -113,7 +172,7 @@ def detents(x, rate, spacing, crest, antialias=True):
     if not antialias:
         return along(u1 - np.floor(u1))
     boxed = _periodic_mean(u0, u1, c / 2, lambda g: np.where(g < c, g * g / (2 * c), c / 2), along)
-    return np.clip(c / 2 + fade(speed / spacing, t) * (boxed - c / 2), 0, 1)
+    return np.clip(band_limited_series(boxed, c / 2, detent_harmonics(c), u0, u1, speed, spacing, t), 0, 1)
 
 
 def _splitmix(state):
