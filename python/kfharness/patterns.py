@@ -59,8 +59,8 @@ def band_limited_series(boxed, mean, harmonics, u0, u1, speed, period_mm, period
     f1 = np.asarray(speed, dtype=np.float64) / period_mm
     with np.errstate(divide="ignore", invalid="ignore"):
         k_stop = np.where(f1 > 0, 0.5 / period_s / np.where(f1 > 0, f1, 1), np.inf)
-    h = np.where(k_stop <= MAX_HARMONICS, 0.0, np.where(
-        k_stop < 2 * MAX_HARMONICS, 0.5 * (1 - np.cos(np.pi * (k_stop - MAX_HARMONICS) / MAX_HARMONICS)), 1.0))
+    between = np.clip(k_stop, MAX_HARMONICS, 2 * MAX_HARMONICS)
+    h = 0.5 * (1 - np.cos(np.pi * (between - MAX_HARMONICS) / MAX_HARMONICS))
     k_cut = np.minimum(k_stop, MAX_HARMONICS)
     mid, length = 0.5 * (u0 + u1), np.abs(u1 - u0)
     phase = 2 * np.pi * (mid - np.floor(mid))
