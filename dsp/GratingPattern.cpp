@@ -39,8 +39,8 @@ double GratingPattern::level(const Travel& travel, bool antialias) const {
   const double u1 = coordinate_.cycles(travel.toMm);
   if (!antialias) return at(fractionOf(u1));
   const double u0 = coordinate_.cycles(travel.fromMm);
-  const double boxed =
-      periodicMean(u0, u1, duty_, [this](double f) { return integralTo(f); }, [this](double f) { return at(f); });
+  const double boxed = periodicMean(
+      u0, u1, duty_, [this](double f) { return integralTo(f); }, [this](double f) { return at(f); });
   return bandLimitedSeries(boxed, duty_, harmonics_, u0, u1, travel, coordinate_.periodMm());
 }
 

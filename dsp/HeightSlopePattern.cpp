@@ -55,7 +55,8 @@ double BumpPattern::level(const Travel& travel, bool antialias) const {
   const double scale = omega_ / M_PI;
   const double u0 = coordinate_.cycles(travel.fromMm);
   const double boxed = periodicMean(
-      u0, u1, scale, [&](double f) { return scale * climbTo(f, direction); }, [&](double f) { return at(f, direction); });
+      u0, u1, scale, [&](double f) { return scale * climbTo(f, direction); },
+      [&](double f) { return at(f, direction); });
   return bandLimitedSeries(boxed, mean(), direction > 0 ? climbingUp_ : climbingDown_, u0, u1, travel,
                            coordinate_.periodMm());
 }

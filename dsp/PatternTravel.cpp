@@ -48,7 +48,7 @@ double splineGain(double r) {
 double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
                          double periodMm) {
   const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
-  if (!(f1 > 0.0)) return boxed;                     // at rest (or NaN): the pattern as it is
+  if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
   const double kStop = 0.5 / travel.framePeriodS / f1;
   if (!(kStop < 2.0 * kMaxHarmonics)) return boxed;  // slow: the closed form, h = 1
   const double h =

@@ -7,8 +7,8 @@
 // (a box filter in space whose length follows the speed), computed in closed form from g's
 // integral; with anti-aliasing on, each harmonic k of a periodic pattern is then weighted on its
 // own temporal frequency k * speed / period, down to 0 at half the frame rate (the frames' Nyquist
-// frequency): the frames get no component they would fold (bandLimitedSeries). With anti-aliasing off, a pattern is g at the current position (sampled per
-// audio sample: what aliases in the frames).
+// frequency): the frames get no component they would fold (bandLimitedSeries). With anti-aliasing off, a pattern is g
+// at the current position (sampled per audio sample: what aliases in the frames).
 #pragma once
 
 #include <algorithm>

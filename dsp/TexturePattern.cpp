@@ -47,22 +47,29 @@ void TexturePattern::set(double lo, double hi, double seed, double sampleRateHz)
   const double a = std::min(lo_, hi_), b = std::max(lo_, hi_);
   Components wanted;
   draw(a, b, s, wanted);
+  auto same = [](const Components& a, const Components& b) {
+    return std::equal(a.frequency, a.frequency + kComponents, b.frequency) &&
+           std::equal(a.phase, a.phase + kComponents, b.phase);
+  };
+  seed_ = s;
+  sampleRateHz_ = sampleRateHz;
   if (!set_) {
     current_ = wanted;
     set_ = true;
-  } else if (std::equal(wanted.frequency, wanted.frequency + kComponents, current_.frequency) &&
-             std::equal(wanted.phase, wanted.phase + kComponents, current_.phase)) {
-    return;
-  } else {
-    // A fade in progress keeps its start; its end moves to the newest texture.
-    if (fade_ >= 1.0) {
-      previous_ = current_;
-      fade_ = 0.0;
-    }
-    current_ = wanted;
-    fadeStep_ = 1.0 / std::max(1.0, kCrossfadeS * sampleRateHz);
+  } else if (fade_ < 1.0) {
+    // Fading to current_: a different texture waits until the fade ends.
+    hasPending_ = !same(wanted, current_);
+    if (hasPending_) pending_ = wanted;
+  } else if (!same(wanted, current_)) {
+    startFade(wanted);
   }
-  seed_ = s;
+}
+
+void TexturePattern::startFade(const Components& to) {
+  previous_ = current_;
+  current_ = to;
+  fade_ = 0.0;
+  fadeStep_ = 1.0 / std::max(1.0, kCrossfadeS * sampleRateHz_);
 }
 
 double TexturePattern::render(const Components& c, const Travel& travel, bool antialias) {
@@ -83,6 +90,10 @@ double TexturePattern::render(const Components& c, const Travel& travel, bool an
 }
 
 double TexturePattern::level(const Travel& travel, bool antialias) {
+  if (fade_ >= 1.0 && hasPending_) {
+    hasPending_ = false;
+    startFade(pending_);
+  }
   const double now = render(current_, travel, antialias);
   if (fade_ >= 1.0) return now;
   const double before = render(previous_, travel, antialias);

@@ -7,7 +7,9 @@
 // Rendered as each sine's mean over the frame's travel (sin(mid) * sinc(half), exact, no
 // cancellation) times bandLimitGain(speed * f_k): each component fades on its own frequency.
 // A change of band or seed crossfades from the old texture to the new over kCrossfadeS; each is
-// a function of position, so after the fade a place feels as it will at every later visit.
+// a function of position, so after the fade a place feels as it will at every later visit. A
+// change during a fade waits for it to end (the newest pending one wins), then fades in: replacing
+// the texture being faded in would step the force by the fade weight times the difference.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +39,10 @@ class TexturePattern {
 
  private:
   static double render(const Components& c, const Travel& travel, bool antialias);
-  Components current_{}, previous_{};
+  void startFade(const Components& to);
+  Components current_{}, previous_{}, pending_{};
+  bool hasPending_ = false;
+  double sampleRateHz_ = 48000.0;
   double lo_ = 0.5, hi_ = 2.0;
   uint64_t seed_ = 0;
   bool set_ = false;

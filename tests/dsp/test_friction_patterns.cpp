@@ -123,7 +123,8 @@ TEST_CASE("grating: point values on a ramp are the definition, and the box filte
   const auto g = run(boxed, x, period, duty, edge);
   // 5 mm/s over 2 mm is 2.5 Hz: harmonic 200 is at the frames' 500 Hz, past 2 * kMaxHarmonics, so
   // no harmonic is weighted (PatternTravel.hpp): the level is the box mean itself.
-  for (size_t i = 48; i < x.size(); i += 389) REQUIRE(level(g[i]) == Approx(boxMean(def, x[i - 48], x[i])).margin(2e-6));
+  for (size_t i = 48; i < x.size(); i += 389)
+    REQUIRE(level(g[i]) == Approx(boxMean(def, x[i - 48], x[i])).margin(2e-6));
 }
 
 TEST_CASE("grating: integral of one period is the duty, the level is periodic and far from 0 stays exact") {
@@ -331,6 +332,38 @@ TEST_CASE("texture: a new seed crossfades over 50 ms, nothing jumps") {
         Approx(kMinN + (kMaxN - kMinN) * TexturePattern::at(0.5, 3, 2, x[9600 + 2400 + 64])).margin(0.01));
 }
 
+TEST_CASE("texture: a second change during the crossfade waits for it to end, nothing steps") {
+  // Seeds 1 -> 2 at 200 ms -> 3 at 220 ms (inside the first 50 ms fade) -> 4 at 240 ms. Per sample
+  // the force may change by what the moving texture makes (the same run with no change: own) plus
+  // the fade's own step, the range over the 2400 samples of the fade (0.36 N / 2400 = 1.5e-4 N).
+  // Replacing the texture being faded in steps by the fade weight times the difference (~0.04 N).
+  const auto x = ramp(0.0, 20.0, 0.5, 48000);
+  auto render = [&](double fixedSeed) {  // fixedSeed 0: the changes above
+    auto c = core(PatternKind::Texture);
+    std::vector<float> f(x.size());
+    for (size_t i = 0; i < x.size(); i += 64) {
+      const double seed = fixedSeed > 0 ? fixedSeed : (i < 9600 ? 1 : (i < 10560 ? 2 : (i < 11520 ? 3 : 4)));
+      c.setParameters(0.5, 3, seed, x[i]);
+      c.process(x.data() + i, 1, nullptr, 0, f.data() + i, 64);
+    }
+    return f;
+  };
+  auto worstStep = [](const std::vector<float>& f) {
+    double worst = 0;
+    for (size_t i = 49; i < f.size(); ++i) worst = std::max(worst, double(std::fabs(f[i] - f[i - 1])));
+    return worst;
+  };
+  const auto changed = render(0);
+  double own = 0;
+  for (double seed : {1, 2, 3, 4}) own = std::max(own, worstStep(render(seed)));
+  CHECK(worstStep(changed) <= own + (kMaxN - kMinN) / 2400.0);
+  // 1 -> 2 ends at 250 ms, then 2 -> 4 (the newest pending) ends at 300 ms: texture 4 alone, as if
+  // it had been there from the start (a function of position and travel).
+  const auto four = render(4);
+  for (size_t i = 9600 + 2 * 2400 + 64; i < x.size(); ++i) REQUIRE(changed[i] == four[i]);
+  CHECK(changed[9600 + 2400 + 64] != four[9600 + 2400 + 64]);
+}
+
 TEST_CASE("grating: a change of period keeps the phase under the puck") {
   GratingPattern p;
   p.set(1.0, 0.5, 0.05, 0.0);  // edge 0.05 mm: the same shape in both periods at cycle 0.3
@@ -432,6 +465,7 @@ TEST_CASE("sample rates 44.1 to 192 kHz: the same grating against position, the 
     const auto x = ramp(0.0, 2.5, 0.45, sr);
     const auto f = run(c, x, period, duty, edge);
     const size_t n = static_cast<size_t>(std::round(sr * 1e-3));
-    for (size_t i = n; i < x.size(); i += 211) REQUIRE(level(f[i]) == Approx(boxMean(def, x[i - n], x[i])).margin(2e-6));
+    for (size_t i = n; i < x.size(); i += 211)
+      REQUIRE(level(f[i]) == Approx(boxMean(def, x[i - n], x[i])).margin(2e-6));
   }
 }
