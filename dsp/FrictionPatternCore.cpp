@@ -14,7 +14,10 @@ FrictionPatternCore::FrictionPatternCore(PatternKind kind, double sampleRateHz, 
   travel_.setSampleRate(sampleRateHz, framePeriodS);
 }
 
-void FrictionPatternCore::setParameters(double p1, double p2, double p3, float anchorMm) {
+void FrictionPatternCore::setParameters(double p1, double p2, double p3, float anchorPositionMm) {
+  // A NaN/inf anchor (the block's first position) is held like any position: the last finite one.
+  // Left non-finite, a period change would take effect without keeping the phase.
+  const double anchorMm = std::isfinite(anchorPositionMm) ? anchorPositionMm : travel_.lastPositionMm();
   switch (kind_) {
     case PatternKind::Grating:
       return grating_.set(p1, p2, p3, anchorMm);

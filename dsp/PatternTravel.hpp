@@ -41,6 +41,8 @@ class FrameTravel {
   // The value pushed with the position at the start of the travel last returned.
   double valueFrameAgo() const { return valueFrom_; }
   double valueNow() const { return valueTo_; }
+  // The last finite position pushed (0 before the first): where a non-finite one holds the puck.
+  double lastPositionMm() const { return lastPositionMm_; }
   double framePeriodS() const { return frameSamples_ / sampleRateHz_; }
 
  private:

@@ -376,6 +376,19 @@ TEST_CASE("grating: a change of period keeps the phase under the puck") {
   CHECK(p.level(further, false) == Approx(before).margin(1e-9));
 }
 
+TEST_CASE("a NaN position at the anchor sample of a period change still keeps the phase under the puck") {
+  // The puck rests at 37.3 mm; the block that changes the period 1 -> 0.37 mm starts with a NaN
+  // (held: the puck is still at 37.3 mm). The force under the puck must not move.
+  auto c = core(PatternKind::Grating, 48000, false);
+  std::vector<float> x(256, 37.3f), f(256);
+  x[128] = kNaN;
+  for (size_t i = 0; i < x.size(); i += 64) {
+    c.setParameters(i < 128 ? 1.0 : 0.37, 0.5, 0.05, x[i]);
+    c.process(x.data() + i, 1, nullptr, 0, f.data() + i, 64);
+  }
+  for (size_t i = 1; i < f.size(); ++i) REQUIRE(f[i] == f[0]);
+}
+
 TEST_CASE(
     "viscous rises linearly with speed to full and stick-slip breaks away above the sliding level with hysteresis") {
   auto v = core(PatternKind::Viscous);
