@@ -1,10 +1,14 @@
 // FrictionPattern: a spatial friction pattern (dsp/FrictionPatternCore), position (mm) in, force
 // (N) out. Inputs: kind (fixed at init), position, minForce (N), maxForce (N), antialias (0/1),
-// p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal,
-// read at its rate. Everything else is read once per block. Bad inputs (help: "Bad inputs"): a
+// p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal.
+// Position and height are read at audio rate as they are; at control rate they are interpolated
+// linearly across the block from the last block's value (as SC UGens do), since a value held per
+// block would make the travel, and every speed-based pattern, jump at block rate. Everything else
+// is read once per block. Bad inputs (help: "Bad inputs"): a
 // NaN/inf position holds the last finite one; a parameter out of its range keeps the last good
 // value (the pattern's default before the first); minForce/maxForce not finite are the paper
 // mapping's loForce/hiForce, negative 0 N; an unknown kind is a grating. Each posted once.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -61,6 +65,8 @@ class FrictionPatternUGen : public SCUnit {
     }
     mKind = code >= 0 && code < kf::patterns::kPatternKinds ? code : 0;
     mCore.emplace(static_cast<PatternKind>(mKind), sampleRate());
+    mLastPositionMm = in0(kPositionMm);
+    mLastHeight = in0(kP1);
     mCalcFunc = make_calc_function<FrictionPatternUGen, &FrictionPatternUGen::next>();
     updateRange();
     // The initial value, before the first block: the minimum force (no travel yet).
@@ -72,10 +78,34 @@ class FrictionPatternUGen : public SCUnit {
     updateRange();
     checkParameters();
     mCore->setAntialias(in0(kAntialias) > 0.5f);
-    mCore->setParameters(in0(kP1), in0(kP2), in0(kP3), in(kPositionMm)[0]);
     const bool slope = mKind == static_cast<int>(PatternKind::Slope);
-    mCore->process(in(kPositionMm), isAudioRateIn(kPositionMm) ? 1 : 0, slope ? in(kP1) : nullptr,
-                   isAudioRateIn(kP1) ? 1 : 0, out(0), numSamples);
+    const bool positionAudio = isAudioRateIn(kPositionMm), heightAudio = !slope || isAudioRateIn(kP1);
+    const float positionNow = in0(kPositionMm), heightNow = in0(kP1);
+    // The anchor of a phase-continuous period change: the block's first position.
+    mCore->setParameters(in0(kP1), in0(kP2), in0(kP3),
+                         positionAudio ? in(kPositionMm)[0] : ramp(mLastPositionMm, positionNow, 1, numSamples));
+    if (positionAudio && heightAudio) {
+      mCore->process(in(kPositionMm), 1, slope ? in(kP1) : nullptr, 1, out(0), numSamples);
+    } else {
+      // In chunks through small arrays on the stack: nothing allocated.
+      float positions[kChunk], heights[kChunk];
+      for (int start = 0; start < numSamples; start += kChunk) {
+        const int n = std::min(kChunk, numSamples - start);
+        for (int i = 0; i < n; ++i) {
+          const int at = start + i;
+          positions[i] = positionAudio ? in(kPositionMm)[at] : ramp(mLastPositionMm, positionNow, at + 1, numSamples);
+          if (slope) heights[i] = heightAudio ? in(kP1)[at] : ramp(mLastHeight, heightNow, at + 1, numSamples);
+        }
+        mCore->process(positions, 1, slope ? heights : nullptr, 1, out(0) + start, n);
+      }
+    }
+    mLastPositionMm = positionNow;
+    mLastHeight = heightNow;
+  }
+
+  // Sample k (1..n) of a block's line from the last block's value to this one's.
+  static float ramp(float from, float to, int k, int n) {
+    return static_cast<float>(from + (static_cast<double>(to) - from) * k / n);
   }
 
   void updateRange() {
@@ -106,7 +136,9 @@ class FrictionPatternUGen : public SCUnit {
     }
   }
 
+  static constexpr int kChunk = 64;
   int mKind = 0;
+  float mLastPositionMm = 0.f, mLastHeight = 0.f;          // control-rate values of the last block
   std::optional<kf::patterns::FrictionPatternCore> mCore;  // inside the unit: no allocation
   kf::patterns::ForceRange mRange;
   kf::sc::FirstTimeOnly mBadInputs;

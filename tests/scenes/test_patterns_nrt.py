@@ -22,14 +22,34 @@ KINDS = [
 ]
 
 
+# Channels after the kinds: a fine grating on position ramps (Sweep), with and without
+# anti-aliasing; a viscous pattern on a control-rate ramp; a grating whose period changes while moving.
+EXTRA = [
+    ("fast", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02)"),
+    ("fast raw", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02, antialias: 0)"),
+    ("36 mm/s", "FrictionPattern.grating(Sweep.ar(0, 36), 0.2, 0.5, 0.02)"),
+    ("60 mm/s duty 0.3", "FrictionPattern.grating(Sweep.ar(0, 60), 0.2, 0.3, 0.02)"),
+    ("viscous kr", "FrictionPattern.viscous(Sweep.kr(0, 40), 100)"),
+    # 10 mm/s from 1.237 mm; the period 1 -> 0.37 mm in the block after 0.2 s (x ~ 3.25 mm: cycle
+    # 0.25, high in both periods with the phase kept, low (cycle 0.78) without).
+    ("period change", "FrictionPattern.grating(Sweep.ar(0, 10) + 1.237, Select.kr(Sweep.kr(0, 1) > 0.2, [1, 0.37]), "
+     "0.5, 0.05)"),
+    ("period fixed", "FrictionPattern.grating(Sweep.ar(0, 10) + 1.237, 1, 0.5, 0.05)"),
+]
+
+
+def column(data, name):
+    return data[:, 2 + len(KINDS) + [n for n, _ in EXTRA].index(name)].astype(np.float64)
+
+
 def render(rate, seconds):
     outs = ", ".join(code for _, code, _ in KINDS)
+    extra = ", ".join(code for _, code in EXTRA)
     data, log = nrt.score_and_render(f"patterns{rate}", f"""
         var dev = FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.25, 40], [0.35, 40], [{seconds}, 20]]));
         var def = SynthDef(\\patterns, {{
-            var x = FrictionMouseIn.ar(0)[0], h = sin(x * 0.5), fast = Sweep.ar(0, 300);
-            Out.ar(0, [x, h, {outs}, FrictionPattern.grating(fast, 0.2, 0.5, 0.02),
-                FrictionPattern.grating(fast, 0.2, 0.5, 0.02, antialias: 0)])
+            var x = FrictionMouseIn.ar(0)[0], h = sin(x * 0.5);
+            Out.ar(0, [x, h, {outs}, {extra}])
         }});
         score = Score([
             [0.0, dev.openMsg],
@@ -37,7 +57,7 @@ def render(rate, seconds):
             [0.0, Synth.basicNew(\\patterns, nil, 1000).newMsg],
             [{seconds}, dev.closeMsg],
             [{seconds} + 0.01, ['/c_set', 0, 0]]]);
-    """, sample_rate=rate, channels=4 + len(KINDS))
+    """, sample_rate=rate, channels=2 + len(KINDS) + len(EXTRA))
     return data, log
 
 
@@ -70,14 +90,64 @@ def largest_alias_n(force, rate):
     return (2 * np.abs(np.fft.rfft((frames - frames.mean()) * w)) / w.sum())[3:].max()
 
 
+def frame_means(force, rate):
+    n = patterns.frame_samples(rate)
+    return force[:len(force) // n * n].reshape(-1, n).mean(axis=1)
+
+
+def amplitude_at(frames, frequency_hz):
+    """Amplitude (N) at one frequency of 1 kHz frames: a DFT there under a 4-term Blackman-Harris
+    window (sidelobes below -92 dB)."""
+    i = np.arange(len(frames))
+    p = 2 * np.pi * i / len(frames)
+    w = 0.35875 - 0.48829 * np.cos(p) + 0.14128 * np.cos(2 * p) - 0.01168 * np.cos(3 * p)
+    v = frames - frames.mean()
+    return 2 * abs(np.sum(v * w * np.exp(-2j * np.pi * frequency_hz * i / 1000))) / w.sum()
+
+
+_rendered = {}
+
+
+def render48k():
+    if not _rendered:
+        _rendered["data"] = render(48000, 0.4)[0]
+    return _rendered["data"]
+
+
 def test_a_fine_grating_moved_fast_has_no_alias_in_its_frames():
     # 300 mm/s over 0.2 mm: 1500 Hz, above the frames' 500 Hz. Band-limited, the grating is its mean
     # (0.32 N) to float rounding (0.36 N * 2^-24 = 2e-8 N): stated level 1e-6 N. The raw grating's
     # frames alias (measured 0.10 N, exactly 0 with it); > 0.02 N shows this test sees an alias.
     rate = 48000
-    data, _ = render(rate, 0.4)
+    data = render48k()
     n = int(0.4 * rate) - 64
-    on, off = (data[rate // 100:n, k].astype(np.float64) for k in (-2, -1))
+    on, off = (column(data, name)[rate // 100:n] for name in ("fast", "fast raw"))
     assert largest_alias_n(on, rate) < 1e-6
     assert largest_alias_n(off, rate) > 0.02
     assert abs(on.mean() - 0.32) < 1e-6
+    # The harmonics of a sharp grating (0.02 mm edges) fold when only the fundamental is faded:
+    # 36 mm/s, 540 Hz -> 460 Hz (was 0.0195 N); 60 mm/s duty 0.3, 600 Hz -> 400 Hz (was 0.021 N).
+    # Each harmonic band-limited on its own frequency: nothing there but float rounding and the
+    # window's leakage from the lines kept (>= 80 Hz away: < 1e-6 N); stated level 1e-5 N.
+    for name, folded in (("36 mm/s", 460.0), ("60 mm/s duty 0.3", 400.0)):
+        frames = frame_means(column(data, name)[rate // 100:n], rate)
+        assert amplitude_at(frames, folded) < 1e-5, name
+
+
+def test_control_rate_positions_and_period_changes_while_moving():
+    rate = 48000
+    data = render48k()
+    n = int(0.4 * rate) - 64
+    # A control-rate ramp at 40 mm/s, interpolated across each block: viscous (full at 100 mm/s) is
+    # 0.14 + 0.36 * 0.4 = 0.284 N throughout. Float positions up to 16 mm (2e-6 mm steps) move the
+    # speed over a 1 ms frame by 4e-3 mm/s: 1.4e-5 N; stated 1e-4 N. Held per block (64 samples
+    # against 48-sample frames), the speed read 0..53 mm/s: a 0.05 N buzz at block rate.
+    viscous = column(data, "viscous kr")[rate // 50:n]
+    assert np.abs(viscous - 0.284).max() < 1e-4
+    # The period 1 -> 0.37 mm while moving at 10 mm/s: no step at the change beyond the largest the
+    # moving pattern makes by itself (the same grating with a fixed period, over the whole run).
+    changed, fixed = column(data, "period change")[:n], column(data, "period fixed")[:n]
+    own = np.abs(np.diff(fixed[rate // 100:])).max()
+    at = int(0.2 * rate)
+    assert np.abs(np.diff(changed[at - 128:at + 256])).max() <= own
+    assert changed[at - 128] > 0.45 and changed[at + 256] > 0.45, "high before and after: the phase kept"
