@@ -2,10 +2,10 @@
 
 namespace kf::patterns {
 
-ForceRange usableForceRange(double minN, double maxN) {
+ForceRange usableForceRange(double loN, double hiN) {
   ForceRange r;
-  if (std::isfinite(minN)) r.minN = std::max(0.0, minN);
-  if (std::isfinite(maxN)) r.maxN = std::max(0.0, maxN);
+  if (std::isfinite(loN)) r.loN = std::max(0.0, loN);
+  if (std::isfinite(hiN)) r.hiN = std::max(0.0, hiN);
   return r;
 }
 
@@ -59,13 +59,13 @@ double FrictionPatternCore::level(const Travel& travel) {
 void FrictionPatternCore::process(const float* positionMm, int positionStride, const float* height, int heightStride,
                                   float* forceN, int numSamples) {
   const bool withHeight = kind_ == PatternKind::Slope && height != nullptr;
-  const double span = range_.maxN - range_.minN;
+  const double span = range_.hiN - range_.loN;
   for (int i = 0; i < numSamples; ++i) {
     // Both inputs read before the output is written: forceN may alias either.
     const float x = positionMm[i * positionStride];
     const double h = withHeight ? static_cast<double>(height[i * heightStride]) : 0.0;
     lastLevel_ = level(travel_.push(x, h));
-    forceN[i] = static_cast<float>(range_.minN + span * lastLevel_);
+    forceN[i] = static_cast<float>(range_.loN + span * lastLevel_);
   }
 }
 

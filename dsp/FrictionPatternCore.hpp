@@ -1,5 +1,5 @@
 // One friction pattern of a kind chosen at construction, run over blocks: position (mm) in,
-// force (N) out, force = minForce + (maxForce - minForce) * level. What FrictionPattern (the
+// force (N) out, force = loForce + (hiForce - loForce) * level. What FrictionPattern (the
 // UGen) runs; the patterns themselves are in their own files (GratingPattern, HeightSlopePattern,
 // DetentPattern, TexturePattern, SpeedFriction). Nothing here allocates.
 #pragma once
@@ -31,13 +31,13 @@ enum class PatternKind : int {
 constexpr int kPatternKinds = 7;
 
 struct ForceRange {
-  double minN = paper::mapping::loForceN;
-  double maxN = paper::mapping::hiForceN;
+  double loN = paper::mapping::loForceN;
+  double hiN = paper::mapping::hiForceN;
 };
 
 // Not finite: the paper mapping's loForce / hiForce; negative: 0 N (friction never pushes).
 // Reversed bounds are kept (the level then lowers the force).
-ForceRange usableForceRange(double minN, double maxN);
+ForceRange usableForceRange(double loN, double hiN);
 
 class FrictionPatternCore {
  public:

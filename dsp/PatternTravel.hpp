@@ -2,7 +2,7 @@
 // (1 ms), its direction and speed, and the tools the patterns share to band-limit themselves to
 // what 1 ms force frames can show (ARCHITECTURE.md, "Friction patterns").
 //
-// A pattern is a level g in [0, 1] (force = minForce + (maxForce - minForce) * g). A pattern of
+// A pattern is a level g in [0, 1] (force = loForce + (hiForce - loForce) * g). A pattern of
 // position g(x) is rendered as its mean over the travel of the last frame, [x(t - T), x(t)]
 // (a box filter in space whose length follows the speed), computed in closed form from g's
 // integral; with anti-aliasing on, each harmonic k of a periodic pattern is then weighted on its

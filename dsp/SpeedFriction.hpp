@@ -1,9 +1,9 @@
 // Friction that depends on speed, not on place (the speed is the travel over the last frame
 // over the frame period, PatternTravel.hpp):
 // - viscous: the level rises linearly with speed and is full at fullSpeed (mm/s): a damping of
-//   (maxForce - minForce) / fullSpeed N per mm/s up to maxForce;
-// - stick-slip: a puck at rest sticks (level 1: the breakaway force, maxForce); it slips (level
-//   0: the sliding force, minForce) once its speed exceeds slipSpeed, and sticks again only when
+//   (hiForce - loForce) / fullSpeed N per mm/s up to hiForce;
+// - stick-slip: a puck at rest sticks (level 1: the breakaway force, hiForce); it slips (level
+//   0: the sliding force, loForce) once its speed exceeds slipSpeed, and sticks again only when
 //   its speed falls below stickSpeed <= slipSpeed (the hysteresis between the two).
 #pragma once
 

@@ -1,12 +1,12 @@
 // FrictionPattern: a spatial friction pattern (dsp/FrictionPatternCore), position (mm) in, force
-// (N) out. Inputs: kind (fixed at init), position, minForce (N), maxForce (N), antialias (0/1),
+// (N) out. Inputs: kind (fixed at init), position, loForce (N), hiForce (N), antialias (0/1),
 // p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal.
 // Position and height are read at audio rate as they are; at control rate they are interpolated
 // linearly across the block from the last block's value (as SC UGens do), since a value held per
 // block would make the travel, and every speed-based pattern, jump at block rate. Everything else
 // is read once per block. Bad inputs (help: "Bad inputs"): a
 // NaN/inf position holds the last finite one; a parameter out of its range keeps the last good
-// value (the pattern's default before the first); minForce/maxForce not finite are the paper
+// value (the pattern's default before the first); loForce/hiForce not finite are the paper
 // mapping's loForce/hiForce, negative 0 N; an unknown kind is a grating. Each posted once.
 #include <algorithm>
 #include <cmath>
@@ -19,10 +19,10 @@ namespace {
 
 using kf::patterns::PatternKind;
 
-enum Input { kKind, kPositionMm, kMinForceN, kMaxForceN, kAntialias, kP1, kP2, kP3 };
+enum Input { kKind, kPositionMm, kLoForceN, kHiForceN, kAntialias, kP1, kP2, kP3 };
 
 // The kinds of bad input, each posted once per unit (FirstTimeOnly).
-enum BadInput { kBadKind, kBadMinForce, kBadMaxForce, kBadP1, kBadP2, kBadP3 };
+enum BadInput { kBadKind, kBadLoForce, kBadHiForce, kBadP1, kBadP2, kBadP3 };
 
 // What each kind's parameters are called and must be: positive (finite, > 0), finite, or unused.
 enum class Rule { Unused, Positive, NonNegative, Finite };
@@ -70,7 +70,7 @@ class FrictionPatternUGen : public SCUnit {
     mCalcFunc = make_calc_function<FrictionPatternUGen, &FrictionPatternUGen::next>();
     updateRange();
     // The initial value, before the first block: the minimum force (no travel yet).
-    out0(0) = static_cast<float>(mRange.minN);
+    out0(0) = static_cast<float>(mRange.loN);
   }
 
  private:
@@ -109,14 +109,14 @@ class FrictionPatternUGen : public SCUnit {
   }
 
   void updateRange() {
-    const float minN = in0(kMinForceN), maxN = in0(kMaxForceN);
-    mRange = kf::patterns::usableForceRange(minN, maxN);
-    if (!(minN >= 0.f && std::isfinite(minN)) && mBadInputs.first(kBadMinForce))
-      kf::sc::postFromRt(mWorld, "FrictionPattern: minForce %g N is not a finite force >= 0; %g N used.\n",
-                         kf::sc::shownValue(minN), mRange.minN);
-    if (!(maxN >= 0.f && std::isfinite(maxN)) && mBadInputs.first(kBadMaxForce))
-      kf::sc::postFromRt(mWorld, "FrictionPattern: maxForce %g N is not a finite force >= 0; %g N used.\n",
-                         kf::sc::shownValue(maxN), mRange.maxN);
+    const float loN = in0(kLoForceN), hiN = in0(kHiForceN);
+    mRange = kf::patterns::usableForceRange(loN, hiN);
+    if (!(loN >= 0.f && std::isfinite(loN)) && mBadInputs.first(kBadLoForce))
+      kf::sc::postFromRt(mWorld, "FrictionPattern: loForce %g N is not a finite force >= 0; %g N used.\n",
+                         kf::sc::shownValue(loN), mRange.loN);
+    if (!(hiN >= 0.f && std::isfinite(hiN)) && mBadInputs.first(kBadHiForce))
+      kf::sc::postFromRt(mWorld, "FrictionPattern: hiForce %g N is not a finite force >= 0; %g N used.\n",
+                         kf::sc::shownValue(hiN), mRange.hiN);
     mCore->setForceRange(mRange);
   }
 

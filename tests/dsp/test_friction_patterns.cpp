@@ -445,8 +445,8 @@ TEST_CASE("bad inputs: NaN and inf positions hold, bad parameters keep the last 
     }
   }
   const ForceRange r = usableForceRange(kNaN, -2);
-  CHECK(r.minN == Approx(0.14));
-  CHECK(r.maxN == 0.0);
+  CHECK(r.loN == Approx(0.14));
+  CHECK(r.hiN == 0.0);
 }
 
 TEST_CASE("extreme parameters and positions: tiny and huge periods, far from the origin, within range") {

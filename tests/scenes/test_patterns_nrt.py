@@ -29,7 +29,8 @@ EXTRA = [
     ("fast raw", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02, antialias: 0)"),
     ("36 mm/s", "FrictionPattern.grating(Sweep.ar(0, 36), 0.2, 0.5, 0.02)"),
     ("60 mm/s duty 0.3", "FrictionPattern.grating(Sweep.ar(0, 60), 0.2, 0.3, 0.02)"),
-    ("viscous kr", "FrictionPattern.viscous(Sweep.kr(0, 40), 100)"),
+    # With the force range by name, as LoudnessToFriction names it (loForce, hiForce).
+    ("viscous kr", "FrictionPattern.viscous(Sweep.kr(0, 40), 100, loForce: 0.1, hiForce: 0.6)"),
     # 10 mm/s from 1.237 mm; the period 1 -> 0.37 mm in the block after 0.2 s (x ~ 3.25 mm: cycle
     # 0.25, high in both periods with the phase kept, low (cycle 0.78) without).
     ("period change", "FrictionPattern.grating(Sweep.ar(0, 10) + 1.237, Select.kr(Sweep.kr(0, 1) > 0.2, [1, 0.37]), "
@@ -138,12 +139,13 @@ def test_control_rate_positions_and_period_changes_while_moving():
     rate = 48000
     data = render48k()
     n = int(0.4 * rate) - 64
-    # A control-rate ramp at 40 mm/s, interpolated across each block: viscous (full at 100 mm/s) is
-    # 0.14 + 0.36 * 0.4 = 0.284 N throughout. Float positions up to 16 mm (2e-6 mm steps) move the
-    # speed over a 1 ms frame by 4e-3 mm/s: 1.4e-5 N; stated 1e-4 N. Held per block (64 samples
-    # against 48-sample frames), the speed read 0..53 mm/s: a 0.05 N buzz at block rate.
+    # A control-rate ramp at 40 mm/s, interpolated across each block: viscous (full at 100 mm/s,
+    # loForce 0.1 N, hiForce 0.6 N) is 0.1 + 0.5 * 0.4 = 0.3 N throughout. Float positions up to
+    # 16 mm (2e-6 mm steps) move the speed over a 1 ms frame by 4e-3 mm/s: 2e-5 N; stated 1e-4 N.
+    # Held per block (64 samples against 48-sample frames), the speed read 0..53 mm/s: a buzz at
+    # block rate (measured 0.144 N off).
     viscous = column(data, "viscous kr")[rate // 50:n]
-    assert np.abs(viscous - 0.284).max() < 1e-4
+    assert np.abs(viscous - 0.3).max() < 1e-4
     # The period 1 -> 0.37 mm while moving at 10 mm/s: no step at the change beyond the largest the
     # moving pattern makes by itself (the same grating with a fixed period, over the whole run).
     changed, fixed = column(data, "period change")[:n], column(data, "period fixed")[:n]
