@@ -469,6 +469,30 @@ TEST_CASE("extreme parameters and positions: tiny and huge periods, far from the
   CHECK(p.level(Travel{1e6 + 0.15, 1e6 + 0.15, 1, 0, 1e-3}, false) == 0.0);
 }
 
+TEST_CASE("far from the origin through the float input: exact at the float position, speed to its step") {
+  // Positions reach the core as float: at 1e4 mm one step is 2^-10 mm (0.98 um), at 16 mm 2^-19.
+  // Inside all is double, so a pattern is exact at the float position it got: the raw grating
+  // (0.2 mm) at 1e4 mm is its definition there (to the force's float rounding, 1e-6 N). A speed
+  // over a 1 ms frame is known to one step per ms: viscous at 40 mm/s (full at 100) may be off by
+  // step / 1 ms / 100 mm/s: 9.8e-3 at 1e4 mm (measured 9.4e-3), 1.9e-5 at 16 mm.
+  const auto far = ramp(1e4 + 0.013, 20.0, 0.1, 48000);
+  auto raw = core(PatternKind::Grating, 48000, false);
+  const auto f = run(raw, far, 0.2, 0.5, 0.02);
+  for (size_t i = 0; i < far.size(); i += 3)
+    REQUIRE(f[i] == Approx(kMinN + (kMaxN - kMinN) * gratingDef(frac(double(far[i]) / 0.2), 0.5, 0.1)).margin(1e-6));
+  auto deviation = [](double x0) {
+    auto v = core(PatternKind::Viscous);
+    const auto g = run(v, ramp(x0, 40.0, 0.1, 48000), 100.0, 0, 0);
+    double worst = 0;
+    for (size_t i = 96; i < g.size(); ++i) worst = std::max(worst, std::fabs(level(g[i]) - 0.4));
+    return worst;
+  };
+  const double farDeviation = deviation(1e4), nearDeviation = deviation(12.0);
+  CHECK(farDeviation <= std::ldexp(1.0, -10) / 1e-3 / 100 + 1e-6);
+  CHECK(farDeviation > 1e-3);  // the float path is what is tested: the step shows
+  CHECK(nearDeviation <= std::ldexp(1.0, -19) / 1e-3 / 100 + 1e-6);
+}
+
 TEST_CASE("sample rates 44.1 to 192 kHz: the same grating against position, the frame exact to the sample") {
   const double period = 1.0, duty = 0.5, edge = 0.1;
   auto def = [&](double x) { return gratingDef(frac(x / period), duty, edge / period); };
