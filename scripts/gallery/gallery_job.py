@@ -99,6 +99,38 @@ def largest_alias_n(frames):
     return float(spectrum[3:].max()) if len(spectrum) > 3 else 0.0
 
 
+# Sharp 0.2 mm gratings (0.02 mm edges) on exact position ramps, whose harmonics above 500 Hz fold
+# into the 1 ms frames unless each is band-limited on its own frequency: (speed mm/s, duty, the
+# harmonic (Hz) and where it folds (Hz)).
+FOLDING = [(36.0, 0.5, 540.0, 460.0), (60.0, 0.3, 600.0, 400.0)]
+
+
+def folded_harmonics(rate, seconds=1.0):
+    """The amplitude (N) at each FOLDING frequency of the 1 ms frame means, anti-aliased and raw
+    (a DFT at that frequency under a 4-term Blackman-Harris window)."""
+    outs = ", ".join(f"FrictionPattern.grating(Sweep.ar(0, {v}), 0.2, {d}, 0.02, antialias: {a})"
+                     for v, d, _, _ in FOLDING for a in (1, 0))
+    data, _ = nrt.score_and_render("gallery-folding", f"""
+        var def = SynthDef(\\folding, {{ Out.ar(0, [{outs}]) }});
+        score = Score([[0.0, ['/d_recv', def.asBytes]], [0.0, Synth.basicNew(\\folding, nil, 1000).newMsg],
+            [{seconds}, ['/c_set', 0, 0]]]);
+    """, sample_rate=rate, channels=2 * len(FOLDING))
+    n, step = int(seconds * rate) - 64, K.frame_samples(rate)
+    out = []
+    for i, (v, d, harmonic, folded) in enumerate(FOLDING):
+        amplitudes = []
+        for column in (2 * i, 2 * i + 1):
+            force = data[rate // 100:n, column].astype(np.float64)
+            frames = force[:len(force) // step * step].reshape(-1, step).mean(axis=1)
+            k = np.arange(len(frames))
+            p = 2 * np.pi * k / len(frames)
+            w = 0.35875 - 0.48829 * np.cos(p) + 0.14128 * np.cos(2 * p) - 0.01168 * np.cos(3 * p)
+            line = np.sum((frames - frames.mean()) * w * np.exp(-2j * np.pi * folded * k * step / rate))
+            amplitudes.append(float(2 * abs(line) / w.sum()))
+        out.append((v, d, harmonic, folded, *amplitudes))
+    return out
+
+
 def write_pattern(out_dir, name, speed_name, cols, rate, reference):
     x, v, requested, commanded = cols
     t = np.arange(len(x)) / rate
@@ -176,11 +208,12 @@ def main():
                 deviation=float(np.max(np.abs(cols[2] - ref))) if ref is not None else None,
                 alias=largest_alias_n(frames) if len(frames) else float("nan")))
             figures[(name, speed_name)] = rows[-1]
-    write_summary(out_dir, rows, figures, rate, time.time() - start)
+    folding = folded_harmonics(rate)
+    write_summary(out_dir, rows, figures, folding, rate, time.time() - start)
     log(f"== gallery done in {time.time() - start:.1f} s. Results: {out_dir} (summary: {out_dir / 'summary.md'})")
 
 
-def write_summary(out_dir, rows, figures, rate, elapsed):
+def write_summary(out_dir, rows, figures, folding, rate, elapsed):
     L = ["# KineticFriction pattern gallery: rendered on the simulated device\n",
          f"Rendered with scsynth -N at **{rate} Hz**: each pattern on its own `FrictionDevice.sim` slot "
          f"(paper profile: 0.021 mm counts at 125 Hz, 0.14..1.4 N; a firm hand, `{HAND}`: 0.25 mm of lag at 0.5 N), "
@@ -212,7 +245,12 @@ def write_summary(out_dir, rows, figures, rate, elapsed):
           "|---|---|---|---|",
           f"| anti-aliased (`antialias: 1`) | {on['mean_speed']:.1f} | {on['mean_speed'] / 0.2:.0f} | {on['alias']:.2g} |",
           f"| raw (`antialias: 0`) | {off['mean_speed']:.1f} | {off['mean_speed'] / 0.2:.0f} | {off['alias']:.2g} |",
-          f"\nAt the slow speed ({slow['mean_speed']:.1f} mm/s, {slow['mean_speed'] / 0.2:.0f} Hz) the anti-aliased "
+          "\nThe harmonics of the sharp grating on exact position ramps (`Sweep`), where the fundamental is "
+          "below 500 Hz but a harmonic is above it: the amplitude in the frames at the frequency it folds to.\n",
+          "| speed (mm/s) | duty | harmonic (Hz) | folds to (Hz) | anti-aliased (N) | raw (N) |",
+          "|---|---|---|---|---|---|"]
+    L += [f"| {v:g} | {d:g} | {h:.0f} | {f:.0f} | {on_n:.2g} | {raw_n:.2g} |" for v, d, h, f, on_n, raw_n in folding]
+    L += [f"\nAt the slow speed ({slow['mean_speed']:.1f} mm/s, {slow['mean_speed'] / 0.2:.0f} Hz) the anti-aliased "
           f"grating is rendered in full: {slow['force'][0]:.3f} .. {slow['force'][1]:.3f} N of {LO} .. {HI} N.\n",
           "The pilot's fragment (mapping 3, one sine cycle per 12.5 mm) as bumps by the height rule "
           "(`pilot-bumps-height-rule`) beside the paper's loudness rule (`pilot-loudness-rule`): one resistance "
