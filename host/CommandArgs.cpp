@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/PrintfFormat.hpp"
 namespace kf::sc {
 
 namespace {
@@ -18,7 +19,7 @@ uint32_t bigEndian32(const char* at) {
 
 uint64_t bigEndian64(const char* at) { return uint64_t(bigEndian32(at)) << 32 | bigEndian32(at + 4); }
 
-bool fail(char* error, size_t errorSize, const char* format, ...) __attribute__((format(printf, 3, 4)));
+bool fail(char* error, size_t errorSize, const char* format, ...) KF_PRINTF_FORMAT(3, 4);
 bool fail(char* error, size_t errorSize, const char* format, ...) {
   va_list args;
   va_start(args, format);

@@ -17,6 +17,7 @@
 #include <SC_PlugIn.hpp>
 
 #include "CommandArgs.hpp"
+#include "core/PrintfFormat.hpp"
 #include "DeviceFactory.hpp"
 
 namespace kf::sc {
@@ -45,7 +46,7 @@ struct CommandData {
 };
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.
-void failWith(CommandData* data, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void failWith(CommandData* data, const char* format, ...) KF_PRINTF_FORMAT(2, 3);
 // RT: the failure to the notified clients: /kfFail, node 0, reply ID the device (-1 when the
 // device argument itself was wrong, or the command has none), then the reason as character
 // codes, which starts with the command's name ("kfRecord: ...").

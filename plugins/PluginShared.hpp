@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/PrintfFormat.hpp"
 extern InterfaceTable* ft;
 
 namespace kf::sc {
@@ -20,7 +21,7 @@ inline int codeOf(float input) { return input > -1e9f && input < 1e9f ? static_c
 // Posts a message without doing I/O on the audio thread: the text is formatted into static
 // storage and printed by the NRT thread (directly when rendering a Score, where there is no
 // realtime audio thread to protect).
-void postFromRt(World* world, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void postFromRt(World* world, const char* format, ...) KF_PRINTF_FORMAT(2, 3);
 
 // Each kind of bad input of one unit is posted once, the first time it happens: a bad value
 // held for an hour posts one line, not one a block, and so does an input that flips between good

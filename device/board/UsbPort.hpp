@@ -19,7 +19,20 @@
 namespace kf::usb {
 
 // The outcomes the driver tells apart (libusb's error codes, reduced).
-enum class Result { kOk, kIo, kInvalid, kAccess, kNoDevice, kNotFound, kBusy, kTimeout, kPipe, kLeaked, kOther };
+enum class Result {
+  kOk,
+  kIo,
+  kInvalid,
+  kAccess,
+  kNoDevice,
+  kNotFound,
+  kBusy,
+  kTimeout,
+  kPipe,
+  kLeaked,
+  kOther,
+  kNotBuilt  // a build without hardware backends (KF_WITH_HARDWARE=OFF): no libusb
+};
 const char* describe(Result result);
 
 enum class TransferStatus { kCompleted, kError, kTimedOut, kCancelled, kStall, kNoDevice, kOverflow };
@@ -94,7 +107,8 @@ class Port {
   virtual Result handleEvents(int timeoutMs) = 0;
 };
 
-// libusb-1.0.
+// libusb-1.0 (LibusbPort.cpp); in a build without hardware backends a port whose init() answers
+// kNotBuilt (LibusbPortAbsent.cpp).
 std::unique_ptr<Port> makeLibusbPort();
 
 }  // namespace kf::usb

@@ -1,7 +1,5 @@
 #include "core/Device.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -405,11 +403,9 @@ void Device::emergencyOff() noexcept {
   halted_.store(true);
   // A pump running on another thread may still command a force and write records: let it
   // finish first, for at most 50 ms (the handler may be running on that very thread).
-  timespec start{}, now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &start);
+  const int64_t startNs = monotonicNanosecondsFromSignal();
   while (pumping_.load()) {
-    ::clock_gettime(CLOCK_MONOTONIC, &now);
-    if ((now.tv_sec - start.tv_sec) * 1e9 + (now.tv_nsec - start.tv_nsec) > 50e6) break;
+    if (monotonicNanosecondsFromSignal() - startNs > 50000000) break;
   }
   force_->driveOffFromSignal();
   // The board's off set-point is queued for its event thread; if the process dies first, the

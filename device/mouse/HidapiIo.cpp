@@ -189,11 +189,4 @@ std::shared_ptr<HidApi> realHidApi() {
   return api;
 }
 
-std::string permissionFix(const std::string& path) {
-  return "permission denied opening " + path +
-         ". Fix: install KineticFriction's udev rule (device/mouse/udev/ of the repository, udev/ of the "
-         "extension folder): sudo cp 70-kineticfriction.rules /etc/udev/rules.d/ && sudo udevadm control "
-         "--reload && sudo udevadm trigger, then unplug and replug the mouse";
-}
-
 }  // namespace kf

@@ -1,10 +1,8 @@
 #include "mouse/RealMouseBackend.hpp"
 
-#include <pthread.h>
-
-#include <csignal>
 #include <cstdio>
 
+#include "core/threads/ThreadScheduling.hpp"
 #include "mouse/MouseSelect.hpp"
 
 namespace kf {
@@ -27,22 +25,9 @@ bool RealMouseBackend::openSelected(const std::vector<MouseInfo>& mice, const st
 void RealMouseBackend::startReader() {
   if (thread_.joinable()) return;
   state_.store(static_cast<int>(MouseState::kRunning), std::memory_order_release);
-  // The reader is born with every asynchronous signal blocked (a thread inherits its creator's
-  // mask), so no signal meant for the process (SIGINT, SIGCHLD, a profiler's SIGPROF) is ever
-  // handled on it: hid_read_timeout would return -1 from poll's EINTR, which reads as an
-  // unplug. The faults a thread causes itself stay unblocked, so a crash still reaches the
-  // exit handlers (host/ExitSafety) that drive the magnet off.
-  sigset_t blocked, previous;
-  sigfillset(&blocked);
-  for (int fault : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS}) sigdelset(&blocked, fault);
-  pthread_sigmask(SIG_BLOCK, &blocked, &previous);
-  try {
-    thread_ = std::thread([this] { threadMain(); });
-  } catch (...) {  // no thread: the caller (a command's NRT thread) gets its own mask back
-    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
-    throw;
-  }
-  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  // No signal meant for the process is handled on the reader: hid_read_timeout would return -1
+  // from poll's EINTR, which reads as an unplug.
+  thread_ = startThreadWithAsyncSignalsBlocked([this] { threadMain(); });
 }
 
 void RealMouseBackend::stop() {

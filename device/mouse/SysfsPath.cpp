@@ -1,9 +1,9 @@
 #include "mouse/SysfsPath.hpp"
 
 #include <cctype>
-#include <climits>
-#include <cstdlib>
+#include <filesystem>
 #include <sstream>
+#include <system_error>
 
 namespace kf {
 
@@ -47,8 +47,9 @@ std::string stableBusPath(const std::string& sysfsPath) {
 }
 
 std::string resolveSysfs(const std::string& link) {
-  char resolved[PATH_MAX];
-  return ::realpath(link.c_str(), resolved) ? std::string(resolved) : std::string();
+  std::error_code error;
+  const std::filesystem::path resolved = std::filesystem::canonical(link, error);  // realpath(3)
+  return error ? std::string() : resolved.string();
 }
 
 }  // namespace kf

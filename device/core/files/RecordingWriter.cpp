@@ -1,9 +1,5 @@
 #include "core/files/RecordingWriter.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -11,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/files/FileDescriptors.hpp"
 #include "core/threads/ThreadScheduling.hpp"
 
 namespace kf {
@@ -31,7 +28,7 @@ RecordingFiles& recordingFiles() {
 
 bool writeAll(int fd, const char* data, size_t size, int& code) {
   while (size > 0) {
-    const ssize_t written = ::write(fd, data, size);
+    const long written = writeFile(fd, data, size);
     if (written < 0) {
       if (errno == EINTR) continue;
       code = errno;
@@ -56,7 +53,7 @@ int openRecordingFile(const std::string& path, unsigned long long& fileDevice, u
   }
   // No O_TRUNC yet: a file another recording writes must not be cut. O_NONBLOCK: a FIFO
   // without a reader must not block the command thread.
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0644);
+  const int fd = openFileNoWait(path, true);
   if (fd < 0) {
     const int code = errno;
     if (code == ENXIO)  // a FIFO without a reader, a device without its driver
@@ -65,21 +62,21 @@ int openRecordingFile(const std::string& path, unsigned long long& fileDevice, u
       error = "cannot write " + path + ": " + std::strerror(code);
     return -1;
   }
-  struct stat info {};
+  FileIdentity info;
   std::string problem;
-  if (::fstat(fd, &info) != 0)
+  if (!identifyFile(fd, info))
     problem = "cannot write " + path + ": " + std::strerror(errno);
-  else if (S_ISDIR(info.st_mode))
+  else if (info.directory)
     problem = path + " is a directory";
-  else if (!S_ISREG(info.st_mode))
+  else if (!info.regular)
     problem = "cannot record to " + path + ": not a regular file (a FIFO, device or socket)";
   if (problem.empty()) {
     RecordingFiles& files = recordingFiles();
     std::lock_guard<std::mutex> lock(files.mutex);
-    const std::pair<unsigned long long, unsigned long long> key{info.st_dev, info.st_ino};
+    const std::pair<unsigned long long, unsigned long long> key{info.device, info.inode};
     if (std::find(files.keys.begin(), files.keys.end(), key) != files.keys.end()) {
       problem = "cannot record to " + path + ": another device is recording to this file";
-    } else if (::ftruncate(fd, 0) != 0 || ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
+    } else if (!truncateFile(fd, 0) || !makeBlocking(fd)) {
       problem = "cannot write " + path + ": " + std::strerror(errno);
     } else {
       files.keys.push_back(key);
@@ -88,7 +85,7 @@ int openRecordingFile(const std::string& path, unsigned long long& fileDevice, u
     }
   }
   if (!problem.empty()) {
-    ::close(fd);
+    closeFileDescriptor(fd);
     error = problem;
     return -1;
   }
@@ -174,7 +171,7 @@ bool RecordingWriter::writeOut(const std::string& data) {
   int code = 0;
   if (!writeAll(fd, data.data(), data.size(), code)) {
     // Part of the chunk may be in the file: cut it back to the last whole line written.
-    if (::ftruncate(fd, static_cast<off_t>(bytesWritten_)) != 0) {
+    if (!truncateFile(fd, bytesWritten_)) {
     }
     failWith(code);
     return false;
@@ -194,7 +191,7 @@ void RecordingWriter::failWith(int code) {
 int RecordingWriter::closeFile() {
   const int fd = fd_.exchange(-1, std::memory_order_acq_rel);
   if (fd < 0) return 0;
-  const int code = ::close(fd) == 0 ? 0 : errno;
+  const int code = closeFileDescriptor(fd) == 0 ? 0 : errno;
   RecordingFiles& files = recordingFiles();
   std::lock_guard<std::mutex> lock(files.mutex);
   const std::pair<unsigned long long, unsigned long long> key{fileDevice_, fileInode_};

@@ -1,7 +1,5 @@
 #include "core/files/SessionFile.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -9,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/files/FileDescriptors.hpp"
 #include "core/files/TextFileReader.hpp"
 #include "core/spec/SettingBounds.hpp"
 
@@ -188,8 +187,7 @@ void Recorder::appendOffFromSignal(double hostTimeS) const {
   text[n++] = '.';
   for (uint64_t scale = 100000000; scale > 0; scale /= 10) text[n++] = static_cast<char>('0' + (nanos / scale) % 10);
   text[n++] = '\n';
-  ssize_t ignored = ::write(fd, text, static_cast<size_t>(n));
-  (void)ignored;
+  (void)writeFile(fd, text, static_cast<size_t>(n));
 }
 
 bool isSessionFile(const std::string& path) {

@@ -1,11 +1,9 @@
 #include "core/files/TextFileReader.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstring>
+
+#include "core/files/FileDescriptors.hpp"
 
 namespace kf {
 
@@ -20,7 +18,7 @@ bool TextFileReader::open(const std::string& path, std::string& error, uint64_t 
     return false;
   }
   // O_NONBLOCK: opening a FIFO must not wait for a writer; the checks below refuse it anyway.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  const int fd = openFileNoWait(path, false);
   if (fd < 0) {
     const int code = errno;
     if (code == ENOENT || code == ENOTDIR)
@@ -31,28 +29,28 @@ bool TextFileReader::open(const std::string& path, std::string& error, uint64_t 
       error = "cannot open " + path + ": " + std::strerror(code);
     return false;
   }
-  struct stat info {};
+  FileIdentity info;
   std::string problem;
-  if (::fstat(fd, &info) != 0)
+  if (!identifyFile(fd, info))
     problem = "cannot read " + path + ": " + std::strerror(errno);
-  else if (S_ISDIR(info.st_mode))
+  else if (info.directory)
     problem = path + " is a directory, not a recording";
-  else if (!S_ISREG(info.st_mode))
+  else if (!info.regular)
     problem = path + " is not a regular file (a FIFO, device or socket); refused";
-  else if (info.st_size == 0)
+  else if (info.size == 0)
     problem = path + " is empty";
-  else if (static_cast<uint64_t>(info.st_size) > maxBytes)
+  else if (info.size > maxBytes)
     problem = path + " is larger than " + std::to_string(maxBytes) + " bytes; refused";
-  if (problem.empty() && ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0)
+  if (problem.empty() && !makeBlocking(fd))
     problem = "cannot read " + path + ": " + std::strerror(errno);
   if (!problem.empty()) {
-    ::close(fd);
+    closeFileDescriptor(fd);
     error = problem;
     return false;
   }
-  file_ = ::fdopen(fd, "r");
+  file_ = readingStream(fd);
   if (file_ == nullptr) {
-    ::close(fd);
+    closeFileDescriptor(fd);
     error = "cannot read " + path + ": " + std::strerror(errno);
     return false;
   }

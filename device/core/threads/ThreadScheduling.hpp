@@ -3,12 +3,17 @@
 // a name that ps -L and top -H show (kf-device-0), SCHED_FIFO at a priority chosen relative to
 // the audio thread, memory locked. Where the system refuses, the thread runs on at normal
 // priority and one message per process says how to grant it. Never a reason to fail an open.
-// Linux (pthread, sched, mlock, clock_nanosleep); the calls are POSIX but for the thread name.
+// The calls to the system are in one file per platform (ThreadSchedulingPosix.cpp with
+// ThreadSchedulingLinux.cpp or ThreadSchedulingPosixGeneric.cpp; ThreadSchedulingWindows.cpp).
 #pragma once
 
 #include <atomic>
 #include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <string>
+#include <thread>
 
 namespace kf {
 
@@ -76,6 +81,17 @@ ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& reque
 // Sleeps until `deadline` on the monotonic clock, as an absolute deadline (clock_nanosleep
 // TIMER_ABSTIME): a wake-up's lateness does not add to the next one's.
 void sleepUntil(std::chrono::steady_clock::time_point deadline);
+
+// A thread running `work`, born with every asynchronous signal blocked (a thread inherits its
+// creator's mask), so that no signal meant for the process (SIGINT, SIGCHLD, a profiler's
+// SIGPROF) is handled on it: a blocking read there would return EINTR, which reads as an
+// unplug. The faults a thread causes itself stay unblocked, so a crash still reaches the exit
+// handlers (host/ExitSafety) that drive the magnet off. Where there are no signals (Windows), a
+// plain std::thread.
+std::thread startThreadWithAsyncSignalsBlocked(std::function<void()> work);
+
+// The monotonic clock in ns, callable from a signal handler (async-signal-safe).
+int64_t monotonicNanosecondsFromSignal();
 
 // "SCHED_FIFO 66, memory locked" / "normal priority (realtime refused)" / "not started".
 std::string describe(const ThreadScheduling& s);

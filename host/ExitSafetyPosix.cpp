@@ -12,7 +12,8 @@
 // installed before ours if there was one, else the original disposition is restored and the
 // signal raised again, so the exit status is the signal's. A signal ignored when the plugin
 // loads (nohup's SIGHUP) stays ignored. SIGKILL cannot be caught: the device thread dies with
-// the process and a real magnet's own watchdog must act.
+// the process and a real magnet's own watchdog must act. POSIX (SIGPWR and SIGSTKFLT where the
+// system has them: Linux); Windows has ExitSafetyWindows.cpp.
 #include "ExitSafety.hpp"
 
 #include <signal.h>
@@ -24,9 +25,16 @@
 
 namespace {
 
-constexpr int kSignals[] = {SIGTERM, SIGINT,    SIGHUP,  SIGQUIT, SIGUSR1, SIGUSR2,  SIGPIPE,
-                            SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGPWR,  SIGSEGV,  SIGBUS,
-                            SIGFPE,  SIGILL,    SIGABRT, SIGSYS,  SIGTRAP, SIGSTKFLT};
+constexpr int kSignals[] = {SIGTERM, SIGINT,  SIGHUP,  SIGQUIT, SIGUSR1, SIGUSR2, SIGPIPE, SIGALRM, SIGVTALRM, SIGPROF,
+                            SIGXCPU,
+#ifdef SIGPWR
+                            SIGPWR,
+#endif
+                            SIGSEGV, SIGBUS,  SIGFPE,  SIGILL,  SIGABRT, SIGSYS,  SIGTRAP,
+#ifdef SIGSTKFLT
+                            SIGSTKFLT,
+#endif
+};
 
 struct sigaction gPrevious[NSIG];
 std::atomic<bool> gInstalled[NSIG];
