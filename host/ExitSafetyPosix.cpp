@@ -25,14 +25,14 @@
 
 namespace {
 
-constexpr int kSignals[] = {SIGTERM, SIGINT,  SIGHUP,  SIGQUIT, SIGUSR1, SIGUSR2, SIGPIPE, SIGALRM, SIGVTALRM, SIGPROF,
-                            SIGXCPU,
+constexpr int kSignals[] = {
+    SIGTERM,   SIGINT, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGPIPE, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU,
 #ifdef SIGPWR
-                            SIGPWR,
+    SIGPWR,
 #endif
-                            SIGSEGV, SIGBUS,  SIGFPE,  SIGILL,  SIGABRT, SIGSYS,  SIGTRAP,
+    SIGSEGV,   SIGBUS, SIGFPE, SIGILL,  SIGABRT, SIGSYS,  SIGTRAP,
 #ifdef SIGSTKFLT
-                            SIGSTKFLT,
+    SIGSTKFLT,
 #endif
 };
 

@@ -17,8 +17,8 @@
 #include <SC_PlugIn.hpp>
 
 #include "CommandArgs.hpp"
-#include "core/PrintfFormat.hpp"
 #include "DeviceFactory.hpp"
+#include "core/PrintfFormat.hpp"
 
 namespace kf::sc {
 

@@ -11,6 +11,7 @@ PACKAGES=(
   libhidapi-dev libusb-1.0-0-dev catch2 libsndfile1-dev jackd2
   python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
   rt-tests
+  g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
 )
 source scripts/packages.sh
 kf_install_missing "${PACKAGES[@]}"

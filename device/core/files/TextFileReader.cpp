@@ -41,8 +41,7 @@ bool TextFileReader::open(const std::string& path, std::string& error, uint64_t 
     problem = path + " is empty";
   else if (info.size > maxBytes)
     problem = path + " is larger than " + std::to_string(maxBytes) + " bytes; refused";
-  if (problem.empty() && !makeBlocking(fd))
-    problem = "cannot read " + path + ": " + std::strerror(errno);
+  if (problem.empty() && !makeBlocking(fd)) problem = "cannot read " + path + ": " + std::strerror(errno);
   if (!problem.empty()) {
     closeFileDescriptor(fd);
     error = problem;

@@ -1,0 +1,28 @@
+"""The extension folder as SuperCollider users install it: KF_EXTENSION_DIR=user is the folder
+sclang's Platform.userExtensionDir names (cmake/UserExtensionDir.cmake, on this system), and the
+installed folder is a quark whose classes and help Quarks.install would add."""
+import os
+import re
+import subprocess
+
+from kfharness import paths, sclang
+
+
+def test_user_extension_dir_is_sclangs_and_the_folder_is_a_quark():
+    cmake = subprocess.run(["cmake", "-DKF_EXTENSION_DIR=user", "-P", str(paths.REPO_DIR / "cmake" / "UserExtensionDir.cmake")],
+                           capture_output=True, text=True, check=True, env=os.environ)
+    configured = cmake.stdout.strip().removeprefix("-- Extension folder: ")
+    ext = paths.extension_dir()
+    out = sclang.run_script(f"""
+        var quark = Quark.fromLocalPath({sclang.sc_string(ext)});
+        "USER-EXTENSIONS %".format(Platform.userExtensionDir).postln;
+        "QUARK % % %".format(quark.name, quark.version, quark.data['schelp']).postln;
+        "QUARK-HELP %".format(File.exists(quark.localPath +/+ "HelpSource" +/+ quark.data['schelp'] ++ ".schelp")).postln;
+        "QUARK-CLASSES %".format(File.exists(quark.localPath +/+ "Classes/FrictionDevice.sc")).postln;
+    """)
+    line = next(l for l in out.splitlines() if l.startswith("USER-EXTENSIONS "))
+    assert configured == line.removeprefix("USER-EXTENSIONS ") + "/KineticFriction"
+    version = re.search(r"project\(KineticFriction VERSION ([0-9.]+)", (paths.REPO_DIR / "CMakeLists.txt").read_text())[1]
+    assert f"QUARK KineticFriction {version} Overviews/KineticFriction" in out
+    assert "QUARK-HELP true" in out
+    assert "QUARK-CLASSES true" in out
