@@ -3,6 +3,7 @@
 #   *Posix.cpp          every POSIX system (Linux and the others)
 #   *PosixGeneric.cpp   a POSIX system other than Linux: the path macOS takes
 #   *Windows.cpp        Windows
+#   *NotLinux.cpp       every system but Linux
 # KF_PLATFORM=posix on Linux builds the macOS path here (scripts/check.sh cross, with clang and
 # libc++). KF_WITH_HARDWARE=OFF leaves hidapi and libusb out (mouse/HidapiIoAbsent.cpp,
 # board/LibusbPortAbsent.cpp answer instead): Debian ships neither for MinGW.
@@ -18,8 +19,8 @@ set_property(CACHE KF_PLATFORM PROPERTY STRINGS linux posix windows)
 option(KF_WITH_HARDWARE "Real mice (hidapi) and the friction board (libusb)" ON)
 
 set(kf_platform_linux Linux Posix)
-set(kf_platform_posix Posix PosixGeneric)
-set(kf_platform_windows Windows)
+set(kf_platform_posix Posix PosixGeneric NotLinux)
+set(kf_platform_windows Windows NotLinux)
 if(NOT DEFINED kf_platform_${KF_PLATFORM})
   message(FATAL_ERROR "KF_PLATFORM must be linux, posix or windows, not '${KF_PLATFORM}'")
 endif()
@@ -30,7 +31,7 @@ function(kf_platform_sources sources_var)
   set(kept)
   foreach(source IN LISTS ${sources_var})
     get_filename_component(name ${source} NAME_WE)
-    if(name MATCHES "(Linux|PosixGeneric|Posix|Windows)$")
+    if(name MATCHES "(NotLinux|Linux|PosixGeneric|Posix|Windows)$")
       if(NOT CMAKE_MATCH_1 IN_LIST kf_platform_${KF_PLATFORM})
         continue()
       endif()

@@ -2,7 +2,7 @@
 // (enumerate, open by path, read with a timeout, close, the report descriptor) and a Linux
 // evdev node (open, EVIOCSCLOCKID, EVIOCGRAB, EVIOCGNAME, EVIOCGID, read input_event). The
 // backends only see these, so tests put fakes behind them that replay recorded devices in real
-// time and fail as the real ones do. Real implementations: HidapiIo.cpp, EvdevIo.cpp.
+// time and fail as the real ones do. Real implementations: HidapiIo.cpp, EvdevIoLinux.cpp.
 #pragma once
 
 #include <cstdint>

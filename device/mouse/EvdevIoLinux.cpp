@@ -1,7 +1,16 @@
 // The real EvdevApi: Linux input event nodes. Enumeration reads sysfs (names, ids, the REL
 // capability bits), which needs no permission on the nodes themselves.
+// Off Linux, EvdevIoNotLinux.cpp.
+#include <dirent.h>
+#include <fcntl.h>
+#include <linux/input.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -10,20 +19,8 @@
 #include "mouse/MouseSelect.hpp"
 #include "mouse/SysfsPath.hpp"
 
-#ifdef __linux__
-#include <dirent.h>
-#include <fcntl.h>
-#include <linux/input.h>
-#include <poll.h>
-#include <sys/ioctl.h>
-#include <unistd.h>
-
-#include <ctime>
-#endif
-
 namespace kf {
 
-#ifdef __linux__
 namespace {
 
 std::string readLine(const std::string& path) {
@@ -201,31 +198,5 @@ std::shared_ptr<EvdevApi> realEvdevApi() {
 std::shared_ptr<EvdevApi> evdevApiReadingSysfsAt(const std::string& sysClassInput) {
   return std::make_shared<RealEvdevApi>(sysClassInput);
 }
-
-#else
-
-namespace {
-class NoEvdevApi : public EvdevApi {
- public:
-  bool enumerateMice(std::vector<MouseInfo>& out, std::string&) override {
-    out.clear();
-    return true;
-  }
-  std::unique_ptr<EvdevHandle> open(const std::string&, std::string& error, OpenFailure& why) override {
-    error = "evdev is Linux only; use the hidapi backend";
-    why = OpenFailure::kOther;
-    return nullptr;
-  }
-};
-}  // namespace
-
-std::shared_ptr<EvdevApi> realEvdevApi() {
-  static std::shared_ptr<EvdevApi> api = std::make_shared<NoEvdevApi>();
-  return api;
-}
-
-std::shared_ptr<EvdevApi> evdevApiReadingSysfsAt(const std::string&) { return realEvdevApi(); }
-
-#endif
 
 }  // namespace kf
