@@ -6,13 +6,12 @@ pattern's deviation from its definition (kfharness.patterns) and the anti-aliasi
 Usage: scripts/gallery/gallery_job.py [--rate 48000] [--out out/gallery]
 """
 import argparse
-import csv
 import time
 from pathlib import Path
 
 import numpy as np
 
-from kfharness import nrt, paths
+from kfharness import nrt, paths, trace_csv
 from kfharness import patterns as K
 from kfharness import pilot as P
 
@@ -80,8 +79,8 @@ def render(speed_name, speed, seconds, rate):
     data, _ = nrt.score_and_render(f"gallery-{speed_name}", score_code(speed, seconds), sample_rate=rate,
                                    channels=CHANNELS_PER_PATTERN * len(PATTERNS), memory_kb=262144,
                                    extra_args=("-w", "1024"))  # wires: 11 patterns in one SynthDef
-    # Only while the synth ran: after it, the outputs are silence (no all-zero row in the CSVs).
-    n = min(len(data), int(seconds * rate) - 64)
+    # Only while the synth ran (the Score frees it at `seconds`): after it, the render is silence.
+    n = min(len(data), trace_csv.end_sample(seconds, rate))
     return data[:n].astype(np.float64)
 
 
@@ -134,14 +133,15 @@ def folded_harmonics(rate, seconds=1.0):
 def write_pattern(out_dir, name, speed_name, cols, rate, reference):
     x, v, requested, commanded = cols
     t = np.arange(len(x)) / rate
-    step = max(1, K.frame_samples(rate))
-    with open(out_dir / f"{name}-{speed_name}.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["time_s", "position_mm", "speed_mm_per_s", "force_requested_n", "force_commanded_n",
-                    "force_definition_n"])
-        for i in range(0, len(x), step):
-            ref = f"{reference[i]:.6f}" if reference is not None else ""
-            w.writerow([f"{t[i]:.4f}", f"{x[i]:.5f}", f"{v[i]:.3f}", f"{requested[i]:.6f}", f"{commanded[i]:.6f}", ref])
+    # The pilot's writer (kfharness.trace_csv): one row per frame, none after the scene's end.
+    # (A pattern without a definition here, the pilot's two rules, has no definition column.)
+    trace = dict(t=t, sr=rate, x=x, v=v, requested=requested, commanded=commanded, reference=reference)
+    columns = [("time_s", "t", "{:.4f}"), ("position_mm", "x", "{:.5f}"), ("speed_mm_per_s", "v", "{:.3f}"),
+               ("force_requested_n", "requested", "{:.6f}"), ("force_commanded_n", "commanded", "{:.6f}")]
+    if reference is not None:
+        columns.append(("force_definition_n", "reference", "{:.6f}"))
+    trace_csv.write(out_dir / f"{name}-{speed_name}.csv", trace, len(x) / rate, columns=columns,
+                    period_s=K.frame_samples(rate) / rate)
     fig, ax = plt.subplots(3, 1, figsize=(9, 7.5), gridspec_kw=dict(height_ratios=[3, 2, 1]))
     # A 2 mm window from where the puck was at 60 % of the run: fine patterns made readable.
     x0 = x[int(0.6 * len(x))]
