@@ -21,8 +21,9 @@ SimDevice::Push SimDevice::handPush(double timeS) const {
   // fingertip pushes (along x alone: clamped to +-handMaxForceN, as before there was a y).
   const HandTarget target = hand_.at(timeS);
   auto spring = [&](double targetMm, double puckMm, double targetMmPerS, double puckMmPerS) {
-    return params_.handStiffnessNPerM * (targetMm - puckMm) * 1e-3 +
-           params_.handDampingNSPerM * (targetMmPerS - puckMmPerS) * 1e-3;
+    // Metres first, then the gains: the 1D model's rounding, so that x alone stays bit for bit.
+    return params_.handStiffnessNPerM * ((targetMm - puckMm) * 1e-3) +
+           params_.handDampingNSPerM * ((targetMmPerS - puckMmPerS) * 1e-3);
   };
   const double x = spring(target.positionMm, positionMm(), target.speedMmPerS, speedMmPerS());
   const double y = spring(target.yMm, positionYMm(), target.speedYMmPerS, speedYMmPerS());

@@ -9,6 +9,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -26,13 +28,14 @@ std::atomic<bool> gRefusalPosted{false};
 void postRefusalOnce(const char* name, int priority, int error) {
   if (gRefusalPosted.exchange(true)) return;
   char message[640];
-  std::snprintf(message, sizeof(message),
-                "KineticFriction: realtime scheduling (SCHED_FIFO %d) refused for %s (%s): the device threads run at "
-                "normal priority, so a busy machine can delay force frames and mouse reports by tens of ms. Grant it "
-                "as for JACK: put the user in the 'audio' group with '@audio - rtprio 95' and '@audio - memlock "
-                "unlimited' in /etc/security/limits.d/audio.conf and log in again (a systemd service: "
-                "LimitRTPRIO=95, LimitMEMLOCK=infinity).",
-                priority, name, std::strerror(error));
+  std::snprintf(
+      message, sizeof(message),
+      "KineticFriction: realtime scheduling (SCHED_FIFO %d) refused for %s (%s): the device threads run at "
+      "normal priority, so a busy machine can delay force frames and mouse reports by tens of ms. On Linux, "
+      "grant it as for JACK: put the user in the 'audio' group with '@audio - rtprio 95' and '@audio - memlock "
+      "unlimited' in /etc/security/limits.d/audio.conf and log in again (a systemd service: "
+      "LimitRTPRIO=95, LimitMEMLOCK=infinity).",
+      priority, name, std::strerror(error));
   postDeviceMessage(message);
 }
 
@@ -71,9 +74,13 @@ ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& reque
     // may be realtime), and lowering is always allowed.
     ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &param);
   } else {
-    param.sched_priority = priority;
+    // Within the system's SCHED_FIFO range: Linux's 1..99 holds every priority we ask for, but
+    // other systems have narrower ones (macOS: 15..47), where a priority outside it is refused.
+    // Not testable here (Linux); the libc++ build compiles this path.
+    param.sched_priority =
+        std::clamp(priority, ::sched_get_priority_min(SCHED_FIFO), ::sched_get_priority_max(SCHED_FIFO));
     if (const int error = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &param); error != 0)
-      postRefusalOnce(name, priority, error);
+      postRefusalOnce(name, param.sched_priority, error);
     got.memoryLocked = lockStackBelow();
   }
   got.priority = currentThreadPriority();  // what it has, inherited or not

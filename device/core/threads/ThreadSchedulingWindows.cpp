@@ -2,12 +2,16 @@
 // Process Explorer show it), realtime as THREAD_PRIORITY_TIME_CRITICAL (the highest a thread of
 // a normal-class process gets; scsynth's audio thread is at that level too, so there is no "one
 // above"), memory locked with VirtualLock. Deadlines: std::this_thread::sleep_until, whose
-// wake-up is only as fine as the system timer (1 ms once any process, scsynth's audio driver
-// among them, has asked for timeBeginPeriod(1); 15.6 ms otherwise). Nothing here is tested on
+// wake-up is only as fine as the system timer: 15.6 ms unless the process asks for 1 ms
+// (timeBeginPeriod; since Windows 10 2004 another process's request no longer applies to ours),
+// which the first realtime thread does, for the process's life. Nothing here is tested on
 // Windows itself: the suites run under Wine (scripts/check.sh cross), which does not schedule
 // as Windows does.
 #include <windows.h>
+// After windows.h, which it needs.
+#include <timeapi.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cwchar>
 
@@ -58,6 +62,8 @@ ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& reque
   if (priority == kNormalPriority) {
     ::SetThreadPriority(::GetCurrentThread(), THREAD_PRIORITY_NORMAL);
   } else {
+    static const bool fineTimer = ::timeBeginPeriod(1) == TIMERR_NOERROR;  // once per process, never ended
+    (void)fineTimer;
     if (!::SetThreadPriority(::GetCurrentThread(), THREAD_PRIORITY_TIME_CRITICAL) && !gRefusalPosted.exchange(true)) {
       char message[200];
       std::snprintf(message, sizeof(message),

@@ -2,6 +2,7 @@
 // paths, and the puck and sensor following them in x and y, friction against the motion.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "SimTestSupport.hpp"
@@ -147,5 +148,27 @@ TEST_CASE("friction on the surface is the same in every direction", "[sim][2d]")
     // would brake a diagonal line sqrt(2) times harder (millimetres).
     CHECK(std::fabs(along - along0) < 0.01);
     CHECK(std::fabs(off) < 1e-3);
+  }
+}
+
+TEST_CASE("along x alone the hand pushes as the 1D model did, to the last bit", "[sim][2d]") {
+  // The 1D model's spring-damper: the errors in metres first, then the gains, clamped. Any other
+  // order of the same arithmetic rounds differently and moves a 1D scene in its last bits.
+  const DeviceSpec spec;
+  const SimParams params;
+  const HandScript script = HandScript::path({{0.0, 0.0}, {0.2, 20.0}, {0.4, 5.0}});
+  const HandTrajectory hand(script);
+  SimDevice sim(spec, params, script);
+  for (int i = 0; i < 3000; ++i) {
+    const double t = sim.timeS(), puckMm = sim.positionMm(), puckMmPerS = sim.speedMmPerS();
+    sim.commandForce(t, 0.3f);
+    sim.advanceTo(t + 1.5 * params.stepS);  // one step: the push is decided at its start
+    const HandTarget target = hand.at(t);
+    const double errorM = (target.positionMm - puckMm) * 1e-3;
+    const double speedErrorMPerS = (target.speedMmPerS - puckMmPerS) * 1e-3;
+    const double expected = std::clamp(params.handStiffnessNPerM * errorM + params.handDampingNSPerM * speedErrorMPerS,
+                                       -params.handMaxForceN, params.handMaxForceN);
+    INFO("step " << i);
+    REQUIRE(sim.handForceN() == expected);
   }
 }
