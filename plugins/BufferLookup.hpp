@@ -1,9 +1,15 @@
-// The buffer a bufnum input names, global or local to the synth, for the spatial readers. As
+// The buffer a bufnum input names, global or local to the synth, for the spatial readers, and
+// which of its problems to post. As
 // GET_BUF does, the SndBuf is found again only when bufnum changes: its slot stays put, and a
 // freed or reallocated buffer shows in its fields at once.
 #pragma once
 
 #include <SC_PlugIn.hpp>
+
+#include <cstdio>
+
+#include "AudioClock.hpp"
+#include "PostLimiter.hpp"
 
 namespace kf::sc {
 
@@ -34,6 +40,30 @@ class BufferLookup {
   const SndBuf* buf_ = nullptr;
   int bufnum_ = -1;
   bool bad_ = false;
+};
+
+// Which buffer problem of a reader to post: one message per change of problem, and per kind at
+// most one a second (a buffer reallocated 300 times a second posts a line, not hundreds); none
+// when the server runs quiet (verbosity -2 and below, as for SC's own buffer UGens). Problems are
+// numbered 1..kKinds-1, 0 is none.
+template <int kKinds>
+class BufferProblemPosts {
+ public:
+  // True when `problem` is to be posted now; `more` then says how many like it were held back.
+  bool shouldPost(World* world, int problem, char (&more)[64]) {
+    more[0] = '\0';
+    if (problem == current_) return false;
+    current_ = problem;
+    if (problem <= 0 || problem >= kKinds || world->mVerbosity <= -2) return false;
+    int heldBack = 0;
+    if (!limits_[problem].allow(blockStartTimeS(world), heldBack)) return false;
+    if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
+    return true;
+  }
+
+ private:
+  int current_ = 0;
+  PostLimiter limits_[kKinds];
 };
 
 }  // namespace kf::sc

@@ -110,17 +110,10 @@ class SpatialBufRd : public SCUnit {
     return mLayoutOriginMm;
   }
 
-  // One message per change of problem, and per kind of problem at most one a second: a buffer
-  // reallocated 300 times a second posts a line, not hundreds. None when the server runs quiet
-  // (verbosity -2 and below, as for SC's own buffer UGens).
+  // Posts a buffer problem as BufferProblemPosts allows (once per change, a second apart a kind).
   void report(BufferProblem problem, const SndBuf* buf) {
-    if (problem == mProblem) return;
-    mProblem = problem;
-    if (problem == BufferProblem::None || mWorld->mVerbosity <= -2) return;
-    int heldBack = 0;
-    if (!mLimits[static_cast<int>(problem)].allow(kf::sc::blockStartTimeS(mWorld), heldBack)) return;
-    char more[64] = "";
-    if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
+    char more[64];
+    if (!mPosts.shouldPost(mWorld, static_cast<int>(problem), more)) return;
     if (problem == BufferProblem::BadBufnum)
       kf::sc::postFromRt(mWorld, "SpatialBufRd: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
                          kf::sc::shownValue(mBuffer.input()),
@@ -133,9 +126,8 @@ class SpatialBufRd : public SCUnit {
                          mBuffer.bufnum(), buf->channels, static_cast<int>(mNumOutputs), more);
   }
 
-  BufferProblem mProblem = BufferProblem::None;
   kf::sc::BufferLookup mBuffer;
-  kf::sc::PostLimiter mLimits[4];
+  kf::sc::BufferProblemPosts<4> mPosts;
   kf::sc::FirstTimeOnly mBadInputs;
   double mGoodSamplesPerMm = 0.0;  // the last good samplesPerMm, 0 before the first
   double mGoodOriginMm = 0.0;      // the last finite origin, 0 before the first

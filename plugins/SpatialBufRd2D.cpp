@@ -81,15 +81,10 @@ class SpatialBufRd2D : public SCUnit {
     return good;
   }
 
-  // One message per change of problem, at most one a second per kind (SpatialBufRd's rule).
+  // Posts a buffer problem as BufferProblemPosts allows (once per change, a second apart a kind).
   void report(BufferProblem problem, const SndBuf* buf) {
-    if (problem == mProblem) return;
-    mProblem = problem;
-    if (problem == BufferProblem::None || mWorld->mVerbosity <= -2) return;
-    int heldBack = 0;
-    if (!mLimits[static_cast<int>(problem)].allow(kf::sc::blockStartTimeS(mWorld), heldBack)) return;
-    char more[64] = "";
-    if (heldBack > 0) std::snprintf(more, sizeof more, " (%d more like it held back)", heldBack);
+    char more[64];
+    if (!mPosts.shouldPost(mWorld, static_cast<int>(problem), more)) return;
     if (problem == BufferProblem::BadBufnum)
       kf::sc::postFromRt(mWorld, "SpatialBufRd2D: bufnum %g is not a buffer number 0..%d; output is silent.%s\n",
                          kf::sc::shownValue(mBuffer.input()),
@@ -109,9 +104,8 @@ class SpatialBufRd2D : public SCUnit {
                          kf::sc::shownValue(in0(kWidth)), buf->frames, mBuffer.bufnum(), more);
   }
 
-  BufferProblem mProblem = BufferProblem::None;
   kf::sc::BufferLookup mBuffer;
-  kf::sc::PostLimiter mLimits[5];
+  kf::sc::BufferProblemPosts<5> mPosts;
   kf::sc::FirstTimeOnly mBadInputs;
   double mGoodSamplesPerMmX = 0.0, mGoodSamplesPerMmY = 0.0;  // the last good values, 0 before the first
   double mGoodOriginXMm = 0.0, mGoodOriginYMm = 0.0;          // the last finite origins, 0 before the first
