@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/force/TableLines.hpp"
+
 namespace kf {
 
 namespace {
@@ -55,30 +57,15 @@ bool CalibrationTable::fromPoints(std::vector<CalibrationPoint> points, Calibrat
 }
 
 bool CalibrationTable::parse(const std::string& text, CalibrationTable& out, std::string& error) {
-  std::istringstream lines(text);
-  std::string line;
-  int lineNumber = 0;
-  bool haveHeader = false;
-  std::string serial;
+  TableLines lines(text, kHeader, kVersion, "calibration format");
+  std::istringstream fields;
+  std::string first, serial;
   std::vector<CalibrationPoint> points;
   auto fail = [&](const std::string& what) {
-    error = "line " + std::to_string(lineNumber) + ": " + what;
+    error = lines.error(what);
     return false;
   };
-  while (std::getline(lines, line)) {
-    ++lineNumber;
-    const size_t hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    std::istringstream fields(line);
-    std::string first;
-    if (!(fields >> first)) continue;  // blank or comment
-    if (!haveHeader) {
-      int version = 0;
-      if (first != kHeader || !(fields >> version)) return fail("expected the header \"kf-calibration 1\"");
-      if (version != kVersion) return fail("calibration format version " + std::to_string(version) + " is not 1");
-      haveHeader = true;
-      continue;
-    }
+  while (lines.next(fields, first)) {
     if (first == "serial") {
       std::string rest;
       if (!(fields >> serial) || (fields >> rest)) return fail("expected \"serial <the board's USB serial>\"");
@@ -88,11 +75,11 @@ bool CalibrationTable::parse(const std::string& text, CalibrationTable& out, std
     std::istringstream firstField(first);
     std::string rest;
     if (!(firstField >> point.drive) || !firstField.eof() || !(fields >> point.forceN) || (fields >> rest))
-      return fail("expected two numbers, drive (0..1) and force (N): \"" + line + "\"");
+      return fail("expected two numbers, drive (0..1) and force (N): \"" + fields.str() + "\"");
     points.push_back(point);
   }
-  if (!haveHeader) {
-    error = "empty file: expected the header \"kf-calibration 1\"";
+  if (!lines.failure().empty()) {
+    error = lines.failure();
     return false;
   }
   CalibrationTable table;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/files/TextFileReader.hpp"
+#include "core/force/TableLines.hpp"
 
 namespace kf {
 
@@ -52,32 +53,18 @@ double DriveCircuit::sampleForDrive(double driveLevel) const {
 }
 
 bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string& magnetTablePath, std::string& error) {
-  std::istringstream lines(text);
-  std::string line;
-  int lineNumber = 0;
-  bool haveHeader = false;
+  TableLines lines(text, kHeader, kVersion, "drive format");
+  std::istringstream fields;
+  std::string key;
   bool seen[kNumFields] = {};
   DriveCircuit circuit;
   magnetTablePath.clear();
   auto fail = [&](const std::string& what) {
-    error = "line " + std::to_string(lineNumber) + ": " + what;
+    error = lines.error(what);
     return false;
   };
-  while (std::getline(lines, line)) {
-    ++lineNumber;
-    const size_t hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    std::istringstream fields(line);
-    std::string key;
-    if (!(fields >> key)) continue;  // blank or comment
+  while (lines.next(fields, key)) {
     std::string rest;
-    if (!haveHeader) {
-      int version = 0;
-      if (key != kHeader || !(fields >> version)) return fail("expected the header \"kf-drive 1\"");
-      if (version != kVersion) return fail("drive format version " + std::to_string(version) + " is not 1");
-      haveHeader = true;
-      continue;
-    }
     if (key == "magnetTable") {
       if (!magnetTablePath.empty()) return fail("magnetTable is given twice");
       if (!(fields >> magnetTablePath) || (fields >> rest))
@@ -110,8 +97,8 @@ bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string
     circuit.*(field->member) = value;
     seen[index] = true;
   }
-  if (!haveHeader) {
-    error = "empty file: expected the header \"kf-drive 1\"";
+  if (!lines.failure().empty()) {
+    error = lines.failure();
     return false;
   }
   for (int i = 0; i < kNumFields; ++i)

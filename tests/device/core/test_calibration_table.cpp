@@ -99,6 +99,12 @@ TEST_CASE("tables that are not monotone or malformed are rejected with a clear e
   CHECK_FALSE(CalibrationTable::parse("0 0.14\n1 1.4\n", table, error));
   CHECK(error.find("header") != std::string::npos);
   CHECK_FALSE(CalibrationTable::parse("kf-calibration 2\n0 0.1\n", table, error));
+  CHECK(error == "line 1: calibration format version 2 is not 1");
+  CHECK_FALSE(CalibrationTable::parse("# a comment only\n\n", table, error));
+  CHECK(error == "empty file: expected the header \"kf-calibration 1\"");
+  // Blank and comment lines count: the error names the file's own line.
+  CHECK_FALSE(CalibrationTable::parse("# made by hand\nkf-calibration 1\n\n0 0.1 # low\n0.5\n", table, error));
+  CHECK(error == "line 5: expected two numbers, drive (0..1) and force (N): \"0.5\"");
   CHECK_FALSE(CalibrationTable::parse("kf-calibration 1\n0 0.1\n0.5\n", table, error));
   CHECK(error.find("line 3") != std::string::npos);
   CHECK_FALSE(CalibrationTable::parse("kf-calibration 1\n0 0.1 7\n", table, error));
