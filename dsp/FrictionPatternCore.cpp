@@ -33,6 +33,8 @@ void FrictionPatternCore::setParameters(double p1, double p2, double p3, float a
       return stickSlip_.set(p1, p2);
     case PatternKind::Slope:
       return slope_.setFullSlope(p2);
+    case PatternKind::Bumps2D:
+      return gridBumps_.set(p1, p2, p3, anchorMm, lastYMm_);
   }
 }
 
@@ -52,18 +54,22 @@ double FrictionPatternCore::level(const Travel& travel) {
       return stickSlip_.level(travel);
     case PatternKind::Slope:
       return slope_.level(travel, travel_.valueFrameAgo(), travel_.valueNow());
+    case PatternKind::Bumps2D:
+      return gridBumps_.level(travel.fromMm, travel_.valueFrameAgo(), travel.toMm, travel_.valueNow(), antialias_);
   }
   return 0.0;
 }
 
 void FrictionPatternCore::process(const float* positionMm, int positionStride, const float* height, int heightStride,
                                   float* forceN, int numSamples) {
-  const bool withHeight = kind_ == PatternKind::Slope && height != nullptr;
+  const bool twoD = kind_ == PatternKind::Bumps2D;
+  const bool withHeight = (kind_ == PatternKind::Slope || twoD) && height != nullptr;
   const double span = range_.hiN - range_.loN;
   for (int i = 0; i < numSamples; ++i) {
     // Both inputs read before the output is written: forceN may alias either.
     const float x = positionMm[i * positionStride];
-    const double h = withHeight ? static_cast<double>(height[i * heightStride]) : 0.0;
+    double h = withHeight ? static_cast<double>(height[i * heightStride]) : 0.0;
+    if (twoD) h = lastYMm_ = std::isfinite(h) ? h : lastYMm_;
     lastLevel_ = level(travel_.push(x, h));
     forceN[i] = static_cast<float>(range_.loN + span * lastLevel_);
   }

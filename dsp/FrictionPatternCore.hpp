@@ -6,6 +6,7 @@
 
 #include "DetentPattern.hpp"
 #include "GratingPattern.hpp"
+#include "GridBumpsPattern.hpp"
 #include "HeightSlopePattern.hpp"
 #include "PaperProfile.hpp"
 #include "PatternTravel.hpp"
@@ -19,6 +20,7 @@ namespace kf::patterns {
 //   detents: spacing (mm), crest (0..1)               texture: lo, hi (cycles/mm), seed
 //   viscous: fullSpeed (mm/s)                         stickSlip: slipSpeed, stickSpeed (mm/s)
 //   slope: p1 is the height signal (audio rate), p2 fullSlope (height units per mm)
+//   bumps2D: spacingX, spacingY, width (mm); the second signal is y (mm)
 enum class PatternKind : int {
   Grating = 0,
   Bumps = 1,
@@ -26,9 +28,10 @@ enum class PatternKind : int {
   Texture = 3,
   Viscous = 4,
   StickSlip = 5,
-  Slope = 6
+  Slope = 6,
+  Bumps2D = 7
 };
-constexpr int kPatternKinds = 7;
+constexpr int kPatternKinds = 8;
 
 struct ForceRange {
   double loN = paper::mapping::loForceN;
@@ -50,8 +53,9 @@ class FrictionPatternCore {
   void setForceRange(const ForceRange& range) { range_ = range; }
   void setAntialias(bool on) { antialias_ = on; }
 
-  // position and height at stride 1 (audio rate) or 0 (held); height is read for Slope only
-  // (may be nullptr otherwise). forceN may share memory with position or height.
+  // position and height at stride 1 (audio rate) or 0 (held); height is read for Slope only, and
+  // is y (mm) for Bumps2D (a NaN/inf y holds the last finite one, 0 before the first); nullptr
+  // otherwise. forceN may share memory with position or height.
   void process(const float* positionMm, int positionStride, const float* height, int heightStride, float* forceN,
                int numSamples);
   // The level process() gave last (0..1).
@@ -73,6 +77,8 @@ class FrictionPatternCore {
   ViscousFriction viscous_;
   StickSlipFriction stickSlip_;
   SlopeOfHeight slope_;
+  GridBumpsPattern gridBumps_;
+  double lastYMm_ = 0.0;
 };
 
 }  // namespace kf::patterns

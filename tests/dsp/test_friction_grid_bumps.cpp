@@ -1,0 +1,181 @@
+// FrictionPattern's bumps2D (dsp/GridBumpsPattern) against its definition, written again here:
+// h(x, y) = b(x) b(y), b a raised-cosine bump of width w from 0 in every spacing; the level is
+// clip((h(now) - h(one frame ago)) / |travel| / (pi / w), 0, 1), held below 1e-4 mm of travel.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "FrictionPatternCore.hpp"
+
+using namespace kf::patterns;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kLoN = 0.14, kHiN = 0.5;
+constexpr double kSx = 4, kSy = 3, kW = 2;  // spacings and width (mm)
+
+double bumpDef(double u, double spacing) {
+  const double f = u / spacing - std::floor(u / spacing);
+  return f * spacing < kW ? 0.5 * (1 - std::cos(2 * kPi * f * spacing / kW)) : 0.0;
+}
+double heightDef(double x, double y) { return bumpDef(x, kSx) * bumpDef(y, kSy); }
+
+struct Path {
+  std::vector<float> x, y;
+};
+
+// A line from (x0, y0) at speed mm/s along angle (rad), for seconds.
+Path line(double x0, double y0, double angle, double speed, double seconds, double rate) {
+  Path p;
+  for (int i = 0; i < static_cast<int>(seconds * rate); ++i) {
+    p.x.push_back(static_cast<float>(x0 + std::cos(angle) * speed * i / rate));
+    p.y.push_back(static_cast<float>(y0 + std::sin(angle) * speed * i / rate));
+  }
+  return p;
+}
+
+std::vector<double> levels(const Path& p, double rate, bool antialias = true, double sx = kSx, double sy = kSy,
+                           double w = kW) {
+  FrictionPatternCore core(PatternKind::Bumps2D, rate);
+  core.setForceRange({kLoN, kHiN});
+  core.setAntialias(antialias);
+  std::vector<float> force(p.x.size());
+  for (size_t i = 0; i < p.x.size(); i += 64) {
+    const int n = static_cast<int>(std::min<size_t>(64, p.x.size() - i));
+    core.setParameters(sx, sy, w, p.x[i]);
+    core.process(p.x.data() + i, 1, p.y.data() + i, 1, force.data() + i, n);
+  }
+  std::vector<double> out;
+  for (float f : force) out.push_back((f - kLoN) / (kHiN - kLoN));
+  return out;
+}
+
+// The definition's level per sample, from the float positions the core was given.
+std::vector<double> definition(const Path& p, double rate) {
+  const int n = static_cast<int>(std::lround(rate * 1e-3));
+  std::vector<double> out;
+  double held = 0;
+  for (size_t i = 0; i < p.x.size(); ++i) {
+    const size_t j = i >= static_cast<size_t>(n) ? i - n : 0;
+    const double dx = double(p.x[i]) - p.x[j], dy = double(p.y[i]) - p.y[j], d = std::sqrt(dx * dx + dy * dy);
+    if (d >= 1e-4)
+      held = std::clamp((heightDef(p.x[i], p.y[i]) - heightDef(p.x[j], p.y[j])) / d / (kPi / kW), 0.0, 1.0);
+    out.push_back(held);
+  }
+  return out;
+}
+
+// The force is a float: its level is exact to ~1e-7 N / 0.36 N; 1e-6 leaves room for the
+// double rounding of the cosines.
+constexpr double kTol = 1e-6;
+
+}  // namespace
+
+TEST_CASE("bumps2D: the definition along lines at angles, 44.1 to 192 kHz") {
+  for (double rate : {44100.0, 48000.0, 96000.0, 192000.0}) {
+    for (double angle : {0.0, 0.5, kPi / 4, 2.0, -2.5}) {
+      const Path p = line(0.3, 0.7, angle, 60, 0.25, rate);
+      const auto got = levels(p, rate), want = definition(p, rate);
+      double worst = 0, top = 0;
+      for (size_t i = 0; i < got.size(); ++i)
+        worst = std::max(worst, std::fabs(got[i] - want[i])), top = std::max(top, got[i]);
+      INFO("rate " << rate << " angle " << angle);
+      CHECK(worst < kTol);
+      CHECK(top > 0.2);  // the line meets bumps
+    }
+  }
+}
+
+TEST_CASE("bumps2D: along a diagonal through a bump's centre, climbing resists and descending is free") {
+  // Bump centre at (1, 1); the diagonal x = y from (0.2, 0.2) to (1.8, 1.8) and back, 40 mm/s.
+  const double rate = 48000, angle = kPi / 4, length = 1.6 * std::sqrt(2.0), speed = 40;
+  const Path up = line(0.2, 0.2, angle, speed, length / speed, rate);
+  const Path down = line(1.8, 1.8, angle + kPi, speed, length / speed, rate);
+  // The minimum force is 0.14f, 1.7e-9 above 0.14 in level: "free" is a level below kFree.
+  constexpr double kFree = 1e-8;
+  for (const Path* p : {&up, &down}) {
+    const auto got = levels(*p, rate);
+    const size_t half = got.size() / 2;
+    // First half (after the first frame): approaching the centre, climbing; after it (one frame
+    // past the centre on): descending, the minimum force exactly.
+    for (size_t i = 100; i < half - 10; ++i) REQUIRE(got[i] > kFree);
+    for (size_t i = half + 60; i < got.size(); ++i) REQUIRE(got[i] < kFree);
+  }
+  // Across the centre along x the steepest slope is met: the full level, less the frame's mean of
+  // sin(pi x) over 0.06 mm (60 mm/s, 1 ms): sinc(0.03 pi) = 1 - 1.5e-3.
+  const auto across = levels(line(0.0, 1.0, 0.0, 60, 1.0 / 60, rate), rate);
+  CHECK(*std::max_element(across.begin(), across.end()) == Approx(1.0).margin(2e-3));
+}
+
+TEST_CASE("bumps2D: the same force at every revisit of a circle, whatever came between") {
+  const double rate = 48000;
+  const int perTurn = 24000;  // 0.5 s a turn, radius 5 mm about (3, 2)
+  Path p;
+  auto circle = [&](int i) {
+    p.x.push_back(static_cast<float>(3 + 5 * std::cos(2 * kPi * (i % perTurn) / perTurn)));
+    p.y.push_back(static_cast<float>(2 + 5 * std::sin(2 * kPi * (i % perTurn) / perTurn)));
+  };
+  for (int i = 0; i < perTurn; ++i) circle(i);
+  const Path away = line(8, 2, 1.0, 70, 0.2, rate);  // elsewhere, then back to the start of the turn
+  p.x.insert(p.x.end(), away.x.begin(), away.x.end());
+  p.y.insert(p.y.end(), away.y.begin(), away.y.end());
+  for (int i = 0; i < 100; ++i) p.x.push_back(8), p.y.push_back(2);  // back at the circle's start: one frame at rest
+  const size_t second = p.x.size();
+  for (int i = 0; i < perTurn; ++i) circle(i);
+  const auto got = levels(p, rate);
+  size_t differ = 0;
+  for (int i = 48; i < perTurn; ++i) differ += got[i] != got[second + i];
+  CHECK(differ == 0);
+  CHECK(*std::max_element(got.begin(), got.begin() + perTurn) > 0.2);
+}
+
+TEST_CASE("bumps2D: far from the origin, the same as near it (float positions exact there)") {
+  // Steps of 2^-9 mm per sample (93.75 mm/s at 48 kHz) along a diagonal: exact floats both near 0
+  // and near 7200 mm (a multiple of both spacings; floats there step by 2^-10 mm).
+  const double rate = 48000, offset = 7200, step = 1.0 / 512;
+  Path nearPath, farPath;
+  for (int i = 0; i < 9600; ++i) {
+    nearPath.x.push_back(static_cast<float>(0.5 + step * i)), nearPath.y.push_back(static_cast<float>(0.25 + step * i));
+    farPath.x.push_back(static_cast<float>(offset + 0.5 + step * i));
+    farPath.y.push_back(static_cast<float>(offset + 0.25 + step * i));
+  }
+  REQUIRE(double(farPath.x.back()) - offset == double(nearPath.x.back()));
+  const auto a = levels(nearPath, rate), b = levels(farPath, rate);
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::fabs(a[i] - b[i]));
+  // x / spacing loses ~7200 / 3 * 2^-52 cycles (1e-12) far away: far below a float's step.
+  CHECK(worst < kTol);
+  CHECK(*std::max_element(b.begin(), b.end()) > 0.2);
+}
+
+TEST_CASE("bumps2D: NaN and inf positions hold, bad parameters keep the last good, raw is the slope at the point") {
+  const double rate = 48000;
+  Path p = line(0.3, 0.7, 0.5, 60, 0.2, rate);
+  const auto clean = levels(p, rate);
+  Path bad = p;
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_limits<float>::infinity();
+  for (size_t i = 3000; i < 3010; ++i) bad.x[i] = kNaN, bad.y[i] = (i % 2 ? kInf : -kInf);
+  const auto held = levels(bad, rate);
+  for (double v : held) REQUIRE((v >= 0.0 && v <= 1.0));
+  // Outside the frames that saw the held position, the same as the clean run.
+  for (size_t i = 0; i < 3000; ++i) REQUIRE(held[i] == clean[i]);
+  for (size_t i = 3010 + 48; i < held.size(); ++i) REQUIRE(held[i] == Approx(clean[i]).margin(kTol));
+  // Bad parameters from the start: the defaults (spacings 1 mm, width 0.5 mm, as bumps'), as the
+  // core given them.
+  Path q = line(0.3, 0.7, 0.5, 60, 0.2, rate);
+  const auto defaults = levels(q, rate, true, 1, 1, 0.5);
+  const auto nans = levels(q, rate, true, std::nan(""), -1, HUGE_VAL);
+  for (size_t i = 0; i < q.x.size(); ++i) REQUIRE(nans[i] == defaults[i]);
+  // Raw (antialias 0): the directional slope at the current point, here ~ the frame mean (60 mm/s
+  // is 0.06 mm a frame; the mean and point differ by < 0.06 mm * max curvature (2 pi^2 / w^2 over
+  // pi / w) = 0.06 * pi = 0.19 at most).
+  const auto raw = levels(p, rate, false);
+  double worst = 0;
+  for (size_t i = 48; i < raw.size(); ++i) worst = std::max(worst, std::fabs(raw[i] - clean[i]));
+  CHECK(worst < 0.19);
+  CHECK(worst > 0.0);
+}
