@@ -1,6 +1,7 @@
 // FrictionPattern: a spatial friction pattern (dsp/FrictionPatternCore), position (mm) in, force
 // (N) out. Inputs: kind (fixed at init), position, loForce (N), hiForce (N), antialias (0/1),
-// p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal.
+// p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal; the
+// 2D kinds (bumps2D) have one more input, y (mm), read as position is (0 when absent).
 // Position and height are read at audio rate as they are; at control rate they are interpolated
 // linearly across the block from the last block's value (as SC UGens do), since a value held per
 // block would make the travel, and every speed-based pattern, jump at block rate. Everything else
@@ -19,7 +20,7 @@ namespace {
 
 using kf::patterns::PatternKind;
 
-enum Input { kKind, kPositionMm, kLoForceN, kHiForceN, kAntialias, kP1, kP2, kP3 };
+enum Input { kKind, kPositionMm, kLoForceN, kHiForceN, kAntialias, kP1, kP2, kP3, kYMm };
 
 // The kinds of bad input, each posted once per unit (FirstTimeOnly).
 enum BadInput { kBadKind, kBadLoForce, kBadHiForce, kBadP1, kBadP2, kBadP3 };
@@ -39,6 +40,7 @@ constexpr KindInfo kKinds[kf::patterns::kPatternKinds] = {
     {"viscous", {"fullSpeed", "", ""}, {Rule::Positive, Rule::Unused, Rule::Unused}},
     {"stickSlip", {"slipSpeed", "stickSpeed", ""}, {Rule::NonNegative, Rule::NonNegative, Rule::Unused}},
     {"slope", {"height", "fullSlope", ""}, {Rule::Unused, Rule::Positive, Rule::Unused}},
+    {"bumps2D", {"spacingX", "spacingY", "width"}, {Rule::Positive, Rule::Positive, Rule::Positive}},
 };
 
 bool follows(Rule rule, float value) {
@@ -66,7 +68,10 @@ class FrictionPatternUGen : public SCUnit {
     mKind = code >= 0 && code < kf::patterns::kPatternKinds ? code : 0;
     mCore.emplace(static_cast<PatternKind>(mKind), sampleRate());
     mLastPositionMm = in0(kPositionMm);
-    mLastHeight = in0(kP1);
+    // The second signal beside the position: slope's height, bumps2D's y; none otherwise.
+    if (mKind == static_cast<int>(PatternKind::Slope)) mSecond = kP1;
+    if (mKind == static_cast<int>(PatternKind::Bumps2D) && numInputs() > kYMm) mSecond = kYMm;
+    mLastHeight = mSecond >= 0 ? in0(mSecond) : 0.f;
     mCalcFunc = make_calc_function<FrictionPatternUGen, &FrictionPatternUGen::next>();
     updateRange();
     // The initial value, before the first block: the minimum force (no travel yet).
@@ -78,14 +83,14 @@ class FrictionPatternUGen : public SCUnit {
     updateRange();
     checkParameters();
     mCore->setAntialias(in0(kAntialias) > 0.5f);
-    const bool slope = mKind == static_cast<int>(PatternKind::Slope);
-    const bool positionAudio = isAudioRateIn(kPositionMm), heightAudio = !slope || isAudioRateIn(kP1);
-    const float positionNow = in0(kPositionMm), heightNow = in0(kP1);
+    const bool slope = mSecond >= 0;  // a second signal is read (slope's height, bumps2D's y)
+    const bool positionAudio = isAudioRateIn(kPositionMm), heightAudio = !slope || isAudioRateIn(mSecond);
+    const float positionNow = in0(kPositionMm), heightNow = slope ? in0(mSecond) : 0.f;
     // The anchor of a phase-continuous period change: the block's first position.
     mCore->setParameters(in0(kP1), in0(kP2), in0(kP3),
                          positionAudio ? in(kPositionMm)[0] : ramp(mLastPositionMm, positionNow, 1, numSamples));
     if (positionAudio && heightAudio) {
-      mCore->process(in(kPositionMm), 1, slope ? in(kP1) : nullptr, 1, out(0), numSamples);
+      mCore->process(in(kPositionMm), 1, slope ? in(mSecond) : nullptr, 1, out(0), numSamples);
     } else {
       // In chunks through small arrays on the stack: nothing allocated.
       float positions[kChunk], heights[kChunk];
@@ -94,7 +99,7 @@ class FrictionPatternUGen : public SCUnit {
         for (int i = 0; i < n; ++i) {
           const int at = start + i;
           positions[i] = positionAudio ? in(kPositionMm)[at] : ramp(mLastPositionMm, positionNow, at + 1, numSamples);
-          if (slope) heights[i] = heightAudio ? in(kP1)[at] : ramp(mLastHeight, heightNow, at + 1, numSamples);
+          if (slope) heights[i] = heightAudio ? in(mSecond)[at] : ramp(mLastHeight, heightNow, at + 1, numSamples);
         }
         mCore->process(positions, 1, slope ? heights : nullptr, 1, out(0) + start, n);
       }
@@ -138,6 +143,7 @@ class FrictionPatternUGen : public SCUnit {
 
   static constexpr int kChunk = 64;
   int mKind = 0;
+  int mSecond = -1;                                        // the input of the signal read beside the position, -1: none
   float mLastPositionMm = 0.f, mLastHeight = 0.f;          // control-rate values of the last block
   std::optional<kf::patterns::FrictionPatternCore> mCore;  // inside the unit: no allocation
   kf::patterns::ForceRange mRange;

@@ -242,3 +242,32 @@ def slope(x, height, rate, full_slope):
             held = min(max((h[i] - h0[i]) / moved[i] / full_slope, 0.0), 1.0)
         out[i] = held
     return out
+
+
+def _grid_bump(u, spacing, omega):
+    f = u / spacing
+    f = f - np.floor(f)
+    return np.where(f < omega, 0.5 * (1.0 - np.cos(2.0 * np.pi * f / omega)), 0.0)
+
+
+def bumps2d(x, y, rate, spacing_x, spacing_y, width):
+    """The 2D grid of bumps h = b(x) b(y) by the height rule: the rise over the frame's travel in
+    (x, y) over its length, over the steepest slope pi / width, clipped to [0, 1]; held at rest."""
+    spacing_x, spacing_y, width = _f32(spacing_x, spacing_y, width)
+    ox, oy = min(max(width / spacing_x, 1e-6), 1.0), min(max(width / spacing_y, 1e-6), 1.0)
+    steepest = np.pi / min(ox * spacing_x, oy * spacing_y)
+    x0, x1, _, _, _ = travel(x, rate)
+    y0, y1, _, _, _ = travel(y, rate)
+
+    def h(a, b):
+        return _grid_bump(a, spacing_x, ox) * _grid_bump(b, spacing_y, oy)
+
+    moved = np.hypot(x1 - x0, y1 - y0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.clip((h(x1, y1) - h(x0, y0)) / moved / steepest, 0.0, 1.0)
+    out, held = np.empty(len(g)), 0.0
+    for i in range(len(g)):
+        if moved[i] >= 1e-4:
+            held = g[i]
+        out[i] = held
+    return out

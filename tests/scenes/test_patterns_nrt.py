@@ -153,3 +153,31 @@ def test_control_rate_positions_and_period_changes_while_moving():
     at = int(0.2 * rate)
     assert np.abs(np.diff(changed[at - 128:at + 256])).max() <= own
     assert changed[at - 128] > 0.45 and changed[at + 256] > 0.45, "high before and after: the phase kept"
+
+
+def test_bumps2d_under_the_hands_circle_is_its_definition():
+    # The simulated hand's circle (r 15 mm about (1, 1) at 60 mm/s: 1.57 s a turn) over a grid of
+    # bumps (4 by 3 mm, 2 mm wide), against kfharness.patterns.bumps2d at the positions
+    # FrictionMouseIn gave; same float tolerance as the 1D kinds (measured here: 1.5e-8 N at worst).
+    rate, seconds = 48000, 1.2
+    data, log = nrt.score_and_render("patterns2d", f"""
+        var dev = FrictionDevice.sim(nil, 0, FrictionHand.circle(15, 60, 1, 1, 1));
+        var def = SynthDef(\\patterns2d, {{
+            var m = FrictionMouseIn.ar(0);
+            Out.ar(0, [m[0], m[1], FrictionPattern.bumps2D(m[0], m[1], 4, 3, 2)])
+        }});
+        score = Score([
+            [0.0, dev.openMsg],
+            [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\patterns2d, nil, 1000).newMsg],
+            [{seconds}, dev.closeMsg],
+            [{seconds} + 0.01, ['/c_set', 0, 0]]]);
+    """, sample_rate=rate, channels=3)
+    n = int(seconds * rate) - 64
+    x, y, force = (data[:n, i].astype(np.float64) for i in range(3))
+    assert np.ptp(x) > 3 and np.ptp(y) > 3, "the puck goes round in x and y"
+    want = LO + (HI - LO) * patterns.bumps2d(x, y, rate, 4, 3, 2)
+    err = np.abs(force - want)
+    assert err.max() < 1e-6, f"worst {err.max()} N at sample {err.argmax()}"
+    assert force.max() - force.min() > 0.05 and (force == np.float32(LO)).mean() > 0.2, "climbs and descents"
+    assert "FrictionPattern" not in log, log

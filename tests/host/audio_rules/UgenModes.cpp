@@ -217,6 +217,18 @@ std::unique_ptr<Synth> patternsSynth(FakeServer& server) {
   synth->add(pattern, ar, {c(6), sweepAr(), c(0.14f), c(0.5f), c(0), toneAr(), c(1), c(0)}, 1, "slope of a tone");
   synth->add(pattern, ar, {c(6), sweepAr(), c(0.14f), c(0.5f), c(0), sweepKr(), c(kNaN), c(0)}, 1,
              "slope, height kr, fullSlope NaN");
+  // bumps2D (kind 7): y as a ninth input, at the puck, both rates, moving, bad, and absent.
+  const Input puckY = Input::from(synth->out(mouse, 1));
+  synth->add(pattern, ar, {c(7), puck, c(0.14f), c(0.5f), c(1), c(4), c(3), c(2), puckY}, 1, "bumps2D at the puck");
+  synth->add(pattern, ar,
+             {c(7), sweepAr(), c(0.14f), c(0.5f), alternating(0, 1), alternating(4, 9), alternating(3, 4),
+              alternating(2, 3), toneAr()},
+             1, "bumps2D, parameters moving");
+  synth->add(pattern, kr, {c(7), sweepKr(), c(0.14f), c(0.5f), c(1), c(4), c(3), c(2), sweepKr()}, 1,
+             "bumps2D, control rate");
+  synth->add(pattern, ar, {c(7), sweepAr(), c(kNaN), c(-1), c(1), c(kNaN), c(kInf), c(-kInf), c(kNaN)}, 1,
+             "bumps2D, bad parameters, forces and y");
+  synth->add(pattern, ar, {c(7), sweepAr(), c(0.14f), c(0.5f), c(1), c(4), c(3), c(2)}, 1, "bumps2D, no y");
   synth->add(pattern, ar, {c(kNaN), puck, c(0.14f), c(0.5f), c(1), c(1), c(0.5f), c(0.1f)}, 1, "kind NaN");
   Unit* grating = synth->add(pattern, ar, {c(0), puck, c(0.14f), c(0.5f), c(1), c(0.2f), c(0.5f), c(0.02f)}, 1,
                              "a grating under the puck");
