@@ -113,23 +113,29 @@ TEST_CASE("bumps2D: along a diagonal through a bump's centre, climbing resists a
 
 TEST_CASE("bumps2D: the same force at every revisit of a circle, whatever came between") {
   const double rate = 48000;
-  const int perTurn = 24000;  // 0.5 s a turn, radius 5 mm about (3, 2)
+  // 0.5 s a turn, radius 5 mm about (-4, 1.5): it starts at (1, 1.5) moving +y, on a bump's
+  // steepest flank along y (its centre line in x): leaving forwards descends, arriving backwards
+  // climbs (the full level).
+  const int perTurn = 24000;
   Path p;
   auto circle = [&](int i) {
-    p.x.push_back(static_cast<float>(3 + 5 * std::cos(2 * kPi * (i % perTurn) / perTurn)));
-    p.y.push_back(static_cast<float>(2 + 5 * std::sin(2 * kPi * (i % perTurn) / perTurn)));
+    const int k = ((i % perTurn) + perTurn) % perTurn;
+    p.x.push_back(static_cast<float>(-4 + 5 * std::cos(2 * kPi * k / perTurn)));
+    p.y.push_back(static_cast<float>(1.5 + 5 * std::sin(2 * kPi * k / perTurn)));
   };
   for (int i = 0; i < perTurn; ++i) circle(i);
-  const Path away = line(8, 2, 1.0, 70, 0.2, rate);  // elsewhere, then back to the start of the turn
-  p.x.insert(p.x.end(), away.x.begin(), away.x.end());
+  const Path away = line(-4 + 5 * std::cos(2 * kPi * (perTurn - 1) / perTurn), 1.5, 1.0, 70, 0.2, rate);
+  p.x.insert(p.x.end(), away.x.begin(), away.x.end());  // elsewhere,
   p.y.insert(p.y.end(), away.y.begin(), away.y.end());
-  for (int i = 0; i < 100; ++i) p.x.push_back(8), p.y.push_back(2);  // back at the circle's start: one frame at rest
+  for (int i = 0; i <= perTurn / 4; ++i) circle(perTurn / 4 - i);  // then backwards to the start
   const size_t second = p.x.size();
   for (int i = 0; i < perTurn; ++i) circle(i);
   const auto got = levels(p, rate);
+  // One frame after the start of each turn the frames hold the same positions: the same level.
   size_t differ = 0;
   for (int i = 48; i < perTurn; ++i) differ += got[i] != got[second + i];
   CHECK(differ == 0);
+  CHECK(got[second - 1] > 0.9);  // arriving, it climbed
   CHECK(*std::max_element(got.begin(), got.begin() + perTurn) > 0.2);
 }
 
