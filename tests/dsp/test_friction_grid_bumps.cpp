@@ -192,3 +192,42 @@ TEST_CASE("bumps2D: NaN and inf positions hold, bad parameters keep the last goo
   CHECK(worst < 0.19);
   CHECK(worst > 0.0);
 }
+
+TEST_CASE("bumps2D: a change of spacing while moving keeps the bumps' phase under the puck, on both axes") {
+  // 60 mm/s at 30 degrees, at (48.5, 37) at sample 4800 (a block start: 0.5 mm up a bump's flank
+  // in x, on its centre line in y) where the spacings go 4 x 3 -> 4.4 x 3.3 mm. Kept at the anchor
+  // (x: the block's first position; y: the last y before it), a cell coordinate after the change
+  // is (u - anchor) / new spacing + anchor / old spacing. Anchored at the origin instead, the puck
+  // would jump from 0.5 to 0.1 mm into its bump in x and from 1.0 to 0.7 mm in y.
+  const double rate = 48000;
+  const size_t change = 4800;
+  const Path p = line(48.5 - 6 * std::cos(kPi / 6), 34, kPi / 6, 60, 0.2, rate);
+  FrictionPatternCore core(PatternKind::Bumps2D, rate);
+  core.setForceRange({kLoN, kHiN});
+  std::vector<float> force(p.x.size());
+  for (size_t i = 0; i < p.x.size(); i += 64) {
+    const bool later = i >= change;
+    core.setParameters(later ? 4.4 : 4.0, later ? 3.3 : 3.0, 2.0, p.x[i]);
+    core.process(p.x.data() + i, 1, p.y.data() + i, 1, force.data() + i, 64);
+  }
+  const double ax = p.x[change], ay = p.y[change - 1];
+  auto bumpAt = [](double cycles, double spacing) {
+    const double d = (cycles - std::floor(cycles)) * spacing;  // mm into the cell
+    return d < kW ? 0.5 * (1 - std::cos(2 * kPi * d / kW)) : 0.0;
+  };
+  auto h = [&](double x, double y, bool later) {
+    if (!later) return bumpAt(x / 4.0, 4.0) * bumpAt(y / 3.0, 3.0);
+    return bumpAt((x - ax) / 4.4 + ax / 4.0, 4.4) * bumpAt((y - ay) / 3.3 + ay / 3.0, 3.3);
+  };
+  double worst = 0, jump = 0;
+  for (size_t i = 48; i < force.size(); ++i) {
+    const double dx = double(p.x[i]) - p.x[i - 48], dy = double(p.y[i]) - p.y[i - 48];
+    const double d = std::sqrt(dx * dx + dy * dy), later = i >= change;
+    const double want =
+        std::clamp((h(p.x[i], p.y[i], later) - h(p.x[i - 48], p.y[i - 48], later)) / d / (kPi / kW), 0.0, 1.0);
+    worst = std::max(worst, std::fabs((force[i] - kLoN) / (kHiN - kLoN) - want));
+    if (i == change) jump = std::fabs(force[i] - force[i - 1]) / (kHiN - kLoN);
+  }
+  CHECK(worst < kTol);
+  CHECK(jump < 0.2);  // the zoom about the puck: 0.5 -> 0.55 mm into the bump, level 0.87 -> 0.75
+}
