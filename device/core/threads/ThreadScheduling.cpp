@@ -22,6 +22,14 @@ int resolvePriority(int requested) {
   return audio > 0 ? std::min(audio + 1, kMaxPriority) : kFallbackPriority;
 }
 
+// Not inlined: its frame must lie below the caller's. Written, so that the pages are mapped.
+__attribute__((noinline)) bool lockStackBelow() {
+  constexpr size_t kBytes = 64 * 1024;  // the device pump's calls need a few kB
+  volatile char stack[kBytes];
+  for (size_t i = 0; i < kBytes; i += 256) stack[i] = 0;
+  return lockMemory(const_cast<char*>(stack), kBytes);
+}
+
 std::string describe(const ThreadScheduling& s) {
   if (s.priority < 0) return "not started";
   std::string text = s.priority > 0 ? "SCHED_FIFO " + std::to_string(s.priority) : std::string("normal priority");

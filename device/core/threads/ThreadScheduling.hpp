@@ -71,6 +71,9 @@ int resolvePriority(int requested);
 // device's own memory: mlockall would fault in and pin the whole server (scsynth maps about a
 // gigabyte) and hold every other thread's page faults up meanwhile, the audio thread's too.
 bool lockMemory(const void* data, size_t bytes);
+// For scheduleThisThread on every system: faults in and locks the 64 kB of stack below the
+// caller, where the thread's work will run.
+bool lockStackBelow();
 
 // Called by the thread itself as it starts: names it "kf-<role>-<slot>", asks SCHED_FIFO at
 // resolvePriority(request.priority) (kNormalPriority sets SCHED_OTHER), and with realtime

@@ -49,19 +49,6 @@ bool lockMemory(const void* data, size_t bytes) {
   return ::mlock(reinterpret_cast<const void*>(start), end - start) == 0;
 }
 
-namespace {
-
-// The stack below the caller, where the thread's work will run: written (so that it is mapped)
-// and locked. Not inlined: its frame must lie below the caller's.
-__attribute__((noinline)) bool lockStackBelow() {
-  constexpr size_t kBytes = 64 * 1024;  // the device pump's calls need a few kB
-  volatile char stack[kBytes];
-  for (size_t i = 0; i < kBytes; i += 256) stack[i] = 0;
-  return lockMemory(const_cast<char*>(stack), kBytes);
-}
-
-}  // namespace
-
 ThreadScheduling scheduleThisThread(const char* role, const ThreadRequest& request) {
   char name[16];  // the kernel keeps 15 characters
   std::snprintf(name, sizeof(name), "kf-%s-%d", role, request.slot);

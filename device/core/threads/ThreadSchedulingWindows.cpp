@@ -34,13 +34,6 @@ void nameThisThread(const char* name) {
   reinterpret_cast<SetDescription>(reinterpret_cast<void*>(found))(::GetCurrentThread(), wideName);
 }
 
-__attribute__((noinline)) bool lockStackBelow() {
-  constexpr size_t kBytes = 64 * 1024;  // the device pump's calls need a few kB
-  volatile char stack[kBytes];
-  for (size_t i = 0; i < kBytes; i += 256) stack[i] = 0;
-  return lockMemory(const_cast<char*>(stack), kBytes);
-}
-
 }  // namespace
 
 int currentThreadPriority() {
