@@ -8,7 +8,7 @@ void DetentPattern::set(double spacingMm, double crest, double anchorMm) {
   if (crest_ == harmonicsCrest_) return;
   const double c = crest_;
   for (int k = 1; k <= kMaxHarmonics; ++k) {
-    const double a = 2.0 * M_PI * k;
+    const double a = 2.0 * kPi * k;
     const std::complex<double> e = std::polar(1.0, -a * c);
     harmonics_[k - 1] = std::complex<double>(0.0, 1.0) * e / a + (e - 1.0) / (a * a * c);
   }

@@ -9,8 +9,8 @@ void GratingPattern::set(double periodMm, double duty, double edgeMm, double anc
   edge_ = std::clamp(edgeMm_ / coordinate_.periodMm(), 0.0, std::min(duty_, 1.0 - duty_));
   if (duty_ == harmonicsDuty_ && edge_ == harmonicsEdge_) return;
   for (int k = 1; k <= kMaxHarmonics; ++k) {
-    const double e = M_PI * k * edge_, sincEdge = e > 0.0 ? std::sin(e) / e : 1.0;
-    harmonics_[k - 1] = std::polar(std::sin(M_PI * k * duty_) / (M_PI * k) * sincEdge, -M_PI * k * (duty_ + edge_));
+    const double e = kPi * k * edge_, sincEdge = e > 0.0 ? std::sin(e) / e : 1.0;
+    harmonics_[k - 1] = std::polar(std::sin(kPi * k * duty_) / (kPi * k) * sincEdge, -kPi * k * (duty_ + edge_));
   }
   harmonicsDuty_ = duty_;
   harmonicsEdge_ = edge_;

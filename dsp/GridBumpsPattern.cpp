@@ -14,12 +14,12 @@ void GridBumpsPattern::set(double spacingXMm, double spacingYMm, double widthMm,
 
 double GridBumpsPattern::bump(const PeriodicCoordinate& axis, double omega, double uMm) {
   const double f = fractionOf(axis.cycles(uMm));
-  return f < omega ? 0.5 * (1.0 - std::cos(2.0 * M_PI * f / omega)) : 0.0;
+  return f < omega ? 0.5 * (1.0 - std::cos(2.0 * kPi * f / omega)) : 0.0;
 }
 
 double GridBumpsPattern::bumpSlope(const PeriodicCoordinate& axis, double omega, double widthMm, double uMm) {
   const double f = fractionOf(axis.cycles(uMm));
-  return f < omega ? M_PI / widthMm * std::sin(2.0 * M_PI * f / omega) : 0.0;
+  return f < omega ? kPi / widthMm * std::sin(2.0 * kPi * f / omega) : 0.0;
 }
 
 double GridBumpsPattern::height(double xMm, double yMm) const {

@@ -25,7 +25,7 @@ class GridBumpsPattern {
   double level(double x0, double y0, double x1, double y1, bool antialias);
   // The definition: height (bump height 1) and its gradient (per mm) at (x, y).
   double height(double xMm, double yMm) const;
-  double steepestSlope() const { return M_PI / std::min(widthX_, widthY_); }
+  double steepestSlope() const { return kPi / std::min(widthX_, widthY_); }
 
  private:
   // b and db/du (per mm) along one axis.

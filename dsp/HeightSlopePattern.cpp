@@ -8,14 +8,14 @@ void BumpPattern::set(double periodMm, double widthMm, bool valleys, double anch
   omega_ = std::clamp(widthMm_ / coordinate_.periodMm(), 1e-6, 1.0);
   valleys_ = valleys;
   if (omega_ == harmonicsOmega_ && valleys_ == harmonicsValleys_) return;
-  const double half = 0.5 * omega_, b = 2.0 * M_PI / omega_;
+  const double half = 0.5 * omega_, b = 2.0 * kPi / omega_;
   // E(q) = integral of e^(i q u) over [0, half] = half e^(i q half / 2) sinc(q half / 2).
   auto E = [half](double q) {
     const double x = 0.5 * q * half;
     return std::polar(half * (x == 0.0 ? 1.0 : std::sin(x) / x), x);
   };
   for (int k = 1; k <= kMaxHarmonics; ++k) {
-    const double a = 2.0 * M_PI * k;
+    const double a = 2.0 * kPi * k;
     const std::complex<double> first = (E(b - a) - E(-b - a)) / std::complex<double>(0.0, 2.0);
     const std::complex<double> second = std::polar(1.0, -a * omega_) * std::conj(first);
     climbingUp_[k - 1] = valleys_ ? second : first;
@@ -26,13 +26,13 @@ void BumpPattern::set(double periodMm, double widthMm, bool valleys, double anch
 }
 
 double BumpPattern::height(double f) const {
-  const double h = f < omega_ ? 0.5 * (1.0 - std::cos(2.0 * M_PI * f / omega_)) : 0.0;
+  const double h = f < omega_ ? 0.5 * (1.0 - std::cos(2.0 * kPi * f / omega_)) : 0.0;
   return valleys_ ? -h : h;
 }
 
 double BumpPattern::at(double f, int direction) const {
   if (f >= omega_) return 0.0;
-  const double slope = std::sin(2.0 * M_PI * f / omega_) * (valleys_ ? -1.0 : 1.0);  // dh/du over pi/omega
+  const double slope = std::sin(2.0 * kPi * f / omega_) * (valleys_ ? -1.0 : 1.0);  // dh/du over pi/omega
   return std::max(0.0, direction * slope);
 }
 
@@ -41,7 +41,7 @@ double BumpPattern::climbTo(double f, int direction) const {
   // way round. Moving -1 climbs where +1 descends.
   const bool climbsFirstHalf = (direction > 0) != valleys_;
   const double half = 0.5 * omega_;
-  const double bump = f < omega_ ? 0.5 * (1.0 - std::cos(2.0 * M_PI * f / omega_)) : 0.0;
+  const double bump = f < omega_ ? 0.5 * (1.0 - std::cos(2.0 * kPi * f / omega_)) : 0.0;
   if (climbsFirstHalf) return f < half ? bump : 1.0;
   if (f < half) return 0.0;
   return f < omega_ ? 1.0 - bump : 1.0;
@@ -52,7 +52,7 @@ double BumpPattern::level(const Travel& travel, bool antialias) const {
   const int direction = travel.direction;
   if (!antialias) return at(fractionOf(u1), direction);
   // The climb per cycle of travel, over the steepest (pi / omega): the mean of at() over the travel.
-  const double scale = omega_ / M_PI;
+  const double scale = omega_ / kPi;
   const double u0 = coordinate_.cycles(travel.fromMm);
   const double boxed = periodicMean(
       u0, u1, scale, [&](double f) { return scale * climbTo(f, direction); },

@@ -34,7 +34,7 @@ class BumpPattern {
   // The climb (height units, bump height 1) from the start of the period to f, moving +1 or -1
   // (for -1: the climb met going the other way, i.e. the descent along +1).
   double climbTo(double f, int direction) const;
-  double mean() const { return omega_ / M_PI; }
+  double mean() const { return omega_ / kPi; }
 
  private:
   double height(double f) const;

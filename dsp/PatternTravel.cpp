@@ -36,7 +36,7 @@ double bandLimitGain(double frequencyHz, double framePeriodS) {
   const double stopHz = 0.5 / framePeriodS, passHz = 0.5 * stopHz;
   if (!(frequencyHz > passHz)) return 1.0;  // NaN speed: the pattern as it is
   if (frequencyHz >= stopHz) return 0.0;
-  return 0.5 * (1.0 + std::cos(M_PI * (frequencyHz - passHz) / (stopHz - passHz)));
+  return 0.5 * (1.0 + std::cos(kPi * (frequencyHz - passHz) / (stopHz - passHz)));
 }
 
 double splineGain(double r) {
@@ -51,18 +51,17 @@ double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u
   if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
   const double kStop = 0.5 / travel.framePeriodS / f1;
   if (!(kStop < 2.0 * kMaxHarmonics)) return boxed;  // slow: the closed form, h = 1
-  const double h =
-      kStop <= kMaxHarmonics ? 0.0 : 0.5 * (1.0 - std::cos(M_PI * (kStop - kMaxHarmonics) / kMaxHarmonics));
+  const double h = kStop <= kMaxHarmonics ? 0.0 : 0.5 * (1.0 - std::cos(kPi * (kStop - kMaxHarmonics) / kMaxHarmonics));
   const double kCut = std::min(kStop, static_cast<double>(kMaxHarmonics));
   // Rotations stepped once per harmonic: e^(i 2 pi k mid) and e^(i pi k length) (its sine over
   // pi k length is the box's sinc).
   const double mid = 0.5 * (u0 + u1), length = std::fabs(u1 - u0);
-  const std::complex<double> stepMid = std::polar(1.0, 2.0 * M_PI * fractionOf(mid));
-  const std::complex<double> stepBox = std::polar(1.0, M_PI * length);
+  const std::complex<double> stepMid = std::polar(1.0, 2.0 * kPi * fractionOf(mid));
+  const std::complex<double> stepBox = std::polar(1.0, kPi * length);
   std::complex<double> atMid = stepMid, box = stepBox;
   double series = mean;
   for (int k = 1; k < kCut; ++k) {
-    const double x = M_PI * k * length;
+    const double x = kPi * k * length;
     const double sinc = x < 1e-9 ? 1.0 : box.imag() / x;
     series += splineGain(k / kCut) * 2.0 * (c[k - 1] * atMid).real() * sinc;
     atMid *= stepMid;

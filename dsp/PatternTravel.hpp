@@ -18,6 +18,9 @@
 
 namespace kf::patterns {
 
+// pi: M_PI is POSIX's, not C++17's (MinGW and a strict libc++ build have no M_PI).
+inline constexpr double kPi = 3.14159265358979323846;
+
 // The puck's travel over the last frame: from fromMm (T ago) to toMm (now).
 struct Travel {
   double fromMm = 0.0;

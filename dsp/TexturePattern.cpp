@@ -28,7 +28,7 @@ void TexturePattern::draw(double lo, double hi, uint64_t seed, Components& out) 
   uint64_t state = seed;
   for (int k = 0; k < kComponents; ++k) {
     out.frequency[k] = lo + (hi - lo) * unit(state);
-    out.phase[k] = 2.0 * M_PI * unit(state);
+    out.phase[k] = 2.0 * kPi * unit(state);
   }
 }
 
@@ -36,7 +36,7 @@ double TexturePattern::at(double lo, double hi, uint64_t seed, double xMm) {
   Components c;
   draw(lo, hi, seed, c);
   double sum = 0.0;
-  for (int k = 0; k < kComponents; ++k) sum += std::sin(2.0 * M_PI * c.frequency[k] * xMm + c.phase[k]);
+  for (int k = 0; k < kComponents; ++k) sum += std::sin(2.0 * kPi * c.frequency[k] * xMm + c.phase[k]);
   return clampLevel(0.5 + amplitude() * sum);
 }
 
@@ -75,7 +75,7 @@ void TexturePattern::startFade(const Components& to) {
 double TexturePattern::render(const Components& c, const Travel& travel, bool antialias) {
   double sum = 0.0;
   for (int k = 0; k < kComponents; ++k) {
-    const double w = 2.0 * M_PI * c.frequency[k];
+    const double w = 2.0 * kPi * c.frequency[k];
     if (!antialias) {
       sum += std::sin(w * travel.toMm + c.phase[k]);
       continue;
