@@ -10,7 +10,9 @@ void GratingPattern::set(double periodMm, double duty, double edgeMm, double anc
   if (duty_ == harmonicsDuty_ && edge_ == harmonicsEdge_) return;
   for (int k = 1; k <= kMaxHarmonics; ++k) {
     const double e = kPi * k * edge_, sincEdge = e > 0.0 ? std::sin(e) / e : 1.0;
-    harmonics_[k - 1] = std::polar(std::sin(kPi * k * duty_) / (kPi * k) * sincEdge, -kPi * k * (duty_ + edge_));
+    // amplitude * polar(1, phase): the amplitude may be negative, which std::polar does not allow
+    // (libc++ returns NaN for it).
+    harmonics_[k - 1] = std::sin(kPi * k * duty_) / (kPi * k) * sincEdge * std::polar(1.0, -kPi * k * (duty_ + edge_));
   }
   harmonicsDuty_ = duty_;
   harmonicsEdge_ = edge_;

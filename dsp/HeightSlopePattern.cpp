@@ -12,7 +12,8 @@ void BumpPattern::set(double periodMm, double widthMm, bool valleys, double anch
   // E(q) = integral of e^(i q u) over [0, half] = half e^(i q half / 2) sinc(q half / 2).
   auto E = [half](double q) {
     const double x = 0.5 * q * half;
-    return std::polar(half * (x == 0.0 ? 1.0 : std::sin(x) / x), x);
+    // A negative amplitude times polar(1, x): std::polar's modulus must not be negative (libc++: NaN).
+    return half * (x == 0.0 ? 1.0 : std::sin(x) / x) * std::polar(1.0, x);
   };
   for (int k = 1; k <= kMaxHarmonics; ++k) {
     const double a = 2.0 * kPi * k;

@@ -14,7 +14,6 @@ using namespace kf::patterns;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kLoN = 0.14, kHiN = 0.5;
 constexpr double kSx = 4, kSy = 3, kW = 2;  // spacings and width (mm)
 

@@ -16,7 +16,6 @@ using namespace kf::patterns;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kMinN = 0.14, kMaxN = 0.5;

@@ -81,7 +81,9 @@ bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string
     const int index = static_cast<int>(field - kFields);
     if (seen[index]) return fail(key + " is given twice");
     double value = 0.0;
-    if (!(fields >> value) || (fields >> rest)) return fail("expected \"" + key + " <number>\"");
+    // Non-finite values too: libstdc++ does not read "nan" as a number and libc++ does.
+    if (!(fields >> value) || (fields >> rest) || !std::isfinite(value))
+      return fail("expected \"" + key + " <number>\"");
     const bool inRange =
         std::isfinite(value) && value <= field->hi && (field->loOpen ? value > field->lo : value >= field->lo);
     const bool isSign = field->member != &DriveCircuit::outputSign || value == 1.0 || value == -1.0;
