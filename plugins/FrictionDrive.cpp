@@ -41,17 +41,13 @@ class FrictionDrive : public SCUnit {
     mSlot.isNew(generation);
     bool another = false;
     const float* samples = drive->samples(clock, generation, *force, another);
-    if (samples == nullptr && another) {
-      if (mNotes.first(kAnotherDrive))
+    if (samples == nullptr) {  // another drive of the slot ran first, or no chain: 0, said once each
+      if (another && mNotes.first(kAnotherDrive))
         kf::sc::postFromRt(mWorld,
                            "FrictionDrive: the device at index %d has one drive, and another FrictionDrive of "
                            "it ran first in this block; this one's output is 0.\n",
                            index);
-      std::fill_n(output, numSamples, 0.0f);
-      return;
-    }
-    if (samples == nullptr) {
-      if (mNotes.first(kNoChain))
+      else if (!another && mNotes.first(kNoChain))
         kf::sc::postFromRt(mWorld,
                            "FrictionDrive: no drive calibration is loaded for the device at index %d "
                            "(FrictionDevice.loadDrive); its output is 0.\n",
