@@ -12,8 +12,8 @@ namespace {
 
 std::atomic<bool> gDrivesHalted{false};
 SlotDrive gDrives[kNumDeviceSlots];
-// NaN is the minimum force: the input of a block no writer framed (never read: such a block is
-// driven off at once), kept so that process() always has a block of input.
+// NaN is the minimum force: the input for the samples of a block beyond those its writers framed
+// (a block size change), so that process() always has a block of input.
 float gNoForce[SlotDrive::kMaxBlockSamples];
 const bool gNoForceFilled = [] {
   std::fill_n(gNoForce, SlotDrive::kMaxBlockSamples, std::numeric_limits<float>::quiet_NaN());
