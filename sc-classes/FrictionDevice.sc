@@ -89,8 +89,8 @@ FrictionDevice {
 	// rather than one composite command: each part already answers with its own reason, and a
 	// failed part is undone by one kfClose; a composite would repeat the mouse's and the board's
 	// arguments and stages in the plugin for the same outcome. See ARCHITECTURE.md.
-	*hardware { |server, mouse, board, profile, calibration, index = 0, backend, grab = false|
-		^this.new.prInitMouse(server, index, mouse, backend, profile, grab)
+	*hardware { |server, mouse, board, profile, calibration, index = 0, backend, grab = false, replace = false|
+		^this.new.prInitMouse(server, index, mouse, backend, profile, grab, replace)
 		.prInitBoard(board, calibration, "FrictionDevice.hardware").prOpen
 	}
 
@@ -109,13 +109,14 @@ FrictionDevice {
 	openCommand { ^(sim: \kfOpenSim, replay: \kfOpenReplay, mouse: \kfOpenMouse)[kind] }
 
 	openMsg {
-		if(kind == \mouse) { ^this.mouseMsg };  // FrictionDeviceMouse.sc
-		^if(kind == \sim) {
-			['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] })
-			++ this.prOverrideArgs
-		} {
-			['/cmd', \kfOpenReplay, index, source] ++ this.prOverrideArgs
-		} ++ (if(replace) { [\replace, 1] } { [] })
+		^switch(kind,
+			\mouse, { this.mouseMsg },  // FrictionDeviceMouse.sc
+			\sim, {
+				['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] })
+				++ this.prOverrideArgs
+			},
+			{ ['/cmd', \kfOpenReplay, index, source] ++ this.prOverrideArgs }
+		) ++ (if(replace) { [\replace, 1] } { [] })
 	}
 
 	// The puck's latest reported position becomes (x, y) mm for every reader of the device, from

@@ -6,12 +6,12 @@
 	// "/dev/input/event5") or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). backend: \evdev (nil on
 	// Linux: it opens wireless receivers' mice too) or \hidapi (nil elsewhere). profile: an Event
 	// of settings (e.g. (countMm: 0.0212)) or the path of a mouse profile file (writeMouseProfile).
-	// grab: evdev only, keeps the desktop cursor still.
-	*mouse { |server, index = 0, which, backend, profile, grab = false|
-		^this.new.prInitMouse(server, index, which, backend, profile, grab).prOpen
+	// grab: evdev only, keeps the desktop cursor still. replace: as *sim's.
+	*mouse { |server, index = 0, which, backend, profile, grab = false, replace = false|
+		^this.new.prInitMouse(server, index, which, backend, profile, grab, replace).prOpen
 	}
 
-	// The OSC message that opens the mouse (as openMsg of any device).
+	// The OSC message that opens the mouse (openMsg adds replace).
 	mouseMsg {
 		^['/cmd', \kfOpenMouse, index, source[\which], source[\backend].asString, source[\profilePath] ? ""]
 		++ (if(source[\grab]) { [\grab, 1] } { [] })
@@ -104,7 +104,7 @@
 		^settings
 	}
 
-	prInitMouse { |argServer, argIndex, which, backend, profile, grab|
+	prInitMouse { |argServer, argIndex, which, backend, profile, grab, replace = false|
 		var settings, profilePath;
 		backend = backend ?? { if(thisProcess.platform.name == \linux) { \evdev } { \hidapi } };
 		if([\hidapi, \evdev].includes(backend.asSymbol).not) {
@@ -121,6 +121,6 @@
 			settings = profile
 		};
 		this.prInit(argServer, argIndex, \mouse, (which: (which ? "").asString, backend: backend.asSymbol,
-			profilePath: profilePath, grab: grab == true), settings);
+			profilePath: profilePath, grab: grab == true), settings, replace);
 	}
 }

@@ -13,6 +13,7 @@ def test_mouse_messages_and_specs():
         var d = FrictionDevice.mouse(nil, 2, "0458:0138", \evdev, (countMm: 0.02), true);
         "KF-MSG %".format(d.openMsg).postln;
         "KF-MOUSEMSG %".format(d.mouseMsg == d.openMsg).postln;
+        "KF-REPLACE %".format(FrictionDevice.mouse(nil, 1, replace: true).openMsg).postln;
         "KF-SPEC % %".format(d.specs[\countMm], d.specs[\maxSpeed]).postln;
         "KF-FIRST %".format(FrictionDevice.mouse(nil, 0).openMsg).postln;
         "KF-INDEX %".format(FrictionDevice.mouse(nil, 1, 3).openMsg).postln;
@@ -22,6 +23,7 @@ def test_mouse_messages_and_specs():
     """)
     assert "KF-MSG [ /cmd, kfOpenMouse, 2, 0458:0138, evdev, , grab, 1, countMm, 0.02 ]" in out
     assert "KF-MOUSEMSG true" in out
+    assert "KF-REPLACE [ /cmd, kfOpenMouse, 1, , evdev, , replace, 1 ]" in out
     assert "KF-SPEC 0.02 317.5" in out  # 0.02 mm x 127 counts x 125 Hz
     assert "KF-FIRST [ /cmd, kfOpenMouse, 0, , evdev,  ]" in out  # Linux: evdev unless asked
     assert "KF-INDEX [ /cmd, kfOpenMouse, 1, 3, evdev,  ]" in out
