@@ -32,7 +32,7 @@ __attribute__((noinline)) bool lockStackBelow() {
 
 std::string describe(const ThreadScheduling& s) {
   if (s.priority < 0) return "not started";
-  std::string text = s.priority > 0 ? "SCHED_FIFO " + std::to_string(s.priority) : std::string("normal priority");
+  std::string text = s.priority > 0 ? realtimeSchedulingName(s.priority) : std::string("normal priority");
   return text + (s.memoryLocked ? ", memory locked" : "");
 }
 

@@ -96,7 +96,11 @@ std::thread startThreadWithAsyncSignalsBlocked(std::function<void()> work);
 // The monotonic clock in ns, callable from a signal handler (async-signal-safe).
 int64_t monotonicNanosecondsFromSignal();
 
-// "SCHED_FIFO 66, memory locked" / "normal priority (realtime refused)" / "not started".
+// "SCHED_FIFO 66, memory locked" / "normal priority (realtime refused)" / "not started"; on
+// Windows "time-critical" for the realtime class.
 std::string describe(const ThreadScheduling& s);
+// What realtime scheduling at `priority` (> 0) is called here: "SCHED_FIFO 66" (POSIX),
+// "time-critical" (Windows, which has one realtime level, not numbers).
+std::string realtimeSchedulingName(int priority);
 
 }  // namespace kf

@@ -41,6 +41,8 @@ void postRefusalOnce(const char* name, int priority, int error) {
 
 }  // namespace
 
+std::string realtimeSchedulingName(int priority) { return "SCHED_FIFO " + std::to_string(priority); }
+
 bool lockMemory(const void* data, size_t bytes) {
   if (data == nullptr || bytes == 0) return true;
   const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));

@@ -41,6 +41,8 @@ int currentThreadPriority() {
   return ::GetThreadPriority(::GetCurrentThread()) >= THREAD_PRIORITY_TIME_CRITICAL ? kMaxPriority : 0;
 }
 
+std::string realtimeSchedulingName(int) { return "time-critical"; }
+
 bool lockMemory(const void* data, size_t bytes) {
   if (data == nullptr || bytes == 0) return true;
   return ::VirtualLock(const_cast<void*>(data), bytes) != 0;
