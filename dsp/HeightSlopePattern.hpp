@@ -8,17 +8,15 @@
 // (a valley is -h). Level = the climb in the direction of motion per unit travel, over the
 // steepest slope (pi / omega per period), so the steepest climb is 1. Rendered as its mean over
 // the frame's travel: the climb over the travel (closed form) over the travel, band-limited to
-// the speed. Its harmonics, climbing along +1 (level sin(2 pi u / omega) on [0, omega / 2)), with
-// a = 2 pi k, b = 2 pi / omega, E(q) = integral of e^(i q u) over [0, omega / 2):
-//   C+_k = (E(b - a) - E(-b - a)) / 2i;  along -1 the mirror image about omega / 2:
-//   C-_k = e^(-i a omega) conj(C+_k); valleys climb where bumps descend (C+ and C- swap).
+// the speed with its harmonics. The bump's height, climb and harmonics are RaisedCosineBump's; a
+// valley climbs where a bump descends: the bump's climb moving the other way.
 //
 // SlopeOfHeight: the same rule on any height signal of the position (a buffer read by
 // SpatialBufRd): level = (height now - height one frame ago) / |travel| / fullSlope, within
 // [0, 1]; held while the travel is below kMinTravelMm (the puck at rest keeps its force).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "RaisedCosineBump.hpp"
 
 namespace kf::patterns {
 
@@ -29,21 +27,11 @@ class BumpPattern {
   // anchorMm.
   void set(double periodMm, double widthMm, bool valleys, double anchorMm);
   double level(const Travel& travel, bool antialias) const;
-  // The definition: the level at cycle fraction f moving in direction (+1, -1).
-  double at(double f, int direction) const;
-  // The climb (height units, bump height 1) from the start of the period to f, moving +1 or -1
-  // (for -1: the climb met going the other way, i.e. the descent along +1).
-  double climbTo(double f, int direction) const;
-  double mean() const { return omega_ / kPi; }
 
  private:
-  double height(double f) const;
   PeriodicCoordinate coordinate_;
-  Harmonics climbingUp_{}, climbingDown_{};  // the level's harmonics moving +1 and -1
-  double harmonicsOmega_ = -1.0;
-  bool harmonicsValleys_ = false;
+  RaisedCosineBump bump_;
   double widthMm_ = 0.5;
-  double omega_ = 0.5;
   bool valleys_ = false;
 };
 
