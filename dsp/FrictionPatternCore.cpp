@@ -55,7 +55,7 @@ double FrictionPatternCore::level(const Travel& travel) {
     case PatternKind::Slope:
       return slope_.level(travel, travel_.valueFrameAgo(), travel_.valueNow());
     case PatternKind::Bumps2D:
-      return gridBumps_.level(travel.fromMm, travel_.valueFrameAgo(), travel.toMm, travel_.valueNow(), antialias_);
+      return gridBumps_.level(travel, travel_.valueFrameAgo(), travel_.valueNow(), antialias_);
   }
   return 0.0;
 }

@@ -3,42 +3,46 @@
 namespace kf::patterns {
 
 void GridBumpsPattern::set(double spacingXMm, double spacingYMm, double widthMm, double anchorXMm, double anchorYMm) {
-  axisX_.setPeriod(spacingXMm, anchorXMm);
-  axisY_.setPeriod(spacingYMm, anchorYMm);
+  x_.coordinate.setPeriod(spacingXMm, anchorXMm);
+  y_.coordinate.setPeriod(spacingYMm, anchorYMm);
   if (widthMm > 0.0 && std::isfinite(widthMm)) widthMm_ = widthMm;
-  omegaX_ = std::clamp(widthMm_ / axisX_.periodMm(), 1e-6, 1.0);
-  omegaY_ = std::clamp(widthMm_ / axisY_.periodMm(), 1e-6, 1.0);
-  widthX_ = omegaX_ * axisX_.periodMm();
-  widthY_ = omegaY_ * axisY_.periodMm();
-}
-
-double GridBumpsPattern::bump(const PeriodicCoordinate& axis, double omega, double uMm) {
-  const double f = fractionOf(axis.cycles(uMm));
-  return f < omega ? 0.5 * (1.0 - std::cos(2.0 * kPi * f / omega)) : 0.0;
-}
-
-double GridBumpsPattern::bumpSlope(const PeriodicCoordinate& axis, double omega, double widthMm, double uMm) {
-  const double f = fractionOf(axis.cycles(uMm));
-  return f < omega ? kPi / widthMm * std::sin(2.0 * kPi * f / omega) : 0.0;
-}
-
-double GridBumpsPattern::height(double xMm, double yMm) const {
-  return bump(axisX_, omegaX_, xMm) * bump(axisY_, omegaY_, yMm);
-}
-
-double GridBumpsPattern::level(double x0, double y0, double x1, double y1, bool antialias) {
-  const double dx = x1 - x0, dy = y1 - y0, travelMm = std::hypot(dx, dy);
-  if (!(travelMm >= kMinTravelMm)) return held_;
-  double slope;  // height units per mm along the travel
-  if (antialias) {
-    slope = (height(x1, y1) - height(x0, y0)) / travelMm;
-  } else {
-    const double gx = bumpSlope(axisX_, omegaX_, widthX_, x1) * bump(axisY_, omegaY_, y1);
-    const double gy = bump(axisX_, omegaX_, x1) * bumpSlope(axisY_, omegaY_, widthY_, y1);
-    slope = (gx * dx + gy * dy) / travelMm;
+  for (Axis* axis : {&x_, &y_}) {
+    axis->bump.setWidth(widthMm_ / axis->coordinate.periodMm());
+    axis->widthMm = axis->bump.omega() * axis->coordinate.periodMm();
   }
-  if (!std::isfinite(slope)) return held_;
-  return held_ = clampLevel(slope / steepestSlope());
+}
+
+GridBumpsPattern::Factors GridBumpsPattern::factors(const Axis& axis, double u0, double u1, int s, double kStop,
+                                                    bool antialias) {
+  const RaisedCosineBump& b = axis.bump;
+  if (!antialias) return {b.climb(fractionOf(u1), s), b.height(fractionOf(u1))};
+  const double climbMean = b.climbMean(), heightMean = b.heightMean();
+  const double climbBoxed = periodicMean(
+      u0, u1, climbMean, [&](double f) { return climbMean * b.climbTo(f, s); },
+      [&](double f) { return b.climb(f, s); });
+  const double heightBoxed = periodicMean(
+      u0, u1, heightMean, [&](double f) { return b.heightTo(f); }, [&](double f) { return b.height(f); });
+  return {bandLimitedSeriesTo(kStop, climbBoxed, climbMean, b.climbHarmonics(s), u0, u1),
+          bandLimitedSeriesTo(kStop, heightBoxed, heightMean, b.heightHarmonics(), u0, u1)};
+}
+
+double GridBumpsPattern::level(const Travel& x, double y0, double y1, bool antialias) {
+  const double dx = x.toMm - x.fromMm, dy = y1 - y0, travelMm = std::hypot(dx, dy);
+  if (!(travelMm >= kMinTravelMm)) return held_;
+  // Each axis's share of the frames' Nyquist frequency (the header): 1 / 0 = inf on a still axis.
+  const double rootX = std::sqrt(std::fabs(dx) / x.framePeriodS / x_.coordinate.periodMm());
+  const double rootY = std::sqrt(std::fabs(dy) / x.framePeriodS / y_.coordinate.periodMm());
+  const double nyquistHz = 0.5 / x.framePeriodS;
+  const Factors fx = factors(x_, x_.coordinate.cycles(x.fromMm), x_.coordinate.cycles(x.toMm), dx > 0.0 ? 1 : -1,
+                             nyquistHz / (rootX * (rootX + rootY)), antialias);
+  const Factors fy = factors(y_, y_.coordinate.cycles(y0), y_.coordinate.cycles(y1), dy > 0.0 ? 1 : -1,
+                             nyquistHz / (rootY * (rootX + rootY)), antialias);
+  const double steepest = steepestSlope();
+  const double level = (std::fabs(dx) * (kPi / x_.widthMm) * fx.climb * fy.height +
+                        std::fabs(dy) * (kPi / y_.widthMm) * fx.height * fy.climb) /
+                       travelMm / steepest;
+  if (!std::isfinite(level)) return held_;
+  return held_ = clampLevel(level);
 }
 
 }  // namespace kf::patterns

@@ -1,16 +1,39 @@
 // A grid of bumps in 2D felt by the height rule (issue 27 item 3): the height
 //   h(x, y) = b(x) * b(y),  b(u) = (1 - cos(2 pi u / w)) / 2 on [0, w) of every spacing, 0 beyond
-// (one raised-cosine bump of width w mm from (0, 0) in every cell of spacingX by spacingY mm),
-// and the level = clip(climb along the frame's travel / its length / steepest slope, 0, 1):
-// climbing resists, going down is free, in any direction of motion. The steepest slope of h is
-// pi / w (crossing a bump's centre along an axis; |grad h| is no larger elsewhere), so that crossing
-// gives the full level. Anti-aliased: (h(end) - h(start)) / |end - start| is the exact mean of the
-// directional slope over the frame's straight travel (a box filter as long as the travel, as the
-// 1D patterns' mean over the travel). Raw: the directional slope at the current position.
+// (one raised-cosine bump of width w mm from (0, 0) in every cell of spacingX by spacingY mm).
+// Climbing resists, going down is free, in any direction of motion, with the climb counted per
+// axis: moving along the unit vector (ux, uy),
+//   level = (|ux| (pi / wx) c_x(x) b(y) + |uy| b(x) (pi / wy) c_y(y)) / (pi / min(wx, wy))
+// where c_axis is the one-axis bump's climb in the sign of that velocity component
+// (RaisedCosineBump::climb: max(0, s sin(2 pi f / omega)), the slope over the steepest, pi / w).
+// It is the directional slope max(0, u . grad h) (over the steepest slope of h, pi / w) wherever
+// both axes climb or both descend (along an axis; through a bump's centre on the diagonal), and
+// counts more where one climbs and the other descends (the climbing axis alone, not the net).
+// Why not the directional slope: rectified, it is not separable and its 2D harmonics depend on
+// the direction (no closed form); this rule is a sum of products of one-axis functions, each with
+// closed-form harmonics, so it is band-limited per harmonic as the 1D patterns are. It is <= 1:
+// where both axes climb it is u . grad h <= |grad h| <= pi / min(wx, wy); where one climbs, that
+// axis's part of u . grad h alone.
+//
+// Rendered (anti-aliased) as each one-axis factor's mean over that axis's travel in the frame
+// (the rule's mean over the box the travel spans in x and y: a kernel >= 0 of unit mass, so the
+// level stays in [0, 1]; along an axis the factor is then exactly the 1D bumps' level, whose box
+// also damps the harmonics past the band in the blend region below), band-limited per harmonic:
+// component (m, n) of the product has temporal frequency |m vx / Sx + n vy / Sy| <= |m| fx + |n| fy
+// (fx = |vx| / Sx, fy = |vy| / Sy, Hz), so each axis gets its own first harmonic not kept, Kx and
+// Ky with Kx fx + Ky fy = the frames' Nyquist frequency (500 Hz at 1 ms), shared as
+//   Kx = N / (sqrt(fx) (sqrt(fx) + sqrt(fy))),  Ky = N / (sqrt(fy) (sqrt(fx) + sqrt(fy)))
+// (Kx -> inf continuously as fx -> 0: along y the x factors are not filtered at all, and along x
+// Kx = N / fx, the 1D bumps' own). Each one-axis factor is bandLimitedSeriesTo(K of its axis):
+// every kept component is below the Nyquist frequency. Left, as in 1D (PatternTravel.hpp): where
+// an axis's K is between kMaxHarmonics and twice it, the boxed factor with weight h keeps that
+// axis's harmonics past kMaxHarmonics (box-weighted, sinc <= 1 / (pi k L)); from 2 kMaxHarmonics
+// on, the boxed closed form (the full rendering).
+// Raw (antialias off): the rule at the current position, in the frame's direction per axis.
 // Held while the travel is below kMinTravelMm (the puck at rest keeps its force).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "RaisedCosineBump.hpp"
 
 namespace kf::patterns {
 
@@ -21,22 +44,26 @@ class GridBumpsPattern {
   // Spacings or width not finite and > 0 keep the last good one; the width is clamped to each
   // spacing. A change of spacing keeps the phase at (anchorXMm, anchorYMm).
   void set(double spacingXMm, double spacingYMm, double widthMm, double anchorXMm, double anchorYMm);
-  // The level for a frame's travel from (x0, y0) to (x1, y1) mm.
-  double level(double x0, double y0, double x1, double y1, bool antialias);
-  // The definition: height (bump height 1) and its gradient (per mm) at (x, y).
-  double height(double xMm, double yMm) const;
-  double steepestSlope() const { return kPi / std::min(widthX_, widthY_); }
+  // The level for a frame's travel: x's (with the frame period), y from y0 to y1 mm.
+  double level(const Travel& x, double y0, double y1, bool antialias);
+  double steepestSlope() const { return kPi / std::min(x_.widthMm, y_.widthMm); }
 
  private:
-  // b and db/du (per mm) along one axis.
-  static double bump(const PeriodicCoordinate& axis, double omega, double uMm);
-  static double bumpSlope(const PeriodicCoordinate& axis, double omega, double widthMm, double uMm);
+  struct Axis {
+    PeriodicCoordinate coordinate;  // spacing 1 mm before the first good one (PeriodicCoordinate's)
+    RaisedCosineBump bump;          // width 0.5 cycle before the first good one
+    double widthMm = 0.5;           // the width as clamped to this spacing
+  };
+  // The climb and the height factors along one axis for its travel u0 -> u1 (cycles), moving in
+  // direction s (+-1; on a still axis either: its climb is counted with weight 0), filtered to
+  // kStop (inf: the box mean; antialias off: the point u1).
+  struct Factors {
+    double climb, height;
+  };
+  static Factors factors(const Axis& axis, double u0, double u1, int s, double kStop, bool antialias);
 
-  PeriodicCoordinate axisX_, axisY_;
-  // Before the first good values: spacings 1 mm (PeriodicCoordinate's) and width 0.5 mm, as BumpPattern.
+  Axis x_, y_;
   double widthMm_ = 0.5;
-  double omegaX_ = 0.5, omegaY_ = 0.5;  // width over spacing, per axis
-  double widthX_ = 0.5, widthY_ = 0.5;  // the width as clamped to each spacing (mm)
   double held_ = 0.0;
 };
 

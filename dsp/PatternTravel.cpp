@@ -49,7 +49,10 @@ double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u
                          double periodMm) {
   const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
   if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
-  const double kStop = 0.5 / travel.framePeriodS / f1;
+  return bandLimitedSeriesTo(0.5 / travel.framePeriodS / f1, boxed, mean, c, u0, u1);
+}
+
+double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1) {
   if (!(kStop < 2.0 * kMaxHarmonics)) return boxed;  // slow: the closed form, h = 1
   const double h = kStop <= kMaxHarmonics ? 0.0 : 0.5 * (1.0 - std::cos(kPi * (kStop - kMaxHarmonics) / kMaxHarmonics));
   const double kCut = std::min(kStop, static_cast<double>(kMaxHarmonics));

@@ -122,6 +122,9 @@ double splineGain(double r);
 // 0 -> 1 (raised cosine in kStop): only harmonics past kMaxHarmonics are left, with weight h.
 double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
                          double periodMm);
+// The same with kStop given: the first harmonic that may not be kept (a 2D pattern shares the
+// frames' Nyquist frequency between its axes, GridBumpsPattern). kStop NaN or inf: boxed.
+double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1);
 
 inline double clampLevel(double g) { return g > 0.0 ? (g < 1.0 ? g : 1.0) : 0.0; }
 
