@@ -59,6 +59,11 @@ def band_limited_series(boxed, mean, harmonics, u0, u1, speed, period_mm, period
     f1 = np.asarray(speed, dtype=np.float64) / period_mm
     with np.errstate(divide="ignore", invalid="ignore"):
         k_stop = np.where(f1 > 0, 0.5 / period_s / np.where(f1 > 0, f1, 1), np.inf)
+    return band_limited_series_to(k_stop, boxed, mean, harmonics, u0, u1)
+
+
+def band_limited_series_to(k_stop, boxed, mean, harmonics, u0, u1):
+    """PatternTravel.cpp bandLimitedSeriesTo: band_limited_series with k_stop given (inf: boxed)."""
     between = np.clip(k_stop, MAX_HARMONICS, 2 * MAX_HARMONICS)
     h = 0.5 * (1 - np.cos(np.pi * (between - MAX_HARMONICS) / MAX_HARMONICS))
     k_cut = np.minimum(k_stop, MAX_HARMONICS)
@@ -78,6 +83,17 @@ def grating_harmonics(duty, edge):
     """GratingPattern.hpp: C_k = e^(-i pi k (d + e)) sin(pi k d) / (pi k) sinc(pi k e)."""
     k = np.arange(1, MAX_HARMONICS + 1)
     return np.exp(-1j * np.pi * k * (duty + edge)) * np.sin(np.pi * k * duty) / (np.pi * k) * np.sinc(k * edge)
+
+
+def height_harmonics(omega):
+    """RaisedCosineBump.hpp: the height's C_k = E(-a) / 2 - (E(b - a) + E(-b - a)) / 4 over [0, omega)."""
+    k = np.arange(1, MAX_HARMONICS + 1)
+    a, b = 2 * np.pi * k, 2 * np.pi / omega
+
+    def e(q):
+        return omega * np.exp(0.5j * q * omega) * np.sinc(q * omega / (2 * np.pi))
+
+    return e(-a) / 2 - (e(b - a) + e(-b - a)) / 4
 
 
 def bump_harmonics(omega, valleys):
@@ -244,30 +260,57 @@ def slope(x, height, rate, full_slope):
     return out
 
 
-def _grid_bump(u, spacing, omega):
-    f = u / spacing
-    f = f - np.floor(f)
-    return np.where(f < omega, 0.5 * (1.0 - np.cos(2.0 * np.pi * f / omega)), 0.0)
-
-
-def bumps2d(x, y, rate, spacing_x, spacing_y, width):
-    """The 2D grid of bumps h = b(x) b(y) by the height rule: the rise over the frame's travel in
-    (x, y) over its length, over the steepest slope pi / width, clipped to [0, 1]; held at rest."""
+def bumps2d(x, y, rate, spacing_x, spacing_y, width, antialias=True):
+    """GridBumpsPattern.hpp: the 2D grid of bumps h = b(x) b(y), the climb counted per axis,
+    (|dx| (pi / wx) c(x) b(y) + |dy| b(x) (pi / wy) c(y)) / travel / (pi / min(wx, wy)), each one-axis
+    factor its mean over that axis's travel, band-limited to its share of the frames' Nyquist
+    frequency (Kx fx + Ky fy = 500 Hz); raw: the rule at the point; held below 1e-4 mm of travel."""
     spacing_x, spacing_y, width = _f32(spacing_x, spacing_y, width)
-    ox, oy = min(max(width / spacing_x, 1e-6), 1.0), min(max(width / spacing_y, 1e-6), 1.0)
-    steepest = np.pi / min(ox * spacing_x, oy * spacing_y)
-    x0, x1, _, _, _ = travel(x, rate)
+    x0, x1, _, _, t = travel(x, rate)
     y0, y1, _, _, _ = travel(y, rate)
+    dx, dy = x1 - x0, y1 - y0
+    moved = np.hypot(dx, dy)
+    rx, ry = np.sqrt(np.abs(dx) / t / spacing_x), np.sqrt(np.abs(dy) / t / spacing_y)
 
-    def h(a, b):
-        return _grid_bump(a, spacing_x, ox) * _grid_bump(b, spacing_y, oy)
+    def axis(u0, u1, omega, s, k_stop):
+        half = omega / 2
 
-    moved = np.hypot(x1 - x0, y1 - y0)
+        def bump(f):
+            return np.where(f < omega, 0.5 * (1 - np.cos(2 * np.pi * f / omega)), 0.0)
+
+        def at(f):
+            return np.where(f < omega, np.maximum(0, s * np.sin(2 * np.pi * f / omega)), 0.0)
+
+        def climb(f):
+            up = np.where(f < half, bump(f), 1.0)
+            down = np.where(f < half, 0.0, np.where(f < omega, 1 - bump(f), 1.0))
+            return np.where(s > 0, up, down)
+
+        def height_to(f):
+            return np.where(f < omega, f / 2 - omega / (4 * np.pi) * np.sin(2 * np.pi * f / omega), half)
+
+        if not antialias:
+            f = u1 - np.floor(u1)
+            return at(f), bump(f)
+        scale = omega / np.pi
+        climbed = _periodic_mean(u0, u1, scale, lambda f: scale * climb(f), at)
+        height = _periodic_mean(u0, u1, half, height_to, bump)
+        up, down = bump_harmonics(omega, False)
+        harmonics = np.where(s[None, :] > 0, up[:, None], down[:, None])
+        return (band_limited_series_to(k_stop, climbed, scale, harmonics, u0, u1),
+                band_limited_series_to(k_stop, height, half, height_harmonics(omega), u0, u1))
+
+    ox, oy = min(max(width / spacing_x, 1e-6), 1.0), min(max(width / spacing_y, 1e-6), 1.0)
+    wx, wy = ox * spacing_x, oy * spacing_y
     with np.errstate(divide="ignore", invalid="ignore"):
-        g = np.clip((h(x1, y1) - h(x0, y0)) / moved / steepest, 0.0, 1.0)
+        nyquist = 0.5 / t
+        cx, bx = axis(x0 / spacing_x, x1 / spacing_x, ox, np.where(dx > 0, 1.0, -1.0), nyquist / (rx * (rx + ry)))
+        cy, by = axis(y0 / spacing_y, y1 / spacing_y, oy, np.where(dy > 0, 1.0, -1.0), nyquist / (ry * (rx + ry)))
+        g = (np.abs(dx) * np.pi / wx * cx * by + np.abs(dy) * np.pi / wy * bx * cy) / moved / (np.pi / min(wx, wy))
+    g = np.clip(g, 0.0, 1.0)
     out, held = np.empty(len(g)), 0.0
     for i in range(len(g)):
-        if moved[i] >= 1e-4:
+        if moved[i] >= 1e-4 and np.isfinite(g[i]):
             held = g[i]
         out[i] = held
     return out

@@ -130,6 +130,34 @@ def folded_harmonics(rate, seconds=1.0):
     return out
 
 
+# bumps2D's 0.2 mm grid (0.1 mm bumps) crossed at 300 mm/s on exact position ramps (Sweep): (path,
+# x, y). Along an axis on the bumps' centre line across it (b = 1), and at 30 degrees.
+GRID_PATHS = [("along x", "Sweep.ar(0, 300) + 0.013", "DC.ar(0.05)"),
+              ("along y", "DC.ar(0.05)", "Sweep.ar(0, 300) + 0.013"),
+              ("at 30 degrees", f"Sweep.ar(0, {300 * np.cos(np.pi / 6)!r}) + 0.013", "Sweep.ar(0, 150) + 0.031")]
+
+
+def grid_aliases(rate, seconds=0.3):
+    """The largest alias (N) in the 1 ms frame means of bumps2D's fine grid per GRID_PATHS entry,
+    anti-aliased and raw."""
+    outs = ", ".join(f"FrictionPattern.bumps2D({x}, {y}, 0.2, 0.2, 0.1, antialias: {a})"
+                     for _, x, y in GRID_PATHS for a in (1, 0))
+    data, _ = nrt.score_and_render("gallery-grid", f"""
+        var def = SynthDef(\\grid, {{ Out.ar(0, [{outs}]) }});
+        score = Score([[0.0, ['/d_recv', def.asBytes]], [0.0, Synth.basicNew(\\grid, nil, 1000).newMsg],
+            [{seconds}, ['/c_set', 0, 0]]]);
+    """, sample_rate=rate, channels=2 * len(GRID_PATHS))
+    n, step = int(seconds * rate) - 64, K.frame_samples(rate)
+    out = []
+    for i, (name, _, _) in enumerate(GRID_PATHS):
+        figures = []
+        for column in (2 * i, 2 * i + 1):
+            force = data[rate // 100:n, column].astype(np.float64)
+            figures.append(largest_alias_n(force[:len(force) // step * step].reshape(-1, step).mean(axis=1)))
+        out.append((name, *figures))
+    return out
+
+
 def write_pattern(out_dir, name, speed_name, cols, rate, reference):
     x, v, requested, commanded = cols
     t = np.arange(len(x)) / rate
@@ -209,11 +237,12 @@ def main():
                 alias=largest_alias_n(frames) if len(frames) else float("nan")))
             figures[(name, speed_name)] = rows[-1]
     folding = folded_harmonics(rate)
-    write_summary(out_dir, rows, figures, folding, rate, time.time() - start)
+    grid = grid_aliases(rate)
+    write_summary(out_dir, rows, figures, folding, grid, rate, time.time() - start)
     log(f"== gallery done in {time.time() - start:.1f} s. Results: {out_dir} (summary: {out_dir / 'summary.md'})")
 
 
-def write_summary(out_dir, rows, figures, folding, rate, elapsed):
+def write_summary(out_dir, rows, figures, folding, grid, rate, elapsed):
     L = ["# KineticFriction pattern gallery: rendered on the simulated device\n",
          f"Rendered with scsynth -N at **{rate} Hz**: each pattern on its own `FrictionDevice.sim` slot "
          f"(paper profile: 0.021 mm counts at 125 Hz, 0.14..1.4 N; a firm hand, `{HAND}`: 0.25 mm of lag at 0.5 N), "
@@ -250,6 +279,13 @@ def write_summary(out_dir, rows, figures, folding, rate, elapsed):
           "| speed (mm/s) | duty | harmonic (Hz) | folds to (Hz) | anti-aliased (N) | raw (N) |",
           "|---|---|---|---|---|---|"]
     L += [f"| {v:g} | {d:g} | {h:.0f} | {f:.0f} | {on_n:.2g} | {raw_n:.2g} |" for v, d, h, f, on_n, raw_n in folding]
+    L += ["\nbumps2D's grid of 0.2 mm spacing (0.1 mm bumps) crossed at 300 mm/s on exact position ramps "
+          "(1500 Hz along an axis; 1299 and 750 Hz at 30 degrees): anti-aliased, each axis keeps the harmonics "
+          "below its share of the frames' 500 Hz (GridBumpsPattern.hpp), here none, so the force is its mean; "
+          "the largest alias in the 1 ms frame means (Hann window, DC excluded).\n",
+          "| path | anti-aliased (N) | raw (N) |",
+          "|---|---|---|"]
+    L += [f"| {name} | {on_n:.2g} | {raw_n:.2g} |" for name, on_n, raw_n in grid]
     L += [f"\nAt the slow speed ({slow['mean_speed']:.1f} mm/s, {slow['mean_speed'] / 0.2:.0f} Hz) the anti-aliased "
           f"grating is rendered in full: {slow['force'][0]:.3f} .. {slow['force'][1]:.3f} N of {LO} .. {HI} N.\n",
           "The pilot's fragment (mapping 3, one sine cycle per 12.5 mm) as bumps by the height rule "

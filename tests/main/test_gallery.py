@@ -32,5 +32,11 @@ def test_the_gallery_renders_every_pattern_with_its_figures():
         # The pilot's writer: no row after the scene, so never the render's all-zero tail.
         last = table[-1]
         assert float(last["force_commanded_n"]) >= 0.14 - 1e-6, f"{name}-{speed}.csv ends below the minimum force"
+    # bumps2D's fine grid at 300 mm/s: no alias anti-aliased (its mean; float rounding ~2e-8 N),
+    # an alias raw (> 0.01 N: the figure shows one).
+    grid = re.findall(r"^\| (along x|along y|at 30 degrees) \| ([\d.e+-]+) \| ([\d.e+-]+) \|$", summary, re.M)
+    assert len(grid) == 3, "bumps2D's alias figures not in the summary"
+    for path, on, raw in grid:
+        assert float(on) < 1e-6 and float(raw) > 0.01, f"bumps2D {path}: {on} N anti-aliased, {raw} N raw"
     for section in ("## Anti-aliasing in space", "## Friction that steers", "## 2D surfaces"):
         assert section in summary, f"no \"{section}\" in the summary"

@@ -179,5 +179,6 @@ def test_bumps2d_under_the_hands_circle_is_its_definition():
     want = LO + (HI - LO) * patterns.bumps2d(x, y, rate, 4, 3, 2)
     err = np.abs(force - want)
     assert err.max() < 1e-6, f"worst {err.max()} N at sample {err.argmax()}"
-    assert force.max() - force.min() > 0.05 and (force == np.float32(LO)).mean() > 0.2, "climbs and descents"
+    # Descents are free but for the band limit's smoothing at 60 mm/s (the series' kernel tails).
+    assert force.max() - force.min() > 0.05 and (force < LO + 1e-3).mean() > 0.2, "climbs and descents"
     assert "FrictionPattern" not in log, log
