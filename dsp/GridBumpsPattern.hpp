@@ -16,9 +16,11 @@
 // axis's part of u . grad h alone.
 //
 // Rendered (anti-aliased) as each one-axis factor's mean over that axis's travel in the frame
-// (the rule's mean over the box the travel spans in x and y: a kernel >= 0 of unit mass, so the
-// level stays in [0, 1]; along an axis the factor is then exactly the 1D bumps' level, whose box
-// also damps the harmonics past the band in the blend region below), band-limited per harmonic:
+// (the rule's mean over the box the travel spans in x and y; along an axis the factor is then
+// exactly the 1D bumps' level, whose box also damps the harmonics past the band in the blend
+// region below), band-limited per harmonic. Both factors on an axis get the same filter (box,
+// spline gains, blend: a kernel >= 0 of unit mass), so the level is the rule smoothed by a
+// kernel >= 0 and stays within [0, 1] with no clamp at work (no clipping to alias). The band:
 // component (m, n) of the product has temporal frequency |m vx / Sx + n vy / Sy| <= |m| fx + |n| fy
 // (fx = |vx| / Sx, fy = |vy| / Sy, Hz), so each axis gets its own first harmonic not kept, Kx and
 // Ky with Kx fx + Ky fy = the frames' Nyquist frequency (500 Hz at 1 ms), shared as
