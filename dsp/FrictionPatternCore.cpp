@@ -10,7 +10,7 @@ ForceRange usableForceRange(double loN, double hiN) {
 }
 
 FrictionPatternCore::FrictionPatternCore(PatternKind kind, double sampleRateHz, double framePeriodS)
-    : kind_(kind), sampleRateHz_(sampleRateHz) {
+    : kind_(kind), sampleRateHz_(sampleRateHz), texture_(kind == PatternKind::Texture2D ? 2 : 1) {
   travel_.setSampleRate(sampleRateHz, framePeriodS);
 }
 
@@ -26,6 +26,7 @@ void FrictionPatternCore::setParameters(double p1, double p2, double p3, float a
     case PatternKind::Detents:
       return detents_.set(p1, p2, anchorMm);
     case PatternKind::Texture:
+    case PatternKind::Texture2D:
       return texture_.set(p1, p2, p3, sampleRateHz_);
     case PatternKind::Viscous:
       return viscous_.set(p1);
@@ -56,13 +57,16 @@ double FrictionPatternCore::level(const Travel& travel) {
       return slope_.level(travel, travel_.valueFrameAgo(), travel_.valueNow());
     case PatternKind::Bumps2D:
       return gridBumps_.level(travel, travel_.valueFrameAgo(), travel_.valueNow(), antialias_);
+    case PatternKind::Texture2D:
+      return texture_.level(travel.fromMm, travel_.valueFrameAgo(), travel.toMm, travel_.valueNow(),
+                            travel.framePeriodS, antialias_);
   }
   return 0.0;
 }
 
 void FrictionPatternCore::process(const float* positionMm, int positionStride, const float* height, int heightStride,
                                   float* forceN, int numSamples) {
-  const bool twoD = kind_ == PatternKind::Bumps2D;
+  const bool twoD = isTwoD(kind_);
   const bool withHeight = (kind_ == PatternKind::Slope || twoD) && height != nullptr;
   const double span = range_.hiN - range_.loN;
   for (int i = 0; i < numSamples; ++i) {

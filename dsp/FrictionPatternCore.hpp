@@ -21,6 +21,7 @@ namespace kf::patterns {
 //   viscous: fullSpeed (mm/s)                         stickSlip: slipSpeed, stickSpeed (mm/s)
 //   slope: p1 is the height signal (audio rate), p2 fullSlope (height units per mm)
 //   bumps2D: spacingX, spacingY, width (mm); the second signal is y (mm)
+//   texture2D: lo, hi (cycles/mm), seed; the second signal is y (mm)
 enum class PatternKind : int {
   Grating = 0,
   Bumps = 1,
@@ -29,9 +30,13 @@ enum class PatternKind : int {
   Viscous = 4,
   StickSlip = 5,
   Slope = 6,
-  Bumps2D = 7
+  Bumps2D = 7,
+  Texture2D = 8
 };
-constexpr int kPatternKinds = 8;
+constexpr int kPatternKinds = 9;
+
+// The kinds that read y (mm) as their second signal.
+constexpr bool isTwoD(PatternKind kind) { return kind == PatternKind::Bumps2D || kind == PatternKind::Texture2D; }
 
 struct ForceRange {
   double loN = paper::mapping::loForceN;
@@ -54,7 +59,7 @@ class FrictionPatternCore {
   void setAntialias(bool on) { antialias_ = on; }
 
   // position and height at stride 1 (audio rate) or 0 (held); height is read for Slope only, and
-  // is y (mm) for Bumps2D (a NaN/inf y holds the last finite one, 0 before the first); nullptr
+  // is y (mm) for the 2D kinds (a NaN/inf y holds the last finite one, 0 before the first); nullptr
   // otherwise. forceN may share memory with position or height.
   void process(const float* positionMm, int positionStride, const float* height, int heightStride, float* forceN,
                int numSamples);

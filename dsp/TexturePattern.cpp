@@ -22,22 +22,46 @@ uint64_t seedOf(double seed) {
 
 }  // namespace
 
-double TexturePattern::amplitude() { return 1.0 / (6.0 * std::sqrt(kComponents / 2.0)); }
+double TexturePattern::amplitude(int count) { return 1.0 / (6.0 * std::sqrt(count / 2.0)); }
 
 void TexturePattern::draw(double lo, double hi, uint64_t seed, Components& out) {
   uint64_t state = seed;
+  out.count = kComponents;
   for (int k = 0; k < kComponents; ++k) {
-    out.frequency[k] = lo + (hi - lo) * unit(state);
+    out.frequencyX[k] = lo + (hi - lo) * unit(state);
+    out.frequencyY[k] = 0.0;
     out.phase[k] = 2.0 * kPi * unit(state);
   }
+}
+
+void TexturePattern::draw2D(double lo, double hi, uint64_t seed, Components& out) {
+  uint64_t state = seed;
+  out.count = kComponents2D;
+  for (int k = 0; k < kComponents2D; ++k) {
+    const double magnitude = lo + (hi - lo) * unit(state), angle = 2.0 * kPi * unit(state);
+    out.frequencyX[k] = magnitude * std::cos(angle);
+    out.frequencyY[k] = magnitude * std::sin(angle);
+    out.phase[k] = 2.0 * kPi * unit(state);
+  }
+}
+
+double TexturePattern::sum(const Components& c, double xMm, double yMm) {
+  double total = 0.0;
+  for (int k = 0; k < c.count; ++k)
+    total += std::sin(2.0 * kPi * c.frequencyX[k] * xMm + 2.0 * kPi * c.frequencyY[k] * yMm + c.phase[k]);
+  return total;
 }
 
 double TexturePattern::at(double lo, double hi, uint64_t seed, double xMm) {
   Components c;
   draw(lo, hi, seed, c);
-  double sum = 0.0;
-  for (int k = 0; k < kComponents; ++k) sum += std::sin(2.0 * kPi * c.frequency[k] * xMm + c.phase[k]);
-  return clampLevel(0.5 + amplitude() * sum);
+  return clampLevel(0.5 + amplitude(c.count) * sum(c, xMm, 0.0));
+}
+
+double TexturePattern::at2D(double lo, double hi, uint64_t seed, double xMm, double yMm) {
+  Components c;
+  draw2D(lo, hi, seed, c);
+  return clampLevel(0.5 + amplitude(c.count) * sum(c, xMm, yMm));
 }
 
 void TexturePattern::set(double lo, double hi, double seed, double sampleRateHz) {
@@ -46,10 +70,15 @@ void TexturePattern::set(double lo, double hi, double seed, double sampleRateHz)
   const uint64_t s = std::isfinite(seed) ? seedOf(seed) : seed_;
   const double a = std::min(lo_, hi_), b = std::max(lo_, hi_);
   Components wanted;
-  draw(a, b, s, wanted);
+  if (twoD_) {
+    draw2D(a, b, s, wanted);
+  } else {
+    draw(a, b, s, wanted);
+  }
   auto same = [](const Components& a, const Components& b) {
-    return std::equal(a.frequency, a.frequency + kComponents, b.frequency) &&
-           std::equal(a.phase, a.phase + kComponents, b.phase);
+    return std::equal(a.frequencyX, a.frequencyX + a.count, b.frequencyX) &&
+           std::equal(a.frequencyY, a.frequencyY + a.count, b.frequencyY) &&
+           std::equal(a.phase, a.phase + a.count, b.phase);
   };
   seed_ = s;
   sampleRateHz_ = sampleRateHz;
@@ -72,31 +101,40 @@ void TexturePattern::startFade(const Components& to) {
   fadeStep_ = 1.0 / std::max(1.0, kCrossfadeS * sampleRateHz_);
 }
 
-double TexturePattern::render(const Components& c, const Travel& travel, bool antialias) {
-  double sum = 0.0;
-  for (int k = 0; k < kComponents; ++k) {
-    const double w = 2.0 * kPi * c.frequency[k];
-    if (!antialias) {
-      sum += std::sin(w * travel.toMm + c.phase[k]);
-      continue;
-    }
-    // Mean of sin(w x + phi) over [from, to]: sin(w mid + phi) * sin(w half) / (w half).
-    const double mid = 0.5 * (travel.fromMm + travel.toMm), half = 0.5 * w * (travel.toMm - travel.fromMm);
+double TexturePattern::render(const Components& c, const Step& step, bool antialias) {
+  if (!antialias) return clampLevel(0.5 + amplitude(c.count) * sum(c, step.toX, step.toY));
+  // The velocity (mm/s): each wave's temporal frequency is |f.v| (Hz).
+  const double vx = step.dx / step.framePeriodS, vy = step.dy / step.framePeriodS;
+  double total = 0.0;
+  for (int k = 0; k < c.count; ++k) {
+    const double wx = 2.0 * kPi * c.frequencyX[k], wy = 2.0 * kPi * c.frequencyY[k];
+    // Mean of sin(w.p + phi) over the straight travel: sin(w.mid + phi) * sin(w.d / 2) / (w.d / 2).
+    const double half = 0.5 * (wx * step.dx + wy * step.dy);
     const double sinc = std::fabs(half) < 1e-8 ? 1.0 : std::sin(half) / half;
-    const double gain = bandLimitGain(travel.speedMmPerS * c.frequency[k], travel.framePeriodS);
-    sum += gain * sinc * std::sin(w * mid + c.phase[k]);
+    const double gain = bandLimitGain(std::fabs(c.frequencyX[k] * vx + c.frequencyY[k] * vy), step.framePeriodS);
+    total += gain * sinc * std::sin(wx * step.midX + wy * step.midY + c.phase[k]);
   }
-  return clampLevel(0.5 + amplitude() * sum);
+  return clampLevel(0.5 + amplitude(c.count) * total);
 }
 
 double TexturePattern::level(const Travel& travel, bool antialias) {
+  return level(Step{0.5 * (travel.fromMm + travel.toMm), 0.0, travel.toMm - travel.fromMm, 0.0, travel.framePeriodS,
+                    travel.toMm, 0.0},
+               antialias);
+}
+
+double TexturePattern::level(double x0, double y0, double x1, double y1, double framePeriodS, bool antialias) {
+  return level(Step{0.5 * (x0 + x1), 0.5 * (y0 + y1), x1 - x0, y1 - y0, framePeriodS, x1, y1}, antialias);
+}
+
+double TexturePattern::level(const Step& step, bool antialias) {
   if (fade_ >= 1.0 && hasPending_) {
     hasPending_ = false;
     startFade(pending_);
   }
-  const double now = render(current_, travel, antialias);
+  const double now = render(current_, step, antialias);
   if (fade_ >= 1.0) return now;
-  const double before = render(previous_, travel, antialias);
+  const double before = render(previous_, step, antialias);
   const double w = fade_;
   fade_ = std::min(1.0, fade_ + fadeStep_);
   return (1.0 - w) * before + w * now;

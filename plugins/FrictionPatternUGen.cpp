@@ -1,7 +1,7 @@
 // FrictionPattern: a spatial friction pattern (dsp/FrictionPatternCore), position (mm) in, force
 // (N) out. Inputs: kind (fixed at init), position, loForce (N), hiForce (N), antialias (0/1),
 // p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal; the
-// 2D kinds (bumps2D) have one more input, y (mm), read as position is (0 when absent).
+// 2D kinds (bumps2D, texture2D) have one more input, y (mm), read as position is (0 when absent).
 // Position and height are read at audio rate as they are; at control rate they are interpolated
 // linearly across the block from the last block's value (as SC UGens do), since a value held per
 // block would make the travel, and every speed-based pattern, jump at block rate. Everything else
@@ -41,6 +41,7 @@ constexpr KindInfo kKinds[kf::patterns::kPatternKinds] = {
     {"stickSlip", {"slipSpeed", "stickSpeed", ""}, {Rule::NonNegative, Rule::NonNegative, Rule::Unused}},
     {"slope", {"height", "fullSlope", ""}, {Rule::Unused, Rule::Positive, Rule::Unused}},
     {"bumps2D", {"spacingX", "spacingY", "width"}, {Rule::Positive, Rule::Positive, Rule::Positive}},
+    {"texture2D", {"lo", "hi", "seed"}, {Rule::Positive, Rule::Positive, Rule::Finite}},
 };
 
 bool follows(Rule rule, float value) {
@@ -68,9 +69,9 @@ class FrictionPatternUGen : public SCUnit {
     mKind = code >= 0 && code < kf::patterns::kPatternKinds ? code : 0;
     mCore.emplace(static_cast<PatternKind>(mKind), sampleRate());
     mLastPositionMm = in0(kPositionMm);
-    // The second signal beside the position: slope's height, bumps2D's y; none otherwise.
+    // The second signal beside the position: slope's height, the 2D kinds' y; none otherwise.
     if (mKind == static_cast<int>(PatternKind::Slope)) mSecond = kP1;
-    if (mKind == static_cast<int>(PatternKind::Bumps2D) && numInputs() > kYMm) mSecond = kYMm;
+    if (kf::patterns::isTwoD(static_cast<PatternKind>(mKind)) && numInputs() > kYMm) mSecond = kYMm;
     mLastHeight = mSecond >= 0 ? in0(mSecond) : 0.f;
     mCalcFunc = make_calc_function<FrictionPatternUGen, &FrictionPatternUGen::next>();
     updateRange();
@@ -83,7 +84,7 @@ class FrictionPatternUGen : public SCUnit {
     updateRange();
     checkParameters();
     mCore->setAntialias(in0(kAntialias) > 0.5f);
-    const bool slope = mSecond >= 0;  // a second signal is read (slope's height, bumps2D's y)
+    const bool slope = mSecond >= 0;  // a second signal is read (slope's height, the 2D kinds' y)
     const bool positionAudio = isAudioRateIn(kPositionMm), heightAudio = !slope || isAudioRateIn(mSecond);
     const float positionNow = in0(kPositionMm), heightNow = slope ? in0(mSecond) : 0.f;
     // The anchor of a phase-continuous period change: the block's first position.

@@ -314,3 +314,39 @@ def bumps2d(x, y, rate, spacing_x, spacing_y, width, antialias=True):
             held = g[i]
         out[i] = held
     return out
+
+
+TEXTURE_2D_COMPONENTS = 32
+
+
+def texture2d_components(lo, hi, seed):
+    """(fx, fy, phase) per plane wave: |f| in [lo, hi], then its angle, then its phase."""
+    lo, hi = _f32(min(lo, hi), max(lo, hi))
+    state, waves = int(seed) & _MASK, []
+    for _ in range(TEXTURE_2D_COMPONENTS):
+        draws = []
+        for _ in range(3):
+            state, z = _splitmix(state)
+            draws.append((z >> 11) * 2.0 ** -53)
+        magnitude, angle = lo + (hi - lo) * draws[0], 2 * np.pi * draws[1]
+        waves.append((magnitude * np.cos(angle), magnitude * np.sin(angle), 2 * np.pi * draws[2]))
+    return np.array(waves)
+
+
+def texture2d(x, y, rate, lo, hi, seed, antialias=True):
+    """The 2D texture: each plane wave's mean over the frame's straight travel in (x, y), faded on
+    its own temporal frequency |f.v| (antialias False: the sum at the current position)."""
+    x0, x1, _, _, t = travel(x, rate)
+    y0, y1, _, _, _ = travel(y, rate)
+    amplitude = 1 / (6 * np.sqrt(TEXTURE_2D_COMPONENTS / 2))
+    total = np.zeros(len(x1))
+    for fx, fy, phi in texture2d_components(lo, hi, seed):
+        if not antialias:
+            total += np.sin(2 * np.pi * (fx * x1 + fy * y1) + phi)
+            continue
+        half = np.pi * (fx * (x1 - x0) + fy * (y1 - y0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sinc = np.where(np.abs(half) < 1e-8, 1.0, np.sin(half) / half)
+        hz = np.abs(fx * (x1 - x0) + fy * (y1 - y0)) / t
+        total += fade(hz, t) * sinc * np.sin(np.pi * (fx * (x0 + x1) + fy * (y0 + y1)) + phi)
+    return np.clip(0.5 + amplitude * total, 0, 1)

@@ -182,3 +182,36 @@ def test_bumps2d_under_the_hands_circle_is_its_definition():
     # Descents are free but for the band limit's smoothing at 60 mm/s (the series' kernel tails).
     assert force.max() - force.min() > 0.05 and (force < LO + 1e-3).mean() > 0.2, "climbs and descents"
     assert "FrictionPattern" not in log, log
+
+
+def test_texture2d_along_a_line_at_an_angle_is_its_definition():
+    # The simulated hand's line at 30 degrees (50 mm at 250 mm/s from (1, -2)) over a 2D texture of
+    # 0.5..3 cycles/mm: waves up to 750 Hz along the line, so some fade, some are gone, some kept;
+    # band-limited and raw, against kfharness.patterns.texture2d at the positions FrictionMouseIn
+    # gave; the same float tolerance as the 1D kinds (1e-6 N).
+    rate, seconds = 48000, 0.4
+    data, log = nrt.score_and_render("patterns-texture2d", f"""
+        var dev = FrictionDevice.sim(nil, 0, FrictionHand.line(30, 50, 250, 1, -2));
+        var def = SynthDef(\\texture2d, {{
+            var m = FrictionMouseIn.ar(0);
+            Out.ar(0, [m[0], m[1], FrictionPattern.texture2D(m[0], m[1], 0.5, 3, 11),
+                FrictionPattern.texture2D(m[0], m[1], 0.5, 3, 11, antialias: 0)])
+        }});
+        score = Score([
+            [0.0, dev.openMsg],
+            [0.0, ['/d_recv', def.asBytes]],
+            [0.0, Synth.basicNew(\\texture2d, nil, 1000).newMsg],
+            [{seconds}, dev.closeMsg],
+            [{seconds} + 0.01, ['/c_set', 0, 0]]]);
+    """, sample_rate=rate, channels=4)
+    n = int(seconds * rate) - 64
+    x, y, on, off = (data[:n, i].astype(np.float64) for i in range(4))
+    assert np.ptp(x) > 10 and np.ptp(y) > 5, "the puck goes along the line in x and y"
+    assert (np.hypot(np.diff(x), np.diff(y)) * rate).max() > 150, "fast enough to fade waves"
+    for force, antialias in ((on, True), (off, False)):
+        want = LO + (HI - LO) * patterns.texture2d(x, y, rate, 0.5, 3, 11, antialias=antialias)
+        err = np.abs(force - want)
+        assert err.max() < 1e-6, f"antialias {antialias}: worst {err.max()} N at sample {err.argmax()}"
+        assert np.ptp(force) > 0.05
+    assert np.abs(on - off).max() > 0.01, "the band limit is what is tested"
+    assert "FrictionPattern" not in log, log

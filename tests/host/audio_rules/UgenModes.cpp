@@ -229,6 +229,18 @@ std::unique_ptr<Synth> patternsSynth(FakeServer& server) {
   synth->add(pattern, ar, {c(7), sweepAr(), c(kNaN), c(-1), c(1), c(kNaN), c(kInf), c(-kInf), c(kNaN)}, 1,
              "bumps2D, bad parameters, forces and y");
   synth->add(pattern, ar, {c(7), sweepAr(), c(0.14f), c(0.5f), c(1), c(4), c(3), c(2)}, 1, "bumps2D, no y");
+  // texture2D (kind 8): y as a ninth input, as bumps2D's; parameters moving runs its crossfades.
+  synth->add(pattern, ar, {c(8), puck, c(0.14f), c(0.5f), c(1), c(0.5f), c(3), c(7), puckY}, 1,
+             "texture2D at the puck");
+  synth->add(pattern, ar,
+             {c(8), sweepAr(), c(0.14f), c(0.5f), alternating(0, 1), alternating(0.5f, 2), alternating(3, 5),
+              alternating(7, 8), toneAr()},
+             1, "texture2D, parameters moving");
+  synth->add(pattern, kr, {c(8), sweepKr(), c(0.14f), c(0.5f), c(1), c(0.5f), c(3), c(7), sweepKr()}, 1,
+             "texture2D, control rate");
+  synth->add(pattern, ar, {c(8), sweepAr(), c(kNaN), c(-1), c(1), c(kNaN), c(kInf), c(-kInf), c(kNaN)}, 1,
+             "texture2D, bad parameters, forces and y");
+  synth->add(pattern, ar, {c(8), sweepAr(), c(0.14f), c(0.5f), c(1), c(0.5f), c(3), c(7)}, 1, "texture2D, no y");
   synth->add(pattern, ar, {c(kNaN), puck, c(0.14f), c(0.5f), c(1), c(1), c(0.5f), c(0.1f)}, 1, "kind NaN");
   Unit* grating = synth->add(pattern, ar, {c(0), puck, c(0.14f), c(0.5f), c(1), c(0.2f), c(0.5f), c(0.02f)}, 1,
                              "a grating under the puck");
