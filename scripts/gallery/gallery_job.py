@@ -32,6 +32,10 @@ PATTERNS = [
     ("valleys", "FrictionPattern.bumps(x, 4, 2, 1)", lambda x, r: K.bumps(x, r, 4, 2, valleys=True)),
     ("detents", "FrictionPattern.detents(x, 3, 0.5)", lambda x, r: K.detents(x, r, 3, 0.5)),
     ("texture", "FrictionPattern.texture(x, 0.5, 3, 1)", lambda x, r: K.texture(x, r, 0.5, 3, 1)),
+    # The 2D texture along the hand's line (y held at 1.3 mm): waves crossing it fade at speed, waves
+    # along it stay.
+    ("texture2D-along-x", "FrictionPattern.texture2D(x, DC.ar(1.3), 0.5, 3, 1)",
+     lambda x, r: K.texture2d(x, np.full(len(x), np.float32(1.3)), r, 0.5, 3, 1)),
     ("viscous", "FrictionPattern.viscous(x, 100)", lambda x, r: K.viscous(x, r, 100)),
     ("stick-slip", "FrictionPattern.stickSlip(x, 5, 2)", lambda x, r: K.stick_slip(x, r, 5, 2)),
     ("pilot-bumps-height-rule", f"FrictionPattern.slope(x, pilot, 2pi / {PILOT_CYCLE_MM})", None),
