@@ -15,6 +15,8 @@ from kfharness import nrt, paths, trace_csv
 from kfharness import patterns as K
 from kfharness import pilot as P
 
+import texture2d_job  # a sibling: this script's folder is on sys.path
+
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -296,6 +298,7 @@ def write_summary(out_dir, rows, figures, folding, grid, rate, elapsed):
           "(`pilot-bumps-height-rule`) beside the paper's loudness rule (`pilot-loudness-rule`): one resistance "
           "per cycle where the signal climbs, against two force peaks per cycle.\n"]
     L += surfaces_and_steering_section(out_dir)
+    L += texture2d_job.render(out_dir)
     L += ["\n## Files\n",
           "Per pattern and speed: `<pattern>-<slow|fast>.csv` (every 1 ms while the synth ran: time, position, "
           "speed, requested and commanded force, the definition's force) and `.png` (force against position, "
