@@ -21,7 +21,7 @@ def test_the_gallery_renders_every_pattern_with_its_figures():
     summary = (OUT / "summary.md").read_text()
     rows = re.findall(r"^\| ([\w-]+) \| (slow|fast) \|", summary, re.M)
     names = {name for name, _ in rows}
-    for kind in ("grating", "bumps", "valleys", "detents", "texture", "viscous", "stick-slip"):
+    for kind in ("grating", "bumps", "valleys", "detents", "texture", "texture2D-along-x", "viscous", "stick-slip"):
         assert kind in names, f"{kind} not in the gallery's summary"
     for name, speed in rows:
         for suffix in (".csv", ".png"):
@@ -38,5 +38,7 @@ def test_the_gallery_renders_every_pattern_with_its_figures():
     assert len(grid) == 3, "bumps2D's alias figures not in the summary"
     for path, on, raw in grid:
         assert float(on) < 1e-6 and float(raw) > 0.01, f"bumps2D {path}: {on} N anti-aliased, {raw} N raw"
-    for section in ("## Anti-aliasing in space", "## Friction that steers", "## 2D surfaces"):
+    for section in ("## Anti-aliasing in space", "## Friction that steers", "## 2D surfaces", "## The 2D texture"):
         assert section in summary, f"no \"{section}\" in the summary"
+    for name in ("texture2D-raster.csv", "texture2D-raster.png"):
+        assert (OUT / name).is_file() and (OUT / name).stat().st_size > 0, f"{name} missing or empty"
