@@ -4,7 +4,7 @@ position FrictionMouseIn gave it (kfharness.patterns)."""
 import numpy as np
 import pytest
 
-from kfharness import nrt, patterns
+from kfharness import nrt, patterns, sclang
 
 LO, HI = 0.14, 0.5
 # name, FrictionPattern code on x (and h, a height signal), reference level from (x, h, rate)
@@ -215,3 +215,20 @@ def test_texture2d_along_a_line_at_an_angle_is_its_definition():
         assert np.ptp(force) > 0.05
     assert np.abs(on - off).max() > 0.01, "the band limit is what is tested"
     assert "FrictionPattern" not in log, log
+
+
+def test_texture2d_literal_arguments_are_checked_when_the_synthdef_is_built():
+    out = sclang.run_script("""
+        var errors = List.new;
+        SynthDef(\\good, { Out.ar(0, FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, 3, 1)) }).add;
+        [
+            { FrictionPattern.texture2D(DC.ar(0)) },
+            { FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0) },
+            { FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, inf) }
+        ].do { |f| try { SynthDef(\\bad, f).add } { |e| errors.add(e.errorString) } };
+        errors.do(_.postln);
+    """)
+    assert "y is required" in out
+    assert "lo and hi must be finite numbers > 0 (cycles/mm), got 0 and 3" in out
+    assert "lo and hi must be finite numbers > 0 (cycles/mm), got 0.5 and inf" in out
+    assert out.count("ERROR") == 3, out
