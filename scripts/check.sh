@@ -42,6 +42,18 @@ check_sclang_lines() {
   return "$long"
 }
 
+# CMake's catch_discover_tests splits a Catch2 test name at ';' into two tests that fail (each
+# names no test case); commas it escapes. Each such name is printed (file: name).
+check_test_names() {
+  echo "== Catch2 test names without ';'"
+  git ls-files 'tests/*.cpp' | xargs "$KF_PYTHON" -c '
+import re, sys
+bad = [f"{path}: {name}" for path in sys.argv[1:]
+       for name in re.findall(r"TEST_CASE\(\s*\"((?:[^\"\\]|\\.)*)\"", open(path).read()) if ";" in name]
+print("\n".join(bad)) if bad else None
+sys.exit(1 if bad else 0)'
+}
+
 check_pyflakes() {
   echo "== pyflakes"
   git ls-files '*.py' | xargs "$KF_PYTHON" -m pyflakes
@@ -157,7 +169,7 @@ checks=("$@")
 ((${#checks[@]})) || checks=(format pyflakes sanitize fuzz sanitize-plugin cross)
 for check in "${checks[@]}"; do
   case "$check" in
-    format) check_format; check_sclang_lines ;;
+    format) check_format; check_sclang_lines; check_test_names ;;
     sclang-lines) check_sclang_lines ;;
     pyflakes) check_pyflakes ;;
     sanitize) check_sanitize ;;

@@ -202,7 +202,7 @@ TEST_CASE("texture2D: a place feels the same at every visit, from any direction,
   CHECK(atP.front() == Approx(definition(wavesOf(0.5, 3, 7), float(px), float(py))).margin(kTol));
 }
 
-TEST_CASE("texture2D: a new seed crossfades over 50 ms; a second change during it waits, nothing steps") {
+TEST_CASE("texture2D: a new seed crossfades over 50 ms, and a second change during it waits, nothing steps") {
   // Seeds 1 -> 2 at 200 ms -> 3 at 220 ms (inside the fade) -> 4 at 240 ms, moving at 20 mm/s at
   // 30 degrees. Per sample the force may change by what the moving texture makes (the same run
   // with one seed: own) plus the fade's step, the range over 2400 samples. Replacing the texture
@@ -263,7 +263,8 @@ TEST_CASE("texture2D: each wave fades on its own temporal frequency, |f.v|: cres
 }
 
 TEST_CASE(
-    "texture2D: at 300 mm/s over a band of 5 cycles/mm no alias in the 1 ms frames; at 5 mm/s the texture in full") {
+    "texture2D: at 300 mm/s over a band of 5 cycles/mm no alias in the 1 ms frames, and at 5 mm/s the texture in "
+    "full") {
   // Moving at v along 30 degrees, wave k has the temporal frequency |f_k.v| (Hz); a wave above the
   // frames' 500 Hz Nyquist frequency would fold to |F - 1000 m|. At each folded frequency (away
   // from DC and the kept waves' lines by 8 Hz: separable) the frames must hold nothing: left are
