@@ -22,7 +22,8 @@ uint64_t seedOf(double seed) {
 
 }  // namespace
 
-double TexturePattern::amplitude(int count) { return 1.0 / (6.0 * std::sqrt(count / 2.0)); }
+// No components (before the first set()): the level is 1/2, not 0 * inf.
+double TexturePattern::amplitude(int count) { return count > 0 ? 1.0 / (6.0 * std::sqrt(count / 2.0)) : 0.0; }
 
 void TexturePattern::draw(double lo, double hi, uint64_t seed, Components& out) {
   uint64_t state = seed;
@@ -69,6 +70,11 @@ void TexturePattern::set(double lo, double hi, double seed, double sampleRateHz)
   if (hi > 0.0 && std::isfinite(hi)) hi_ = hi;
   const uint64_t s = std::isfinite(seed) ? seedOf(seed) : seed_;
   const double a = std::min(lo_, hi_), b = std::max(lo_, hi_);
+  sampleRateHz_ = sampleRateHz;
+  // Called every block: the same band and seed as the last call leave every state as it is.
+  if (set_ && a == drawnLo_ && b == drawnHi_ && s == seed_) return;
+  drawnLo_ = a;
+  drawnHi_ = b;
   Components wanted;
   if (twoD_) {
     draw2D(a, b, s, wanted);
@@ -81,7 +87,6 @@ void TexturePattern::set(double lo, double hi, double seed, double sampleRateHz)
            std::equal(a.phase, a.phase + a.count, b.phase);
   };
   seed_ = s;
-  sampleRateHz_ = sampleRateHz;
   if (!set_) {
     current_ = wanted;
     set_ = true;
@@ -107,11 +112,12 @@ double TexturePattern::render(const Components& c, const Step& step, bool antial
   const double vx = step.dx / step.framePeriodS, vy = step.dy / step.framePeriodS;
   double total = 0.0;
   for (int k = 0; k < c.count; ++k) {
+    const double gain = bandLimitGain(std::fabs(c.frequencyX[k] * vx + c.frequencyY[k] * vy), step.framePeriodS);
+    if (gain == 0.0) continue;  // at or above the frames' Nyquist frequency: nothing left to compute
     const double wx = 2.0 * kPi * c.frequencyX[k], wy = 2.0 * kPi * c.frequencyY[k];
     // Mean of sin(w.p + phi) over the straight travel: sin(w.mid + phi) * sin(w.d / 2) / (w.d / 2).
     const double half = 0.5 * (wx * step.dx + wy * step.dy);
     const double sinc = std::fabs(half) < 1e-8 ? 1.0 : std::sin(half) / half;
-    const double gain = bandLimitGain(std::fabs(c.frequencyX[k] * vx + c.frequencyY[k] * vy), step.framePeriodS);
     total += gain * sinc * std::sin(wx * step.midX + wy * step.midY + c.phase[k]);
   }
   return clampLevel(0.5 + amplitude(c.count) * total);

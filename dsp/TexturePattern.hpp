@@ -73,7 +73,8 @@ class TexturePattern {
   Components current_{}, previous_{}, pending_{};
   bool hasPending_ = false;
   double sampleRateHz_ = 48000.0;
-  double lo_ = 0.5, hi_ = 2.0;
+  double lo_ = 0.5, hi_ = 3.0;            // before the first good values: FrictionPattern.texture's defaults
+  double drawnLo_ = 0.0, drawnHi_ = 0.0;  // the band current_ or pending_ was last drawn for
   uint64_t seed_ = 0;
   bool set_ = false;
   double fade_ = 1.0;      // weight of current_: 1 when no fade runs

@@ -331,10 +331,10 @@ TEST_CASE("texture2D: NaN and inf positions hold, bad parameters keep the last g
   const auto held = levels(bad, rate), want = levels(holding, rate);
   for (size_t i = 0; i < p.x.size(); ++i) REQUIRE(held[i] == want[i]);
   CHECK(held[2005] != clean[2005]);  // the hold is what is tested
-  // Bad band and seed from the start: band 0.5..2 cycles/mm and seed 0 (the defaults), here at rest.
+  // Bad band and seed from the start: band 0.5..3 cycles/mm and seed 0 (sclang's defaults), here at rest.
   const Path still = rest(1.7, -0.4, 100);
   const auto defaults = levels(still, rate, true, std::nan(""), -1, HUGE_VAL);
-  CHECK(defaults.back() == Approx(definition(wavesOf(0.5, 2, 0), 1.7f, -0.4f)).margin(kTol));
+  CHECK(defaults.back() == Approx(definition(wavesOf(0.5, 3, 0), 1.7f, -0.4f)).margin(kTol));
   // Far from the origin at rest: the definition at the float position. 2 pi * 3 cycles/mm * 3e8 mm
   // is 5.7e9 rad, whose double rounding (~5e-7 rad, each implementation its own) moves 32 waves by
   // 32 * a * 5e-7 = 7e-7: the tolerance is the float force's 1e-6 plus that.

@@ -42,3 +42,7 @@ def test_the_gallery_renders_every_pattern_with_its_figures():
         assert section in summary, f"no \"{section}\" in the summary"
     for name in ("texture2D-raster.csv", "texture2D-raster.png"):
         assert (OUT / name).is_file() and (OUT / name).stat().st_size > 0, f"{name} missing or empty"
+    # The raster's force against the definition recomputed from the rendered (x, y): float rounding
+    # of the force (0.5 N * 2^-24 = 3e-8 N) is all that may differ (measured 1.5e-8 N).
+    texture = re.search(r"largest deviation from the definition .*?: ([\d.e+-]+) N", summary)
+    assert texture and float(texture.group(1)) < 1e-6, f"texture2D raster deviation: {texture and texture.group(1)}"
