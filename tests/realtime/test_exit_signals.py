@@ -11,34 +11,59 @@ import signal
 
 import pytest
 
+from conftest import performer_jack
 from kfharness import paths, procs, readers, sclang
 
 FORCE_N = 1.4
 
 
-def run_and_signal(jack, signal_number, record):
-    """Boots scsynth, drives 1.4 N into device 0 while recording, sends the signal to scsynth
-    from sclang, and returns the sclang run once scsynth is gone."""
-    record.unlink(missing_ok=True)
+def signal_each_in_turn(jack, signal_numbers, records):
+    """One sclang run: for each signal in turn, boots scsynth (the run's first boot is the
+    harness's), drives 1.4 N into device 0 while recording to records[signal], sends the signal
+    to scsynth and waits until it is gone. Posts "KF-GONE <signal> <seconds waited> <pid>" for
+    each, or "KF-SIGNAL-ERROR <signal>" when its turn failed; either way the turn ends with the
+    server gone and no device held, so the next signal starts as on a fresh server: sclang's
+    FrictionDevice would otherwise open the old device again at the boot (prServerBoot)."""
+    for record in records.values():
+        record.unlink(missing_ok=True)
+    turns = ", ".join(f"[{int(n)}, {sclang.sc_string(records[n])}]" for n in signal_numbers)
     return sclang.run_with_server(f"""
-        var dev, synth, pid, waited = 0;
-        SynthDef(\\kfPush, {{ FrictionOut.ar(0, DC.ar({FORCE_N})) }}).add;
-        dev = FrictionDevice.sim(s, 0);
-        s.sync;
-        dev.record({sclang.sc_string(record)});
-        s.sync;
-        synth = Synth(\\kfPush);
-        s.sync;
-        0.6.wait;
-        pid = s.pid;
-        "KF-SIGNAL %".format(pid).postln;
-        ("kill -{signal_number} " ++ pid).unixCmd;
-        // Until the process is gone (kill -0 fails), at most 10 s.
-        while {{ waited < 10 and: {{ ("kill -0 " ++ pid ++ " 2>/dev/null").systemCmd == 0 }} }} {{
-            0.1.wait; waited = waited + 0.1;
+        var period = s.aliveThreadPeriod;
+        [{turns}].do {{ |turn, i|
+            var signal = turn[0], record = turn[1], dev, pid, waited = 0, seen = 0;
+            try {{
+                if(i > 0) {{
+                    // As the harness boots (sclang.py): polled every 0.05 s while booting.
+                    s.aliveThreadPeriod = 0.05;
+                    s.bootSync;
+                    s.aliveThreadPeriod = period;
+                }};
+                SynthDef(\\kfPush, {{ FrictionOut.ar(0, DC.ar({FORCE_N})) }}).add;
+                dev = FrictionDevice.sim(s, 0);
+                s.sync;
+                dev.record(record);
+                s.sync;
+                Synth(\\kfPush);
+                s.sync;
+                0.6.wait;
+                pid = s.pid;
+                ("kill -" ++ signal ++ " " ++ pid).unixCmd;
+                // Until the process is gone (kill -0 fails), at most 10 s.
+                while {{ waited < 10 and: {{ ("kill -0 " ++ pid ++ " 2>/dev/null").systemCmd == 0 }} }} {{
+                    0.1.wait; waited = waited + 0.1;
+                }};
+                "KF-GONE % % %".format(signal, waited, pid).postln;
+            }} {{ |error|
+                error.reportError;
+                "KF-SIGNAL-ERROR %".format(signal).postln;
+            }};
+            // The turn's server goes (SIGKILL if the signal did not end it) and sclang sees it
+            // go (Server.prOnServerProcessExit), then forgets its devices: nothing is sent.
+            s.pid !? {{ |left| if(("kill -0 " ++ left ++ " 2>/dev/null").systemCmd == 0) {{ ("kill -9 " ++ left).systemCmd }} }};
+            while {{ (s.pid.notNil or: {{ s.serverRunning }}) and: {{ seen < 10 }} }} {{ 0.05.wait; seen = seen + 0.05 }};
+            FrictionDevice.all.do(_.close);
         }};
-        "KF-GONE %".format(waited).postln;
-    """, jack, name=f"signal{signal_number}", timeout=90)
+    """, jack, name="signals", timeout=60 + 20 * len(signal_numbers))
 
 
 # Every signal whose default action ends the process (signal(7)); SIGXFSZ, which the plugin
@@ -50,25 +75,41 @@ SIGNALS = [signal.SIGTERM, signal.SIGINT, signal.SIGHUP, signal.SIGQUIT, signal.
            signal.SIGFPE, signal.SIGILL]
 
 
-@pytest.fixture
-def no_core_files():
-    """The crash signals' default action dumps core: not from these servers (the limit is inherited
-    by sclang and the scsynth it starts)."""
+# The handler hands these on to AddressSanitizer's, which reports them as a finding.
+CAUGHT_BY_ASAN = (signal.SIGSEGV, signal.SIGBUS, signal.SIGFPE)
+
+
+def sanitized():
+    return bool(os.environ.get("KF_SERVER_PRELOAD"))
+
+
+@pytest.fixture(scope="module")
+def signalled():
+    """Every signal's turn, in one sclang run (a server per signal, booted in turn), with core
+    files off: the crash signals' default action dumps core, not from these servers (the limit
+    is inherited by sclang and the scsynths it starts). Returns the run and the recordings."""
+    sent = [n for n in SIGNALS if not (sanitized() and n in CAUGHT_BY_ASAN)]
+    records = {n: paths.work_dir() / f"signal-{int(n)}.txt" for n in sent}
     previous = resource.getrlimit(resource.RLIMIT_CORE)
     resource.setrlimit(resource.RLIMIT_CORE, (0, previous[1]))
-    yield
-    resource.setrlimit(resource.RLIMIT_CORE, previous)
+    try:
+        with performer_jack() as jack:
+            return signal_each_in_turn(jack, sent, records), records
+    finally:
+        resource.setrlimit(resource.RLIMIT_CORE, previous)
 
 
 @pytest.mark.parametrize("signal_number", SIGNALS, ids=[s.name for s in SIGNALS])
-def test_a_signal_drives_the_magnet_off(jack, no_core_files, signal_number):
-    if os.environ.get("KF_SERVER_PRELOAD") and signal_number in (signal.SIGSEGV, signal.SIGBUS, signal.SIGFPE):
+def test_a_signal_drives_the_magnet_off(signalled, signal_number):
+    if sanitized() and signal_number in CAUGHT_BY_ASAN:
         pytest.skip("AddressSanitizer's handler, which ours hands the signal on to, reports it as a finding")
-    record = paths.work_dir() / f"signal-{int(signal_number)}.txt"
-    run = run_and_signal(jack, int(signal_number), record)
-    gone = run.lines("KF-GONE ")
-    assert gone and float(gone[0][0]) < 10, f"scsynth did not end on the signal:\n{run.output[-4000:]}"
-    assert run.scsynth_pid is None or procs.wait_pid_gone(run.scsynth_pid, 5)
+    run, records = signalled
+    record = records[signal_number]
+    assert [str(int(signal_number))] not in run.lines("KF-SIGNAL-ERROR "), f"its turn failed:\n{run.output[-4000:]}"
+    gone = [fields[1:] for fields in run.lines("KF-GONE ") if fields[0] == str(int(signal_number))]
+    assert gone, f"no turn for {signal_number.name} (the run ended before it):\n{run.output[-4000:]}"
+    assert float(gone[0][0]) < 10, f"scsynth did not end on the signal:\n{run.output[-4000:]}"
+    assert procs.wait_pid_gone(int(gone[0][1]), 5)
 
     header, records = readers.read_session(record)
     frames = [fields for tag, fields in records if tag == "F"]
