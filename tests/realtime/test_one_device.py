@@ -226,7 +226,7 @@ def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
     wav = paths.work_dir() / "zoom-index.wav"
     wav.unlink(missing_ok=True)
     run = sclang.require_ok(sclang.run_with_server(f"""
-        var dev, ramp, rec, syn, pos;
+        var dev, ramp, rec, syn, pos, recorded = Condition.new;
         dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 12]]));
         ramp = Buffer.loadCollection(s, (0..199999));
         rec = Buffer.alloc(s, 48000 * 2, 2);
@@ -237,9 +237,13 @@ def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
         s.sync;
         1.0.wait;
         syn = Synth(\\kfZoomIndex, [\\ramp, ramp, \\rec, rec]);
+        // The recording (2 s of audio) is over when the synth ends (doneAction); after 5 s
+        // whatever happens, and the check of what was recorded says what is missing.
+        syn.onFree {{ recorded.test = true; recorded.signal }};
         1.0.wait;
         syn.set(\\spm, 1000);          // from sclang, with no bundle: the server decides
-        3.0.wait;                       // the recording (2 s of audio) is over
+        AppClock.sched(5, {{ recorded.test = true; recorded.signal; nil }});
+        recorded.wait;
         rec.write({sclang.sc_string(wav)}, "wav", "float");
         s.sync;
         dev.positionBus;
