@@ -121,12 +121,14 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 	options.maxLogins = 4;
 	options.bindAddress = "127.0.0.1";
 %(options)s	KineticFriction.addPluginPath(options);
-	// Exits once the server has answered the quit (/done /quit), at once when it is not running,
-	// and after 0.5 s whatever happens (a server that does not answer).
+	// Quits the server if it runs, and exits once its process has ended (sclang has posted its
+	// exit code; checked every 0.02 s), or 0.5 s after at the latest.
 	finish = { |code|
-		var exit = { AppClock.sched(0, { code.exit; nil }) };
-		if(s.serverRunning) { s.quit(exit) } { exit.value };
-		AppClock.sched(0.5, { code.exit; nil });
+		var waited = 0;
+		if(s.serverRunning) { s.quit };
+		AppClock.sched(0, {
+			if(s.pid.isNil or: { waited >= 0.5 }) { code.exit; nil } { waited = waited + 0.02; 0.02 }
+		});
 	};
 	// A last resort: never leave sclang running (the harness also kills it by pid).
 	SystemClock.sched(%(timeout)f, { "KF-SCRIPT-TIMEOUT".postln; finish.(3); nil });
