@@ -139,6 +139,8 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 			// sclang sees the server up at its first status poll after scsynth is ready (0.22 s
 			// here): polled every 0.7 s (the default) the boot took 1.8 s, every 0.05 s 0.6 s
 			// (measured against jackd -d dummy). Only while booting: the scene runs as a user's.
+			// A poll answered before the login is may send a second /notify, which scsynth
+			// answers "already registered" (all is well, it says).
 			period = s.aliveThreadPeriod;
 			s.aliveThreadPeriod = 0.05;
 			s.bootSync;

@@ -1,6 +1,6 @@
 """The magnet goes off however scsynth leaves. A simulated device in realtime gets a
 constant 1.4 N (the maximum) from FrictionOut while kfRecord writes a kf-session file; then
-scsynth is stopped by a signal. Its handler (host/ExitSafety.cpp) must drive the force
+scsynth is stopped by a signal. Its handler (host/ExitSafetyPosix.cpp) must drive the force
 backend off and append the off record before the process ends: the recording ends with an
 `O` line after the 1.4 N frames. Without the handler the last commanded force stays 1.4 N.
 The crash signals are sent too (as a crashing server would raise them), with core files off.
