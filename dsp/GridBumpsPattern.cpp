@@ -22,8 +22,12 @@ GridBumpsPattern::Factors GridBumpsPattern::factors(const Axis& axis, double u0,
       [&](double f) { return b.climb(f, s); });
   const double heightBoxed = periodicMean(
       u0, u1, heightMean, [&](double f) { return b.heightTo(f); }, [&](double f) { return b.height(f); });
-  return {bandLimitedSeriesTo(kStop, climbBoxed, climbMean, b.climbHarmonics(s), u0, u1),
-          bandLimitedSeriesTo(kStop, heightBoxed, heightMean, b.heightHarmonics(), u0, u1)};
+  // Both in one pass: they share the travel, so the per-harmonic rotations, gains and sinc.
+  const auto [climb, height] = bandLimitedSeriesTo<2>(
+      kStop,
+      {PeriodicLevel{climbBoxed, climbMean, &b.climbHarmonics(s)}, {heightBoxed, heightMean, &b.heightHarmonics()}}, u0,
+      u1);
+  return {climb, height};
 }
 
 double GridBumpsPattern::level(const Travel& x, double y0, double y1, bool antialias) {

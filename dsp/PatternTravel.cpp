@@ -53,7 +53,17 @@ double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u
 }
 
 double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1) {
-  if (!(kStop < 2.0 * kMaxHarmonics)) return boxed;  // slow: the closed form, h = 1
+  return bandLimitedSeriesTo<1>(kStop, {PeriodicLevel{boxed, mean, &c}}, u0, u1)[0];
+}
+
+template <std::size_t N>
+std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<PeriodicLevel, N>& levels, double u0,
+                                          double u1) {
+  std::array<double, N> out;
+  if (!(kStop < 2.0 * kMaxHarmonics)) {  // slow: the closed form, h = 1
+    for (std::size_t i = 0; i < N; ++i) out[i] = levels[i].boxed;
+    return out;
+  }
   const double h = kStop <= kMaxHarmonics ? 0.0 : 0.5 * (1.0 - std::cos(kPi * (kStop - kMaxHarmonics) / kMaxHarmonics));
   const double kCut = std::min(kStop, static_cast<double>(kMaxHarmonics));
   // Rotations stepped once per harmonic: e^(i 2 pi k mid) and e^(i pi k length) (its sine over
@@ -62,16 +72,21 @@ double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmon
   const std::complex<double> stepMid = std::polar(1.0, 2.0 * kPi * fractionOf(mid));
   const std::complex<double> stepBox = std::polar(1.0, kPi * length);
   std::complex<double> atMid = stepMid, box = stepBox;
-  double series = mean;
+  std::array<double, N> series;
+  for (std::size_t i = 0; i < N; ++i) series[i] = levels[i].mean;
   for (int k = 1; k < kCut; ++k) {
     const double x = kPi * k * length;
     const double sinc = x < 1e-9 ? 1.0 : box.imag() / x;
-    series += splineGain(k / kCut) * 2.0 * (c[k - 1] * atMid).real() * sinc;
+    const double gain = splineGain(k / kCut) * 2.0;
+    for (std::size_t i = 0; i < N; ++i) series[i] += gain * ((*levels[i].harmonics)[k - 1] * atMid).real() * sinc;
     atMid *= stepMid;
     box *= stepBox;
   }
-  return h * boxed + (1.0 - h) * series;
+  for (std::size_t i = 0; i < N; ++i) out[i] = h * levels[i].boxed + (1.0 - h) * series[i];
+  return out;
 }
+template std::array<double, 1> bandLimitedSeriesTo<1>(double, const std::array<PeriodicLevel, 1>&, double, double);
+template std::array<double, 2> bandLimitedSeriesTo<2>(double, const std::array<PeriodicLevel, 2>&, double, double);
 
 void PeriodicCoordinate::setPeriod(double periodMm, double anchorMm) {
   if (!(periodMm > 0.0) || !std::isfinite(periodMm)) return;

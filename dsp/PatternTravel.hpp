@@ -126,6 +126,20 @@ double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u
 // frames' Nyquist frequency between its axes, GridBumpsPattern). kStop NaN or inf: boxed.
 double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1);
 
+// One periodic level as bandLimitedSeriesTo takes it: its mean over the travel (boxed), over a
+// period, and its harmonics.
+struct PeriodicLevel {
+  double boxed;
+  double mean;
+  const Harmonics* harmonics;
+};
+// N levels over the same travel at once, element i the single bandLimitedSeriesTo of levels[i]
+// (to the last bit): the per-harmonic rotations, spline gain and sinc, which depend only on the
+// travel and kStop, are computed once for all N (GridBumpsPattern: an axis's climb and height).
+template <std::size_t N>
+std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<PeriodicLevel, N>& levels, double u0,
+                                          double u1);
+
 inline double clampLevel(double g) { return g > 0.0 ? (g < 1.0 ? g : 1.0) : 0.0; }
 
 }  // namespace kf::patterns
