@@ -12,11 +12,16 @@
 #include <limits>
 #include <vector>
 
+#include "ForceFrameSpectrum.hpp"
 #include "FrictionPatternCore.hpp"
 
 using namespace kf::patterns;
 
 namespace {
+
+// The tests' alias measure, shared with bench/patterns_bench.cpp.
+using kf::spectrum::frames;
+using kf::spectrum::largestNonDcAmplitude;
 
 constexpr double kLoN = 0.14, kHiN = 0.5;
 
@@ -149,37 +154,11 @@ double worstDifference(const std::vector<double>& a, const std::vector<double>& 
 // double rounding of the cosines.
 constexpr double kTol = 1e-6;
 
-// 1 ms frame means of a force at 48 kHz (the device's force frames) from sample `from` on, and
-// the largest amplitude (N) of their spectrum away from DC (Hann window, amplitude-normalized).
-std::vector<double> frames(const std::vector<float>& f, size_t from) {
-  std::vector<double> out;
-  for (size_t i = from; i + 48 <= f.size(); i += 48) {
-    double s = 0;
-    for (size_t k = 0; k < 48; ++k) s += f[i + k];
-    out.push_back(s / 48);
-  }
-  return out;
-}
+// 1 ms frame means of a level's force (ForceFrameSpectrum.hpp's frames).
 std::vector<double> frames(const std::vector<double>& level, size_t from) {
   std::vector<float> f;
   for (double l : level) f.push_back(static_cast<float>(kLoN + (kHiN - kLoN) * l));
   return frames(f, from);
-}
-
-double largestNonDcAmplitude(const std::vector<double>& v) {
-  const size_t n = v.size();
-  double mean = 0;
-  for (double a : v) mean += a;
-  mean /= n;
-  double best = 0, wsum = 0;
-  for (size_t i = 0; i < n; ++i) wsum += 0.5 - 0.5 * std::cos(2 * kPi * i / n);
-  for (size_t k = 3; k < n / 2; ++k) {  // above the Hann window's main lobe at DC
-    std::complex<double> acc = 0;
-    for (size_t i = 0; i < n; ++i)
-      acc += (v[i] - mean) * (0.5 - 0.5 * std::cos(2 * kPi * i / n)) * std::polar(1.0, -2 * kPi * k * i / n);
-    best = std::max(best, 2 * std::abs(acc) / wsum);
-  }
-  return best;
 }
 
 }  // namespace

@@ -10,11 +10,17 @@
 #include <limits>
 #include <vector>
 
+#include "ForceFrameSpectrum.hpp"
 #include "FrictionPatternCore.hpp"
 
 using namespace kf::patterns;
 
 namespace {
+
+// 1 ms frame means of a force at 48 kHz (the device's force frames), and the largest amplitude
+// of their spectrum away from DC: shared with bench/patterns_bench.cpp.
+using kf::spectrum::frames;
+using kf::spectrum::largestNonDcAmplitude;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -80,34 +86,6 @@ FrictionPatternCore core(PatternKind kind, double sampleRate = 48000, bool antia
 }
 
 double level(float forceN) { return (forceN - kMinN) / (kMaxN - kMinN); }
-
-// 1 ms frame means of a force at 48 kHz (the device's force frames), and the largest amplitude
-// of their spectrum away from DC (Hann window, amplitude-normalized).
-std::vector<double> frames(const std::vector<float>& f, size_t from) {
-  std::vector<double> out;
-  for (size_t i = from; i + 48 <= f.size(); i += 48) {
-    double s = 0;
-    for (size_t k = 0; k < 48; ++k) s += f[i + k];
-    out.push_back(s / 48);
-  }
-  return out;
-}
-
-double largestNonDcAmplitude(const std::vector<double>& v) {
-  const size_t n = v.size();
-  double mean = 0;
-  for (double a : v) mean += a;
-  mean /= n;
-  double best = 0, wsum = 0;
-  for (size_t i = 0; i < n; ++i) wsum += 0.5 - 0.5 * std::cos(2 * kPi * i / n);
-  for (size_t k = 3; k < n / 2; ++k) {  // above the Hann window's main lobe at DC
-    std::complex<double> acc = 0;
-    for (size_t i = 0; i < n; ++i)
-      acc += (v[i] - mean) * (0.5 - 0.5 * std::cos(2 * kPi * i / n)) * std::polar(1.0, -2 * kPi * k * i / n);
-    best = std::max(best, 2 * std::abs(acc) / wsum);
-  }
-  return best;
-}
 
 }  // namespace
 
