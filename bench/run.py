@@ -9,7 +9,7 @@ must hold python/ (scripts/env.sh sets it).
     /usr/bin/python3 bench/run.py                 # everything (about 7 minutes on 2 cores, build excluded)
     /usr/bin/python3 bench/run.py --only timing   # one part (repeatable): build, log, timing, spatial,
                                                   # loudness, drift, reconstruction, report_rate, e2e,
-                                                  # rtload, scale
+                                                  # rtload, scale, drive, patterns
 
 Parts:
   log       bench/log_choice.cpp: the logarithm of equation (2), std::log10 against faster ones
@@ -34,6 +34,9 @@ Parts:
             normal priority under load, at 48 kHz / 64 and 256 and 192 kHz / 256 (20 s each)
   scale     realtime: voices of the pilot chain on one simulated device, added stepwise until
             scsynth misses periods, at 48 and 192 kHz
+  patterns  build/bench/kf_patterns_bench: every FrictionPattern kind at 5 and 300 mm/s over a
+            0.2 mm pattern, ns/sample with anti-aliasing on and off (and beside LoudnessToFriction),
+            and the largest alias in the 1 ms frames at 300 mm/s with it on and off
 """
 import argparse
 

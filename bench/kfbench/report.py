@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import drive_path, goals, realtime, report_rate, spatial, timing
+from . import drive_path, goals, patterns, realtime, report_rate, spatial, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -169,6 +169,13 @@ def drive_section(dr):
                   height_n=dr["heightN"], paths=paths, pulses=pulses)
 
 
+def patterns_section(pt, build_dir):
+    return render("patterns", cmd=CMD, exe=f"{build_dir}/bench/kf_patterns_bench", rounds=pt["rounds"],
+                  seconds=pt["seconds"], rate_khz=pt["sample_rate_hz"] // 1000, block=pt["block"],
+                  fine_mm=pt["fine_mm"], angle_deg=pt["angle_deg"], loudness_ns=pt["loudness_ns"],
+                  cost=patterns.cost_table(pt, table), alias=patterns.alias_table(pt, table))
+
+
 def e2e_section(e2e):
     runs = e2e["runs"]
     rows = [(i + 1, key, f"{r[key]['p50_ms']:.3f}", f"{r[key]['p99_ms']:.3f}", f"{r[key]['max_ms']:.3f}", r[key]["n"])
@@ -247,6 +254,7 @@ def write(results, path, build_dir="build"):
                       ("reconstruction", lambda: reconstruction_section(get("reconstruction"), build_dir)),
                       ("report_rate", lambda: report_rate_section(get("report_rate"), build_dir)),
                       ("drive", lambda: drive_section(get("drive"))),
+                      ("patterns", lambda: patterns_section(get("patterns"), build_dir)),
                       ("e2e", lambda: e2e_section(get("e2e"))),
                       ("rtload", lambda: rtload_section(get("rtload"))),
                       ("scale", lambda: scale_section(get("scale"))),

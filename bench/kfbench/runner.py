@@ -8,8 +8,8 @@ import time
 
 from kfharness import nrt
 
-from . import build, drift, drive_path, goals, loudness, native, plots, provenance, realtime, report, report_rate, rtload, scores, \
-    spatial, timing
+from . import build, drift, drive_path, goals, loudness, native, patterns, plots, provenance, realtime, report, report_rate, \
+    rtload, scores, spatial, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import summary_lines
 
@@ -107,6 +107,10 @@ def run_parts(bench, args, parts):
         log("drive: the audio drive's force path beside the board's frames (NRT)")
         results["drive"] = drive_path.run(bench)
         _print({"drive": results["drive"]})
+    if "patterns" in parts:
+        log("patterns: FrictionPattern's kinds, ns/sample with anti-aliasing on and off, and the alias it removes")
+        results["patterns"] = patterns.run(bench)
+        _print({"patterns": results["patterns"]})
     if "e2e" in parts:
         runs = []
         for i in range(args.e2e_runs):

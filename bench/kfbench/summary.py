@@ -3,7 +3,7 @@ over the repeated measurements of the run."""
 import numpy as np
 
 from .common import BLOCK, MAPPING, MAPPINGS, SR, fmt
-from . import drive_path, report_rate
+from . import drive_path, patterns, report_rate
 from .native import reconstruction_checks
 from .timing import READERS
 
@@ -70,6 +70,8 @@ def summary_lines(results):
             f"{m} {rc['cpu'][m]:.2f} [{min(v):.2f}..{max(v):.2f}]" for m, v in rc["cpu_runs"].items()))
     if results.get("drive"):
         lines += drive_path.summary_lines(results["drive"])
+    if results.get("patterns"):
+        lines += patterns.summary_lines(results["patterns"])
     rr = results.get("report_rate")
     if rr:
         lines += report_rate.summary_lines(rr)
