@@ -39,12 +39,6 @@ double bandLimitGain(double frequencyHz, double framePeriodS) {
   return 0.5 * (1.0 + std::cos(kPi * (frequencyHz - passHz) / (stopHz - passHz)));
 }
 
-double splineGain(double r) {
-  const double a = std::fabs(r);
-  if (a <= 0.5) return 1.0 - 6.0 * a * a + 6.0 * a * a * a;
-  return a < 1.0 ? 2.0 * (1.0 - a) * (1.0 - a) * (1.0 - a) : 0.0;
-}
-
 double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
                          double periodMm) {
   const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
@@ -78,7 +72,12 @@ std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<Periodi
     const double x = kPi * k * length;
     const double sinc = x < 1e-9 ? 1.0 : box.imag() / x;
     const double gain = splineGain(k / kCut) * 2.0;
-    for (std::size_t i = 0; i < N; ++i) series[i] += gain * ((*levels[i].harmonics)[k - 1] * atMid).real() * sinc;
+    for (std::size_t i = 0; i < N; ++i) {
+      // Re(C_k e^(i 2 pi k mid)) written out: the complex product's NaN/inf recovery (__muldc3) is
+      // not needed for the finite coefficients and rotations, and its check costs in this loop.
+      const std::complex<double> c = (*levels[i].harmonics)[k - 1];
+      series[i] += gain * (c.real() * atMid.real() - c.imag() * atMid.imag()) * sinc;
+    }
     atMid *= stepMid;
     box *= stepBox;
   }

@@ -110,7 +110,11 @@ using Harmonics = std::array<std::complex<double>, kMaxHarmonics>;
 // 1 - 6 r^2 + 6 |r|^3 up to |r| = 1/2, 2 (1 - |r|)^3 up to 1, 0 beyond. Its transform is sinc^4,
 // never negative: the series is the pattern smoothed by a kernel >= 0 of unit mass, so it stays
 // within the pattern's range (no ringing past 0 or 1), unlike a flat pass band.
-double splineGain(double r);
+inline double splineGain(double r) {  // inline: it runs once per harmonic in bandLimitedSeriesTo's loop
+  const double a = std::fabs(r);
+  if (a <= 0.5) return 1.0 - 6.0 * a * a + 6.0 * a * a * a;
+  return a < 1.0 ? 2.0 * (1.0 - a) * (1.0 - a) * (1.0 - a) : 0.0;
+}
 
 // The level of a periodic pattern over the travel [u0, u1] (cycles), band-limited to the 1 ms
 // frames. kStop = (frame rate / 2) / (speed / period): the first harmonic at the frames' Nyquist
