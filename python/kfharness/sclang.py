@@ -2,6 +2,7 @@
 to run code: `run_script` (plain sclang, e.g. to write Scores) and `run_with_server` (a realtime
 scsynth booted by sclang against a JACK server; see jack.py)."""
 import os
+import pathlib
 import random
 import re
 import subprocess
@@ -213,6 +214,9 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             for pid in sorted(known_children):
                 if not procs.wait_pid_gone(pid, 5.0):
                     procs.stop_pid(pid)
+            # A server that did not quit (a signal, a crash, killed here) leaves its shared memory
+            # behind, 8 MB a server; nothing uses it once the server is gone.
+            pathlib.Path(f"/dev/shm/SuperColliderServer_{port}").unlink(missing_ok=True)
     if os.environ.get("KF_RT_KEEP_LOGS"):
         print(f"sclang log: {log_path}")
     return SclangRun(output, proc.returncode if proc else None, scsynth_pid, log_path)
