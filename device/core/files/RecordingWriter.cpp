@@ -166,6 +166,13 @@ void RecordingWriter::writerLoop(int slot) {
 }
 
 bool RecordingWriter::writeOut(const std::string& data) {
+  struct UnderWay {
+    std::atomic<int>& count;
+    explicit UnderWay(std::atomic<int>& c) : count(c) { count.fetch_add(1); }
+    ~UnderWay() { count.fetch_sub(1); }
+  } underWay(writesUnderWay_);
+  // Sealed by a signal handler: its off record is the last line; the process is on its way out.
+  if (sealed_.load()) return false;
   const int fd = fd_.load(std::memory_order_acquire);
   if (fd < 0) return false;
   int code = 0;
@@ -178,6 +185,14 @@ bool RecordingWriter::writeOut(const std::string& data) {
   }
   bytesWritten_ += data.size();
   return true;
+}
+
+int RecordingWriter::sealFromSignal() {
+  sealed_.store(true);
+  const int64_t startNs = monotonicNanosecondsFromSignal();
+  while (writesUnderWay_.load() > 0 && monotonicNanosecondsFromSignal() - startNs < 50000000) {
+  }
+  return fileDescriptor();
 }
 
 void RecordingWriter::failWith(int code) {

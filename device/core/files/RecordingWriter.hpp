@@ -50,6 +50,10 @@ class RecordingWriter {
   std::string error() const;
   // For signal handlers (async-signal-safe): the file descriptor, -1 once closed.
   int fileDescriptor() const { return fd_.load(std::memory_order_acquire); }
+  // For signal handlers (async-signal-safe), before the off record: no write starts after this,
+  // and one under way is waited for, at most 50 ms (the handler may be running on the writing
+  // thread itself), so the off record is the file's last line. Returns fileDescriptor().
+  int sealFromSignal();
 
  private:
   RecordingWriter(int fd, std::string path, unsigned long long fileDevice, unsigned long long fileInode);
@@ -61,6 +65,10 @@ class RecordingWriter {
   int closeFile();
 
   std::atomic<int> fd_{-1};
+  // sealFromSignal() and the writes it waits for (sequentially consistent, so that a write sees
+  // the seal or the seal sees the write: never neither).
+  std::atomic<bool> sealed_{false};
+  std::atomic<int> writesUnderWay_{0};
   const std::string path_;
   const unsigned long long fileDevice_, fileInode_;  // the key of "one recording per file"
   uint64_t bytesWritten_ = 0;                        // by whoever writes: the caller or the writer

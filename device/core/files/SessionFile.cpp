@@ -164,8 +164,8 @@ std::string Recorder::error() const {
 }
 
 void Recorder::appendOffFromSignal(double hostTimeS) const {
-  const RecordingWriter* writer = signalWriter_.load(std::memory_order_acquire);
-  const int fd = writer ? writer->fileDescriptor() : -1;
+  RecordingWriter* writer = signalWriter_.load(std::memory_order_acquire);
+  const int fd = writer ? writer->sealFromSignal() : -1;
   if (fd < 0) return;
   // "\nO <seconds>.<nanoseconds>\n" by hand: snprintf is not async-signal-safe.
   char text[48];

@@ -81,8 +81,9 @@ class Recorder {
 
   // Async-signal-safe (no allocation, no stdio, no lock): appends an off record at hostTimeS
   // with write(2), for the signal handlers that drive the magnet off on the way out. A blank
-  // line first, so the record stands on its own line whatever a concurrent write left. Lines a
-  // threaded writer had not written yet (at most its 10 ms period's) are lost with the process.
+  // line first, so the record stands on its own line whatever a write cut short left. The file
+  // is sealed first (RecordingWriter::sealFromSignal): lines a threaded writer had not written
+  // yet (at most its 10 ms period's) are lost with the process, never written after the record.
   void appendOffFromSignal(double hostTimeS) const;
 
  private:
