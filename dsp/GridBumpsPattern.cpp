@@ -32,19 +32,24 @@ GridBumpsPattern::Factors GridBumpsPattern::factors(const Axis& axis, double u0,
 
 double GridBumpsPattern::level(const Travel& x, double y0, double y1, bool antialias) {
   const double dx = x.toMm - x.fromMm, dy = y1 - y0, travelMm = std::hypot(dx, dy);
-  if (!(travelMm >= kMinTravelMm)) return held_;
+  // The direction of the last travel, held while the puck is still (as 1D's Travel::direction):
+  // a creeping or reversing puck gets the rule at its point in that direction, not a held level.
+  if (travelMm > 0.0) {
+    ux_ = std::fabs(dx) / travelMm, uy_ = std::fabs(dy) / travelMm;
+    if (dx != 0.0) sx_ = dx > 0.0 ? 1 : -1;
+    if (dy != 0.0) sy_ = dy > 0.0 ? 1 : -1;
+  }
   // Each axis's share of the frames' Nyquist frequency (the header): 1 / 0 = inf on a still axis.
   const double rootX = std::sqrt(std::fabs(dx) / x.framePeriodS / x_.coordinate.periodMm());
   const double rootY = std::sqrt(std::fabs(dy) / x.framePeriodS / y_.coordinate.periodMm());
   const double nyquistHz = 0.5 / x.framePeriodS;
-  const Factors fx = factors(x_, x_.coordinate.cycles(x.fromMm), x_.coordinate.cycles(x.toMm), dx > 0.0 ? 1 : -1,
+  const Factors fx = factors(x_, x_.coordinate.cycles(x.fromMm), x_.coordinate.cycles(x.toMm), sx_,
                              nyquistHz / (rootX * (rootX + rootY)), antialias);
-  const Factors fy = factors(y_, y_.coordinate.cycles(y0), y_.coordinate.cycles(y1), dy > 0.0 ? 1 : -1,
+  const Factors fy = factors(y_, y_.coordinate.cycles(y0), y_.coordinate.cycles(y1), sy_,
                              nyquistHz / (rootY * (rootX + rootY)), antialias);
-  const double steepest = steepestSlope();
-  const double level = (std::fabs(dx) * (kPi / x_.widthMm) * fx.climb * fy.height +
-                        std::fabs(dy) * (kPi / y_.widthMm) * fx.height * fy.climb) /
-                       travelMm / steepest;
+  const double level =
+      (ux_ * (kPi / x_.widthMm) * fx.climb * fy.height + uy_ * (kPi / y_.widthMm) * fx.height * fy.climb) /
+      steepestSlope();
   if (!std::isfinite(level)) return held_;
   return held_ = clampLevel(level);
 }

@@ -16,14 +16,14 @@
 // axis's part of u . grad h alone.
 //
 // Rendered (anti-aliased) as each one-axis factor's mean over that axis's travel in the frame
-// (the rule's mean over the box the travel spans in x and y; along an axis the factor is then
-// exactly the 1D bumps' level, whose box also damps the harmonics past the band in the blend
-// region below), band-limited per harmonic. Both factors on an axis get the same filter (box,
-// spline gains, blend: a kernel >= 0 of unit mass), so the level is the rule smoothed by a
-// kernel >= 0 and stays within [0, 1] with no clamp at work (no clipping to alias). The band:
-// component (m, n) of the product has temporal frequency |m vx / Sx + n vy / Sy| <= |m| fx + |n| fy
-// (fx = |vx| / Sx, fy = |vy| / Sy, Hz), so each axis gets its own first harmonic not kept, Kx and
-// Ky with Kx fx + Ky fy = the frames' Nyquist frequency (500 Hz at 1 ms), shared as
+// (the rule's mean over the box the travel spans in x and y; along an axis the climb factor is then
+// exactly the 1D bumps' level, so the level is theirs times b across it times min(wx, wy) / wx,
+// which is 1 unless the width clamps to one spacing only), band-limited per harmonic. Both factors on an axis get the
+// same filter (box, spline gains, blend: a kernel >= 0 of unit mass), so the level is the rule smoothed by a kernel >=
+// 0 and stays within [0, 1] with no clamp at work (no clipping to alias). The band: component (m, n) of the product has
+// temporal frequency |m vx / Sx + n vy / Sy| <= |m| fx + |n| fy (fx = |vx| / Sx, fy = |vy| / Sy, Hz), so each axis gets
+// its own first harmonic not kept, Kx and Ky with Kx fx + Ky fy = the frames' Nyquist frequency (500 Hz at 1 ms),
+// shared as
 //   Kx = N / (sqrt(fx) (sqrt(fx) + sqrt(fy))),  Ky = N / (sqrt(fy) (sqrt(fx) + sqrt(fy)))
 // (Kx -> inf continuously as fx -> 0: along y the x factors are not filtered at all, and along x
 // Kx = N / fx, the 1D bumps' own). Each one-axis factor is bandLimitedSeriesTo(K of its axis):
@@ -32,7 +32,9 @@
 // axis's harmonics past kMaxHarmonics (box-weighted, sinc <= 1 / (pi k L)); from 2 kMaxHarmonics
 // on, the boxed closed form (the full rendering).
 // Raw (antialias off): the rule at the current position, in the frame's direction per axis.
-// Held while the travel is below kMinTravelMm (the puck at rest keeps its force).
+// The direction (ux, uy and each axis's sign) is the last travel's, held while the puck is still
+// (as 1D's): a creeping or reversing puck is the rule at its point, with no division by a tiny
+// travel (periodicMean's short-travel case).
 #pragma once
 
 #include "RaisedCosineBump.hpp"
@@ -41,8 +43,6 @@ namespace kf::patterns {
 
 class GridBumpsPattern {
  public:
-  static constexpr double kMinTravelMm = 1e-4;  // 0.1 mm/s over a 1 ms frame, as SlopeOfHeight
-
   // Spacings or width not finite and > 0 keep the last good one; the width is clamped to each
   // spacing. A change of spacing keeps the phase at (anchorXMm, anchorYMm).
   void set(double spacingXMm, double spacingYMm, double widthMm, double anchorXMm, double anchorYMm);
@@ -66,7 +66,9 @@ class GridBumpsPattern {
 
   Axis x_, y_;
   double widthMm_ = 0.5;
-  double held_ = 0.0;
+  double ux_ = 0.0, uy_ = 0.0;  // |direction| of the last travel: none before any (level 0)
+  int sx_ = 1, sy_ = 1;         // each axis's last direction of motion
+  double held_ = 0.0;           // the last finite level (a non-finite one holds it)
 };
 
 }  // namespace kf::patterns

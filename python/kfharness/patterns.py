@@ -260,16 +260,28 @@ def slope(x, height, rate, full_slope):
     return out
 
 
+def _held(values, valid, before):
+    """values where valid, else the last valid one (before: before the first)."""
+    idx = np.where(valid, np.arange(len(values)), -1)
+    np.maximum.accumulate(idx, out=idx)
+    return np.where(idx >= 0, values[np.maximum(idx, 0)], before)
+
+
 def bumps2d(x, y, rate, spacing_x, spacing_y, width, antialias=True):
     """GridBumpsPattern.hpp: the 2D grid of bumps h = b(x) b(y), the climb counted per axis,
-    (|dx| (pi / wx) c(x) b(y) + |dy| b(x) (pi / wy) c(y)) / travel / (pi / min(wx, wy)), each one-axis
+    (|ux| (pi / wx) c(x) b(y) + |uy| b(x) (pi / wy) c(y)) / (pi / min(wx, wy)), each one-axis
     factor its mean over that axis's travel, band-limited to its share of the frames' Nyquist
-    frequency (Kx fx + Ky fy = 500 Hz); raw: the rule at the point; held below 1e-4 mm of travel."""
+    frequency (Kx fx + Ky fy = 500 Hz); raw: the rule at the point. The direction (ux, uy and each
+    axis's sign) is the last travel's, held while still (none before the first: 0)."""
     spacing_x, spacing_y, width = _f32(spacing_x, spacing_y, width)
     x0, x1, _, _, t = travel(x, rate)
     y0, y1, _, _, _ = travel(y, rate)
     dx, dy = x1 - x0, y1 - y0
     moved = np.hypot(dx, dy)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ux = _held(np.abs(dx) / moved, moved > 0, 0.0)
+        uy = _held(np.abs(dy) / moved, moved > 0, 0.0)
+    sx, sy = _held(np.sign(dx), dx != 0, 1.0), _held(np.sign(dy), dy != 0, 1.0)
     rx, ry = np.sqrt(np.abs(dx) / t / spacing_x), np.sqrt(np.abs(dy) / t / spacing_y)
 
     def axis(u0, u1, omega, s, k_stop):
@@ -304,13 +316,13 @@ def bumps2d(x, y, rate, spacing_x, spacing_y, width, antialias=True):
     wx, wy = ox * spacing_x, oy * spacing_y
     with np.errstate(divide="ignore", invalid="ignore"):
         nyquist = 0.5 / t
-        cx, bx = axis(x0 / spacing_x, x1 / spacing_x, ox, np.where(dx > 0, 1.0, -1.0), nyquist / (rx * (rx + ry)))
-        cy, by = axis(y0 / spacing_y, y1 / spacing_y, oy, np.where(dy > 0, 1.0, -1.0), nyquist / (ry * (rx + ry)))
-        g = (np.abs(dx) * np.pi / wx * cx * by + np.abs(dy) * np.pi / wy * bx * cy) / moved / (np.pi / min(wx, wy))
+        cx, bx = axis(x0 / spacing_x, x1 / spacing_x, ox, sx, nyquist / (rx * (rx + ry)))
+        cy, by = axis(y0 / spacing_y, y1 / spacing_y, oy, sy, nyquist / (ry * (rx + ry)))
+        g = (ux * np.pi / wx * cx * by + uy * np.pi / wy * bx * cy) / (np.pi / min(wx, wy))
     g = np.clip(g, 0.0, 1.0)
     out, held = np.empty(len(g)), 0.0
     for i in range(len(g)):
-        if moved[i] >= 1e-4 and np.isfinite(g[i]):
+        if np.isfinite(g[i]):
             held = g[i]
         out[i] = held
     return out

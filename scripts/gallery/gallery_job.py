@@ -140,7 +140,7 @@ def folded_harmonics(rate, seconds=1.0):
 # x, y). Along an axis on the bumps' centre line across it (b = 1), and at 30 degrees.
 GRID_PATHS = [("along x", "Sweep.ar(0, 300) + 0.013", "DC.ar(0.05)"),
               ("along y", "DC.ar(0.05)", "Sweep.ar(0, 300) + 0.013"),
-              ("at 30 degrees", f"Sweep.ar(0, {300 * np.cos(np.pi / 6)!r}) + 0.013", "Sweep.ar(0, 150) + 0.031")]
+              ("at 30 degrees", f"Sweep.ar(0, {float(300 * np.cos(np.pi / 6))!r}) + 0.013", "Sweep.ar(0, 150) + 0.031")]
 
 
 def grid_aliases(rate, seconds=0.3):

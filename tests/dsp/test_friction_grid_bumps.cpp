@@ -2,7 +2,8 @@
 // h(x, y) = b(x) b(y), b a raised-cosine bump of width w from 0 in every spacing; the climb
 // counted per axis, level = (|ux| (pi / wx) c_x(x) b(y) + |uy| b(x) (pi / wy) c_y(y)) / (pi / w)
 // (c: the one-axis bump's climb in the sign of that velocity component, over its steepest slope).
-// Slow, the level is each factor's mean over its axis's travel in the frame; held below 1e-4 mm.
+// Slow, the level is each factor's mean over its axis's travel in the frame; with no travel, the
+// rule at the point in the last direction.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -118,6 +119,21 @@ std::vector<float> forces(const Path& p, double rate, bool antialias, const Grid
   return force;
 }
 
+// The 1D bumps' level (spacing, width mm) along positions x.
+std::vector<double> levels1D(const std::vector<float>& x, double rate, double spacing, double width, bool antialias) {
+  FrictionPatternCore bumps(PatternKind::Bumps, rate);
+  bumps.setForceRange({kLoN, kHiN});
+  bumps.setAntialias(antialias);
+  std::vector<float> f(x.size());
+  for (size_t i = 0; i < f.size(); i += 64) {
+    bumps.setParameters(spacing, width, 0, x[i]);
+    bumps.process(x.data() + i, 1, nullptr, 1, f.data() + i, int(std::min<size_t>(64, f.size() - i)));
+  }
+  std::vector<double> out;
+  for (float v : f) out.push_back((v - kLoN) / (kHiN - kLoN));
+  return out;
+}
+
 std::vector<double> levels(const Path& p, double rate, bool antialias = true, const Grid& g = Grid{}) {
   std::vector<double> out;
   for (float f : forces(p, rate, antialias, g)) out.push_back((f - kLoN) / (kHiN - kLoN));
@@ -125,23 +141,31 @@ std::vector<double> levels(const Path& p, double rate, bool antialias = true, co
 }
 
 // A definition per sample over the frame's travel (from one frame ago, the first position
-// before the start), held below 1e-4 mm of travel.
+// before the start); with no travel, the rule at the point in the last direction (none at first: 0).
 template <class Rule>
-std::vector<double> perFrame(const Path& p, double rate, Rule rule) {
+std::vector<double> perFrame(const Path& p, double rate, Rule rule, const Grid& g = Grid{}) {
   const size_t n = static_cast<size_t>(std::lround(rate * 1e-3));
   std::vector<double> out;
-  double held = 0;
+  double ux = 0, uy = 0;
+  int sx = 1, sy = 1;
   for (size_t i = 0; i < p.x.size(); ++i) {
     const size_t j = i >= n ? i - n : 0;
-    if (std::hypot(double(p.x[i]) - p.x[j], double(p.y[i]) - p.y[j]) >= 1e-4)
-      held = rule(double(p.x[j]), double(p.y[j]), double(p.x[i]), double(p.y[i]));
-    out.push_back(held);
+    const double dx = double(p.x[i]) - p.x[j], dy = double(p.y[i]) - p.y[j], d = std::hypot(dx, dy);
+    if (d > 0) {
+      out.push_back(rule(double(p.x[j]), double(p.y[j]), double(p.x[i]), double(p.y[i])));
+      ux = dx / d, uy = dy / d;
+      if (dx != 0) sx = dx > 0 ? 1 : -1;
+      if (dy != 0) sy = dy > 0 ? 1 : -1;
+    } else {
+      out.push_back(pointRule(g, p.x[i], p.y[i], ux, uy, sx, sy));
+    }
   }
   return out;
 }
 
 std::vector<double> slowDefinition(const Path& p, double rate, const Grid& g = Grid{}) {
-  return perFrame(p, rate, [&](double x0, double y0, double x1, double y1) { return boxRule(g, x0, y0, x1, y1); });
+  return perFrame(
+      p, rate, [&](double x0, double y0, double x1, double y1) { return boxRule(g, x0, y0, x1, y1); }, g);
 }
 
 double worstDifference(const std::vector<double>& a, const std::vector<double>& b, size_t from = 0) {
@@ -164,7 +188,7 @@ std::vector<double> frames(const std::vector<double>& level, size_t from) {
 }  // namespace
 
 TEST_CASE("bumps2D: slow lines at angles, out and back, are the rule's mean over the travel, 44.1 to 192 kHz") {
-  // 5 mm/s over 4 x 3 mm: every axis's first harmonic not kept is >= 227 (past 2 * 64 harmonics,
+  // 5 mm/s over 4 x 3 mm: every axis's first harmonic not kept is >= 208 (Ky at 2.0 rad; past 2 * 64 harmonics,
   // GridBumpsPattern.hpp), so the level is the closed form: each factor's mean over its travel.
   for (double rate : {44100.0, 48000.0, 96000.0, 192000.0}) {
     for (double angle : {0.0, kPi / 2, kPi / 6, kPi / 4, 2.0, -2.5, kPi}) {
@@ -211,11 +235,14 @@ TEST_CASE(
   const auto [worst, directional, above] = check(p);
   CHECK(worst < kTol);
   CHECK(above > 0.1);  // counts the x climb the directional slope nets against y's descent
-  // The rule never passes 1 (GridBumpsPattern.hpp), so its clamp never bites: on a 200 x 200
-  // grid of one cell, 24 directions, widths equal and not (the width clamped to a 1 mm spacing).
+  // The rule never passes 1 (GridBumpsPattern.hpp), so the code's clamp never bites: its raw level
+  // on a 200 x 200 grid of one cell, 24 directions, widths equal and not (the width clamped to a
+  // 1 mm spacing), is the rule written here, unclamped, and its top is in (0.99, 1].
   for (const Grid& grid : {Grid{}, Grid{1, 3, 2}}) {
+    GridBumpsPattern pattern;
+    pattern.set(grid.sx, grid.sy, grid.w, 0, 0);
     const double wx = std::min(grid.w, grid.sx), wy = std::min(grid.w, grid.sy), wMin = std::min(wx, wy);
-    double top = 0;
+    double top = 0, worstRule = 0;
     for (int a = 0; a < 24; ++a) {
       const double ux = std::cos(2 * kPi * a / 24), uy = std::sin(2 * kPi * a / 24);
       for (int i = 0; i < 200; ++i)
@@ -223,10 +250,17 @@ TEST_CASE(
           const double x = wx * i / 200, y = wy * j / 200, ox = wx / grid.sx, oy = wy / grid.sy;
           const double cx = std::max(0.0, (ux > 0 ? 1 : -1) * std::sin(2 * kPi * x / wx));
           const double cy = std::max(0.0, (uy > 0 ? 1 : -1) * std::sin(2 * kPi * y / wy));
-          top = std::max(top, (std::fabs(ux) * cx * bumpAt(y / grid.sy, oy) * wMin / wx +
-                               std::fabs(uy) * bumpAt(x / grid.sx, ox) * cy * wMin / wy));
+          const double rule = std::fabs(ux) * cx * bumpAt(y / grid.sy, oy) * wMin / wx +
+                              std::fabs(uy) * bumpAt(x / grid.sx, ox) * cy * wMin / wy;
+          // A frame's travel of 0.01 mm ending at (x, y) along (ux, uy): 10 mm/s.
+          const double got =
+              pattern.level(Travel{x - 0.01 * ux, x, ux > 0 ? 1 : -1, 10, 1e-3}, y - 0.01 * uy, y, false);
+          worstRule = std::max(worstRule, std::fabs(got - rule));
+          top = std::max(top, got);
         }
     }
+    INFO("spacings " << grid.sx << " x " << grid.sy << ": top " << top << ", worst against the rule " << worstRule);
+    CHECK(worstRule < kTol);
     CHECK(top <= 1.0);
     CHECK(top > 0.99);
   }
@@ -256,7 +290,8 @@ TEST_CASE("bumps2D: along an axis the level is the 1D bumps' times the other axi
         const double b = bumpAt(across / (alongX ? 3 : 4), 2 / (alongX ? 3.0 : 4.0));
         const auto got = levels(p, rate);
         double worst = 0, top = 0;
-        for (size_t i = 0; i < got.size(); ++i) {
+        // From the first travel on (before it bumps2D has no direction, 1D's is +1).
+        for (size_t i = 1; i < got.size(); ++i) {
           worst = std::max(worst, std::fabs(got[i] - (f1[i] - kLoN) / (kHiN - kLoN) * b));
           top = std::max(top, got[i]);
         }
@@ -264,6 +299,47 @@ TEST_CASE("bumps2D: along an axis the level is the 1D bumps' times the other axi
         CHECK(worst < kTol);
         CHECK(top > 0.05);
       }
+    }
+  }
+  // A width clamped on one axis only: 4 x 1 mm, width 2 (wy = 1 mm). Along x on the bumps' centre
+  // line in y (b = 1) the level is the 1D bumps' (4 mm, width 2) times min(wx, wy) / wx = 1/2.
+  for (double speed : {5.0, 60.0}) {
+    const Path axis = line(-1, 0, 0, speed, std::min(0.3, 8 / speed), rate);
+    Path p{axis.x, std::vector<float>(axis.x.size(), 0.5f)};
+    const auto got = levels(p, rate, true, Grid{4, 1, 2}), bumps = levels1D(axis.x, rate, 4, 2, true);
+    double worst = 0;
+    for (size_t i = 1; i < got.size(); ++i) worst = std::max(worst, std::fabs(got[i] - 0.5 * bumps[i]));
+    INFO(speed << " mm/s along x on a 4 x 1 mm grid: worst " << worst);
+    CHECK(worst < kTol);
+    CHECK(*std::max_element(bumps.begin(), bumps.end()) > 0.9);
+  }
+}
+
+TEST_CASE("bumps2D: creeping and reversing on a flank, the 1D bumps times the bump across") {
+  // Below 0.1 mm/s (1e-4 mm a frame) the level was held: a puck creeping up a flank at 0.05 mm/s
+  // kept 0 (the 1D bumps climb 0.59 -> 0.81 of the way), and one reversing there stepped. Now the
+  // direction is held, not the level: the rule at the point, as 1D. Along x at y = 1.3 mm.
+  const double rate = 48000, across = 1.3, b = bumpAt(across / 3, 2 / 3.0);
+  const int n = 96000;
+  Path creep, reverse;
+  for (int i = 0; i < n; ++i) {
+    creep.x.push_back(static_cast<float>(0.2 + 0.05 * i / rate));  // 0.05 mm/s for 2 s
+    // 0.6 + 0.5 sin(pi t): turns at 1.1 mm (descending flank) and 0.1 mm (climbing flank).
+    reverse.x.push_back(static_cast<float>(0.6 + 0.5 * std::sin(kPi * i / rate)));
+  }
+  for (Path* p : {&creep, &reverse}) p->y.assign(n, static_cast<float>(across));
+  for (bool antialias : {true, false}) {
+    for (const Path* p : {&creep, &reverse}) {
+      const auto got = levels(*p, rate, antialias), bumps = levels1D(p->x, rate, 4, 2, antialias);
+      double worst = 0, lo = 1, hi = 0;
+      for (size_t i = 1; i < got.size(); ++i) {  // from the first travel on
+        worst = std::max(worst, std::fabs(got[i] - b * bumps[i]));
+        lo = std::min(lo, got[i]), hi = std::max(hi, got[i]);
+      }
+      INFO((p == &creep ? "creeping" : "reversing")
+           << (antialias ? "" : ", raw") << ": worst " << worst << ", level " << lo << " to " << hi);
+      CHECK(worst < kTol);
+      CHECK(hi - lo > 0.2 * b);  // it moves over the flank
     }
   }
 }
