@@ -12,6 +12,7 @@ void DetentPattern::set(double spacingMm, double crest, double anchorMm) {
     const std::complex<double> e = std::polar(1.0, -a * c);
     harmonics_[k - 1] = std::complex<double>(0.0, 1.0) * e / a + (e - 1.0) / (a * a * c);
   }
+  sharp_ = std::max(1.0 / (kPi * c), patterns::sharpHarmonic(1.0 / kPi, 1.0));
   harmonicsCrest_ = crest_;
 }
 
@@ -26,7 +27,7 @@ double DetentPattern::level(const Travel& travel, bool antialias) const {
   const double boxed = periodicMean(
       u0, u1, 0.5 * crest_, [this](double g) { return integralAlongMotion(g); },
       [this](double g) { return alongMotion(g); });
-  return bandLimitedSeries(boxed, mean(), harmonics_, u0, u1, travel, coordinate_.periodMm());
+  return bandLimitedSeries(boxed, mean(), harmonics_, u0, u1, travel, coordinate_.periodMm(), sharp_);
 }
 
 }  // namespace kf::patterns

@@ -7,7 +7,9 @@
 //   level(u') = u' / c on [0, c),  0 on [c, 1)
 // Rendered as its mean over the frame's travel (closed form), band-limited to the speed. Its
 // harmonics in u' (a = 2 pi k): C_k = (1/c) integral of u' e^(-i a u') over [0, c)
-//   = i e^(-i a c) / a + (e^(-i a c) - 1) / (a^2 c).
+//   = i e^(-i a c) / a + (e^(-i a c) - 1) / (a^2 c),
+// so |C_k| <= 1 / (2 pi k) + 1 / (2 pi^2 c k^2) <= 1 / (pi k) from k = 1 / (pi c) on (the drop at the
+// crest: as sharp as a hard edge; PatternTravel.hpp's sharpHarmonic).
 #pragma once
 
 #include "PatternTravel.hpp"
@@ -23,6 +25,7 @@ class DetentPattern {
   // The definition at cycle fraction f (measured along +1) moving in direction (+1, -1).
   double at(double f, int direction) const;
   double mean() const { return 0.5 * crest_; }
+  double sharpHarmonic() const { return sharp_; }  // PatternTravel.hpp's kSharp
 
  private:
   // In the direction's own cycles u' (increasing along the motion): level and its integral.
@@ -32,6 +35,7 @@ class DetentPattern {
   double crest_ = 0.5;
   Harmonics harmonics_{};
   double harmonicsCrest_ = -1.0;
+  double sharp_ = 0.0;  // sharpHarmonic of harmonics_
 };
 
 }  // namespace kf::patterns

@@ -14,6 +14,9 @@ void GratingPattern::set(double periodMm, double duty, double edgeMm, double anc
     // (libc++ returns NaN for it).
     harmonics_[k - 1] = std::sin(kPi * k * duty_) / (kPi * k) * sincEdge * std::polar(1.0, -kPi * k * (duty_ + edge_));
   }
+  const bool flat = duty_ == 0.0 || duty_ == 1.0;
+  const double hard = patterns::sharpHarmonic(1.0 / kPi, 1.0);
+  sharp_ = flat ? 0.0 : (edge_ > 0.0 ? std::min(hard, patterns::sharpHarmonic(1.0 / (kPi * kPi * edge_), 2.0)) : hard);
   harmonicsDuty_ = duty_;
   harmonicsEdge_ = edge_;
 }
@@ -43,7 +46,7 @@ double GratingPattern::level(const Travel& travel, bool antialias) const {
   const double u0 = coordinate_.cycles(travel.fromMm);
   const double boxed = periodicMean(
       u0, u1, duty_, [this](double f) { return integralTo(f); }, [this](double f) { return at(f); });
-  return bandLimitedSeries(boxed, duty_, harmonics_, u0, u1, travel, coordinate_.periodMm());
+  return bandLimitedSeries(boxed, duty_, harmonics_, u0, u1, travel, coordinate_.periodMm(), sharp_);
 }
 
 }  // namespace kf::patterns

@@ -5,7 +5,9 @@
 // with e (as a fraction of the period) at most min(d, 1 - d). Rendered as its mean over the
 // frame's travel (closed form), band-limited to the speed (PatternTravel.hpp). Its harmonics: a
 // square wave of width d centred on (d + e) / 2, convolved with a box of width e:
-//   C_k = e^(-i pi k (d + e)) sin(pi k d) / (pi k) sinc(pi k e).
+//   C_k = e^(-i pi k (d + e)) sin(pi k d) / (pi k) sinc(pi k e),
+// so |C_k| <= 1 / (pi k) (a hard edge) and <= 1 / (pi^2 e k^2); 0 for a duty of 0 or 1 (its
+// sharpness, PatternTravel.hpp's sharpHarmonic: the smaller of the two bounds' kSharp).
 #pragma once
 
 #include "PatternTravel.hpp"
@@ -23,6 +25,7 @@ class GratingPattern {
   double at(double f) const;
   double integralTo(double f) const;
   double mean() const { return duty_; }
+  double sharpHarmonic() const { return sharp_; }  // PatternTravel.hpp's kSharp
 
  private:
   PeriodicCoordinate coordinate_;
@@ -30,6 +33,7 @@ class GratingPattern {
   double edge_ = 0.0;  // in periods
   double edgeMm_ = 0.0;
   Harmonics harmonics_{};
+  double sharp_ = 0.0;                                  // sharpHarmonic of harmonics_
   double harmonicsDuty_ = -1.0, harmonicsEdge_ = -1.0;  // what harmonics_ were computed for
 };
 

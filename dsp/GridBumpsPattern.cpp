@@ -24,7 +24,7 @@ GridBumpsPattern::Factors GridBumpsPattern::factors(const Axis& axis, double u0,
       u0, u1, heightMean, [&](double f) { return b.heightTo(f); }, [&](double f) { return b.height(f); });
   // Both in one pass: they share the travel, so the per-harmonic rotations, gains and sinc.
   const auto [climb, height] = bandLimitedSeriesTo<2>(
-      kStop,
+      kStop, b.sharpHarmonic(),
       {PeriodicLevel{climbBoxed, climbMean, &b.climbHarmonics(s)}, {heightBoxed, heightMean, &b.heightHarmonics()}}, u0,
       u1);
   return {climb, height};

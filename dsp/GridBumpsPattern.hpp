@@ -26,11 +26,11 @@
 // shared as
 //   Kx = N / (sqrt(fx) (sqrt(fx) + sqrt(fy))),  Ky = N / (sqrt(fy) (sqrt(fx) + sqrt(fy)))
 // (Kx -> inf continuously as fx -> 0: along y the x factors are not filtered at all, and along x
-// Kx = N / fx, the 1D bumps' own). Each one-axis factor is bandLimitedSeriesTo(K of its axis):
-// every kept component is below the Nyquist frequency. Left, as in 1D (PatternTravel.hpp): where
-// an axis's K is between kMaxHarmonics and twice it, the boxed factor with weight h keeps that
-// axis's harmonics past kMaxHarmonics (box-weighted, sinc <= 1 / (pi k L)); from 2 kMaxHarmonics
-// on, the boxed closed form (the full rendering).
+// Kx = N / fx, the 1D bumps' own). Each one-axis factor is bandLimitedSeriesTo(K of its axis,
+// the bump's kSharp): below K = kFull = max(kMaxHarmonics, kSharp) every component it keeps is
+// below the Nyquist frequency (cut at kMaxHarmonics past it: smoother than the bump); from kFull
+// on (the blend, then the closed form, PatternTravel.hpp) the box's harmonics past K are left, each
+// folding below kNegligibleFold.
 // Raw (antialias off): the rule at the current position, in the frame's direction per axis.
 // The direction (ux, uy and each axis's sign) is the last travel's, held while the puck is still
 // (as 1D's): a creeping or reversing puck is the rule at its point, with no division by a tiny

@@ -20,7 +20,8 @@ double BumpPattern::level(const Travel& travel, bool antialias) const {
   const double boxed = periodicMean(
       u0, u1, scale, [&](double f) { return scale * bump_.climbTo(f, direction); },
       [&](double f) { return bump_.climb(f, direction); });
-  return bandLimitedSeries(boxed, scale, bump_.climbHarmonics(direction), u0, u1, travel, coordinate_.periodMm());
+  return bandLimitedSeries(boxed, scale, bump_.climbHarmonics(direction), u0, u1, travel, coordinate_.periodMm(),
+                           bump_.sharpHarmonic());
 }
 
 void SlopeOfHeight::setFullSlope(double fullSlope) {

@@ -39,26 +39,35 @@ double bandLimitGain(double frequencyHz, double framePeriodS) {
   return 0.5 * (1.0 + std::cos(kPi * (frequencyHz - passHz) / (stopHz - passHz)));
 }
 
-double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
-                         double periodMm) {
-  const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
-  if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
-  return bandLimitedSeriesTo(0.5 / travel.framePeriodS / f1, boxed, mean, c, u0, u1);
+double sharpHarmonic(double amplitude, double power) {
+  const double level = 0.25 * kPi * kNegligibleFold;  // |C_k| at which (4 / pi) |C_k| is the level
+  if (!(amplitude > level)) return 0.0;
+  return std::pow(amplitude / level, 1.0 / power);
 }
 
-double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1) {
-  return bandLimitedSeriesTo<1>(kStop, {PeriodicLevel{boxed, mean, &c}}, u0, u1)[0];
+double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
+                         double periodMm, double kSharp) {
+  const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
+  if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
+  return bandLimitedSeriesTo(0.5 / travel.framePeriodS / f1, kSharp, boxed, mean, c, u0, u1);
+}
+
+double bandLimitedSeriesTo(double kStop, double kSharp, double boxed, double mean, const Harmonics& c, double u0,
+                           double u1) {
+  return bandLimitedSeriesTo<1>(kStop, kSharp, {PeriodicLevel{boxed, mean, &c}}, u0, u1)[0];
 }
 
 template <std::size_t N>
-std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<PeriodicLevel, N>& levels, double u0,
-                                          double u1) {
+std::array<double, N> bandLimitedSeriesTo(double kStop, double kSharp, const std::array<PeriodicLevel, N>& levels,
+                                          double u0, double u1) {
   std::array<double, N> out;
-  if (!(kStop < 2.0 * kMaxHarmonics)) {  // slow: the closed form, h = 1
+  // NaN kSharp counts as kMaxHarmonics (std::max keeps its first argument).
+  const double kFull = std::max(static_cast<double>(kMaxHarmonics), kSharp);
+  if (!(kStop < 2.0 * kFull)) {  // slow: the closed form, h = 1
     for (std::size_t i = 0; i < N; ++i) out[i] = levels[i].boxed;
     return out;
   }
-  const double h = kStop <= kMaxHarmonics ? 0.0 : 0.5 * (1.0 - std::cos(kPi * (kStop - kMaxHarmonics) / kMaxHarmonics));
+  const double h = kStop <= kFull ? 0.0 : 0.5 * (1.0 - std::cos(kPi * (kStop - kFull) / kFull));
   const double kCut = std::min(kStop, static_cast<double>(kMaxHarmonics));
   // Rotations stepped once per harmonic: e^(i 2 pi k mid) and e^(i pi k length) (its sine over
   // pi k length is the box's sinc).
@@ -84,8 +93,10 @@ std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<Periodi
   for (std::size_t i = 0; i < N; ++i) out[i] = h * levels[i].boxed + (1.0 - h) * series[i];
   return out;
 }
-template std::array<double, 1> bandLimitedSeriesTo<1>(double, const std::array<PeriodicLevel, 1>&, double, double);
-template std::array<double, 2> bandLimitedSeriesTo<2>(double, const std::array<PeriodicLevel, 2>&, double, double);
+template std::array<double, 1> bandLimitedSeriesTo<1>(double, double, const std::array<PeriodicLevel, 1>&, double,
+                                                      double);
+template std::array<double, 2> bandLimitedSeriesTo<2>(double, double, const std::array<PeriodicLevel, 2>&, double,
+                                                      double);
 
 void PeriodicCoordinate::setPeriod(double periodMm, double anchorMm) {
   if (!(periodMm > 0.0) || !std::isfinite(periodMm)) return;

@@ -116,19 +116,34 @@ inline double splineGain(double r) {  // inline: it runs once per harmonic in ba
   return a < 1.0 ? 2.0 * (1.0 - a) * (1.0 - a) * (1.0 - a) : 0.0;
 }
 
+// What a pattern may leave folding: a harmonic k >= kStop that the box keeps folds as a line of
+// amplitude 2 |C_k| sinc(pi k length) <= (4 / pi) |C_k| (length = 1 / (2 kStop) cycles, so the
+// sinc is <= 2 kStop / (pi k) <= 2 / pi), in level units (N per N of force range). 1e-5: the
+// project's 1e-5 N bar on a range up to 1 N.
+inline constexpr double kNegligibleFold = 1e-5;
+// A pattern's sharpness, kSharp: the harmonic from which on (4 / pi) |C_k| <= kNegligibleFold, from
+// a bound on |C_k| of the form amplitude / k^power (each pattern's, in its header): 0 where every
+// harmonic is below it already (amplitude <= the level at k = 1).
+double sharpHarmonic(double amplitude, double power);
+
 // The level of a periodic pattern over the travel [u0, u1] (cycles), band-limited to the 1 ms
 // frames. kStop = (frame rate / 2) / (speed / period): the first harmonic at the frames' Nyquist
-// frequency. Up to kStop = kMaxHarmonics (from 500 * period / 64 mm/s up), the box-filtered
-// harmonics (mean over the travel of e^(i 2 pi k u): e^(i 2 pi k mid) sinc(pi k length)) weighted
-// by splineGain(k / kStop): no component at or above the Nyquist frequency is left (exact). From
-// kStop = 2 kMaxHarmonics down to rest: boxed, the closed-form mean over the travel (the full
-// rendering). Between, h boxed + (1 - h) series with the series cut at kMaxHarmonics and h rising
-// 0 -> 1 (raised cosine in kStop): only harmonics past kMaxHarmonics are left, with weight h.
+// frequency; kSharp: the pattern's (sharpHarmonic). Up to kStop = kMaxHarmonics (from 500 * period
+// / 64 mm/s up), the box-filtered harmonics (mean over the travel of e^(i 2 pi k u):
+// e^(i 2 pi k mid) sinc(pi k length)) weighted by splineGain(k / kStop): no component at or above
+// the Nyquist frequency is left (exact). Past it, up to kFull = max(kMaxHarmonics, kSharp), the
+// same series cut at kMaxHarmonics: below the Nyquist frequency, but smoother than the pattern
+// where it has harmonics past kMaxHarmonics (the price of a bounded cost: a sharp pattern keeps
+// only 64 harmonics until it is slow enough). From kStop = 2 kFull down to rest: boxed, the
+// closed-form mean over the travel (the full rendering), whose harmonics past kStop >= kSharp fold
+// below kNegligibleFold. Between, h boxed + (1 - h) series, h rising 0 -> 1 (raised cosine in
+// kStop): continuous in speed.
 double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
-                         double periodMm);
+                         double periodMm, double kSharp);
 // The same with kStop given: the first harmonic that may not be kept (a 2D pattern shares the
 // frames' Nyquist frequency between its axes, GridBumpsPattern). kStop NaN or inf: boxed.
-double bandLimitedSeriesTo(double kStop, double boxed, double mean, const Harmonics& c, double u0, double u1);
+double bandLimitedSeriesTo(double kStop, double kSharp, double boxed, double mean, const Harmonics& c, double u0,
+                           double u1);
 
 // One periodic level as bandLimitedSeriesTo takes it: its mean over the travel (boxed), over a
 // period, and its harmonics.
@@ -141,8 +156,8 @@ struct PeriodicLevel {
 // (to the last bit): the per-harmonic rotations, spline gain and sinc, which depend only on the
 // travel and kStop, are computed once for all N (GridBumpsPattern: an axis's climb and height).
 template <std::size_t N>
-std::array<double, N> bandLimitedSeriesTo(double kStop, const std::array<PeriodicLevel, N>& levels, double u0,
-                                          double u1);
+std::array<double, N> bandLimitedSeriesTo(double kStop, double kSharp, const std::array<PeriodicLevel, N>& levels,
+                                          double u0, double u1);
 
 inline double clampLevel(double g) { return g > 0.0 ? (g < 1.0 ? g : 1.0) : 0.0; }
 

@@ -14,6 +14,13 @@ void RaisedCosineBump::setWidth(double omega) {
     return length * (x == 0.0 ? 1.0 : std::sin(x) / x) * std::polar(1.0, x);
   };
   const double half = 0.5 * omega;
+  // Each bound holds from k = 2 / omega on; a part whose every harmonic is below the level needs none.
+  auto sharp = [omega](double allK, double amplitude, double power) {
+    const double k = patterns::sharpHarmonic(amplitude, power);
+    return patterns::sharpHarmonic(allK, 1.0) > 0.0 ? std::max(2.0 / omega, k) : 0.0;
+  };
+  sharp_ = std::max(sharp(omega / kPi, 4.0 / (3.0 * kPi * omega), 2.0),
+                    sharp(0.5 * omega, 2.0 / (3.0 * kPi * omega * omega), 3.0));
   for (int k = 1; k <= kMaxHarmonics; ++k) {
     const double a = 2.0 * kPi * k;
     const std::complex<double> up = (E(half, b - a) - E(half, -b - a)) / std::complex<double>(0.0, 2.0);

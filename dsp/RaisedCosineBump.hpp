@@ -9,6 +9,11 @@
 //   climbing along +1 (sin(b f) on [0, omega / 2)): C+_k = (E_half(b - a) - E_half(-b - a)) / 2i;
 //   along -1 the mirror image about omega / 2: C-_k = e^(-i a omega) conj(C+_k);
 //   height: C_k = E_omega(-a) / 2 - (E_omega(b - a) + E_omega(-b - a)) / 4.
+// Their bounds (sharpHarmonic): the climb is a half-sine pulse of omega / 2 cycles,
+// |C+_k| = (omega / pi) |cos(pi k omega / 2)| / |1 - (k omega)^2|, <= omega / pi (its integral) and,
+// for k omega >= 2 (1 / ((k omega)^2 - 1) <= 4 / (3 (k omega)^2)), <= 4 / (3 pi omega k^2); the
+// height's |C_k| = (omega / 2) |sinc(pi k omega)| / |1 - (k omega)^2| <= omega / 2, and for
+// k omega >= 2 <= 2 / (3 pi omega^2 k^3).
 #pragma once
 
 #include "PatternTravel.hpp"
@@ -34,9 +39,13 @@ class RaisedCosineBump {
   double climbTo(double f, int direction) const;
   double climbMean() const { return omega_ / kPi; }
   const Harmonics& climbHarmonics(int direction) const { return direction > 0 ? climbingUp_ : climbingDown_; }
+  // The harmonic from which on both the climb's and the height's fold below kNegligibleFold
+  // (PatternTravel.hpp), from the bounds above.
+  double sharpHarmonic() const { return sharp_; }
 
  private:
   double omega_ = -1.0;
+  double sharp_ = 0.0;
   Harmonics climbingUp_{}, climbingDown_{}, height_{};
 };
 

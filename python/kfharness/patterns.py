@@ -44,6 +44,34 @@ def fade(frequency_hz, period_s):
 
 
 MAX_HARMONICS = 64
+NEGLIGIBLE_FOLD = 1e-5
+
+
+def sharp_harmonic(amplitude, power):
+    """PatternTravel.cpp sharpHarmonic: the harmonic from which on (4 / pi) amplitude / k^power is at
+    most NEGLIGIBLE_FOLD; 0 if amplitude already is."""
+    level = 0.25 * np.pi * NEGLIGIBLE_FOLD
+    return 0.0 if amplitude <= level else (amplitude / level) ** (1.0 / power)
+
+
+def bump_sharp(omega):
+    """RaisedCosineBump.cpp: the climb's and the height's kSharp, the larger."""
+    def part(all_k, amplitude, power):
+        return max(2 / omega, sharp_harmonic(amplitude, power)) if sharp_harmonic(all_k, 1) > 0 else 0.0
+    return max(part(omega / np.pi, 4 / (3 * np.pi * omega), 2), part(omega / 2, 2 / (3 * np.pi * omega ** 2), 3))
+
+
+def grating_sharp(duty, edge):
+    """GratingPattern.cpp: |C_k| <= 1 / (pi k) and <= 1 / (pi^2 e k^2); 0 for duty 0 or 1."""
+    if duty in (0.0, 1.0):
+        return 0.0
+    hard = sharp_harmonic(1 / np.pi, 1)
+    return min(hard, sharp_harmonic(1 / (np.pi ** 2 * edge), 2)) if edge > 0 else hard
+
+
+def detent_sharp(crest):
+    """DetentPattern.cpp: |C_k| <= 1 / (pi k) from k = 1 / (pi c) on."""
+    return max(1 / (np.pi * crest), sharp_harmonic(1 / np.pi, 1))
 
 
 def spline_gain(r):
@@ -52,20 +80,22 @@ def spline_gain(r):
     return np.where(a <= 0.5, 1 - 6 * a * a + 6 * a ** 3, np.where(a < 1, 2 * (1 - a) ** 3, 0.0))
 
 
-def band_limited_series(boxed, mean, harmonics, u0, u1, speed, period_mm, period_s):
+def band_limited_series(boxed, mean, harmonics, u0, u1, speed, period_mm, period_s, k_sharp):
     """PatternTravel.cpp bandLimitedSeries: the box-filtered harmonics (coefficients harmonics[k - 1],
-    fixed or per sample) weighted by spline_gain(k / k_cut) where k_stop = 500 Hz / (speed / period)
-    is at most MAX_HARMONICS; the closed-form boxed level from twice that on; a crossfade between."""
+    fixed or per sample) weighted by spline_gain(k / k_cut), k_cut = min(k_stop, MAX_HARMONICS),
+    k_stop = 500 Hz / (speed / period), up to k_full = max(MAX_HARMONICS, k_sharp); the closed-form
+    boxed level from twice that on; a crossfade between."""
     f1 = np.asarray(speed, dtype=np.float64) / period_mm
     with np.errstate(divide="ignore", invalid="ignore"):
         k_stop = np.where(f1 > 0, 0.5 / period_s / np.where(f1 > 0, f1, 1), np.inf)
-    return band_limited_series_to(k_stop, boxed, mean, harmonics, u0, u1)
+    return band_limited_series_to(k_stop, k_sharp, boxed, mean, harmonics, u0, u1)
 
 
-def band_limited_series_to(k_stop, boxed, mean, harmonics, u0, u1):
+def band_limited_series_to(k_stop, k_sharp, boxed, mean, harmonics, u0, u1):
     """PatternTravel.cpp bandLimitedSeriesTo: band_limited_series with k_stop given (inf: boxed)."""
-    between = np.clip(k_stop, MAX_HARMONICS, 2 * MAX_HARMONICS)
-    h = 0.5 * (1 - np.cos(np.pi * (between - MAX_HARMONICS) / MAX_HARMONICS))
+    k_full = max(MAX_HARMONICS, k_sharp)
+    between = np.clip(k_stop, k_full, 2 * k_full)
+    h = 0.5 * (1 - np.cos(np.pi * (between - k_full) / k_full))
     k_cut = np.minimum(k_stop, MAX_HARMONICS)
     mid, length = 0.5 * (u0 + u1), np.abs(u1 - u0)
     phase = 2 * np.pi * (mid - np.floor(mid))
@@ -144,7 +174,8 @@ def grating(x, rate, period, duty, edge, antialias=True):
     if not antialias:
         return at(u1 - np.floor(u1))
     boxed = _periodic_mean(u0, u1, d, partial, at)
-    return np.clip(band_limited_series(boxed, d, grating_harmonics(d, e), u0, u1, speed, period, t), 0, 1)
+    return np.clip(band_limited_series(boxed, d, grating_harmonics(d, e), u0, u1, speed, period, t,
+                                       grating_sharp(d, e)), 0, 1)
 
 
 def bumps(x, rate, period, width, valleys=False, antialias=True):
@@ -173,7 +204,8 @@ def bumps(x, rate, period, width, valleys=False, antialias=True):
     boxed = _periodic_mean(u0, u1, scale, lambda f: scale * climb(f), at)
     up, down = bump_harmonics(omega, valleys)
     harmonics = np.where(direction[None, :] > 0, up[:, None], down[:, None])
-    return np.clip(band_limited_series(boxed, scale, harmonics, u0, u1, speed, period, t), 0, 1)
+    return np.clip(band_limited_series(boxed, scale, harmonics, u0, u1, speed, period, t, bump_sharp(omega)),
+                   0, 1)
 
 
 def detents(x, rate, spacing, crest, antialias=True):
@@ -188,7 +220,8 @@ def detents(x, rate, spacing, crest, antialias=True):
     if not antialias:
         return along(u1 - np.floor(u1))
     boxed = _periodic_mean(u0, u1, c / 2, lambda g: np.where(g < c, g * g / (2 * c), c / 2), along)
-    return np.clip(band_limited_series(boxed, c / 2, detent_harmonics(c), u0, u1, speed, spacing, t), 0, 1)
+    return np.clip(band_limited_series(boxed, c / 2, detent_harmonics(c), u0, u1, speed, spacing, t,
+                                       detent_sharp(c)), 0, 1)
 
 
 def _splitmix(state):
@@ -309,8 +342,9 @@ def bumps2d(x, y, rate, spacing_x, spacing_y, width, antialias=True):
         height = _periodic_mean(u0, u1, half, height_to, bump)
         up, down = bump_harmonics(omega, False)
         harmonics = np.where(s[None, :] > 0, up[:, None], down[:, None])
-        return (band_limited_series_to(k_stop, climbed, scale, harmonics, u0, u1),
-                band_limited_series_to(k_stop, height, half, height_harmonics(omega), u0, u1))
+        sharp = bump_sharp(omega)
+        return (band_limited_series_to(k_stop, sharp, climbed, scale, harmonics, u0, u1),
+                band_limited_series_to(k_stop, sharp, height, half, height_harmonics(omega), u0, u1))
 
     ox, oy = min(max(width / spacing_x, 1e-6), 1.0), min(max(width / spacing_y, 1e-6), 1.0)
     wx, wy = ox * spacing_x, oy * spacing_y

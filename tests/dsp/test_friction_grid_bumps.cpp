@@ -188,16 +188,17 @@ std::vector<double> frames(const std::vector<double>& level, size_t from) {
 }  // namespace
 
 TEST_CASE("bumps2D: slow lines at angles, out and back, are the rule's mean over the travel, 44.1 to 192 kHz") {
-  // 5 mm/s over 4 x 3 mm: every axis's first harmonic not kept is >= 208 (Ky at 2.0 rad; past 2 * 64 harmonics,
-  // GridBumpsPattern.hpp), so the level is the closed form: each factor's mean over its travel.
+  // 1 mm/s over 4 x 3 mm: every axis's first harmonic not kept is >= 1040 (Ky at 2.0 rad), past
+  // twice the bumps' kSharp (329 for omega 0.5 along x, 285 for 2/3 along y; PatternTravel.hpp), so
+  // the level is the closed form: each factor's mean over its travel.
   for (double rate : {44100.0, 48000.0, 96000.0, 192000.0}) {
     for (double angle : {0.0, kPi / 2, kPi / 6, kPi / 4, 2.0, -2.5, kPi}) {
-      Path p = line(0.3, 0.7, angle, 5, 0.6, rate);
-      p.append(line(p.x.back(), p.y.back(), angle + kPi, 5, 0.6, rate));  // the way back
+      Path p = line(0.3, 0.7, angle, 1, 0.6, rate);
+      p.append(line(p.x.back(), p.y.back(), angle + kPi, 1, 0.6, rate));  // the way back
       const auto got = levels(p, rate), want = slowDefinition(p, rate);
       INFO("rate " << rate << " angle " << angle);
       CHECK(worstDifference(got, want) < kTol);
-      CHECK(*std::max_element(got.begin(), got.end()) > 0.2);  // the line meets bumps
+      CHECK(*std::max_element(got.begin(), got.end()) > 0.1);  // meets bumps (along y: b(0.3 mm) = 0.21)
     }
   }
 }
@@ -436,7 +437,7 @@ TEST_CASE("bumps2D: far from the origin, the same as near it (float positions ex
 
 TEST_CASE("bumps2D: NaN and inf positions hold, bad parameters keep the last good, raw is the rule at the point") {
   const double rate = 48000;
-  Path p = line(0.3, 0.7, 0.5, 5, 1.0, rate);
+  Path p = line(0.3, 0.7, 0.5, 1, 1.0, rate);  // 1 mm/s: the closed form (as the slow lines')
   const auto clean = levels(p, rate);
   Path bad = p;
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_limits<float>::infinity();
@@ -466,14 +467,15 @@ TEST_CASE("bumps2D: NaN and inf positions hold, bad parameters keep the last goo
 }
 
 TEST_CASE("bumps2D: a change of spacing while moving keeps the bumps' phase under the puck, on both axes") {
-  // 5 mm/s at 30 degrees, at (48.5, 37) at sample 4800 (a block start: 0.5 mm up a bump's flank
+  // 1 mm/s at 30 degrees (the closed form: Kx >= 1353, past twice kSharp, 690 on 4.4 mm), at
+  // (48.5, 37) at sample 4800 (a block start: 0.5 mm up a bump's flank
   // in x, on its centre line in y) where the spacings go 4 x 3 -> 4.4 x 3.3 mm. Kept at the anchor
   // (x: the block's first position; y: the last y before it), a cell coordinate after the change
   // is (u - anchor) / new spacing + anchor / old spacing. Anchored at the origin instead, the puck
   // would jump from 0.5 to 0.1 mm into its bump in x and from 1.0 to 0.7 mm in y.
   const double rate = 48000;
   const size_t change = 4800;
-  const Path p = line(48.5 - 0.5 * std::cos(kPi / 6), 37 - 0.25, kPi / 6, 5, 0.2, rate);
+  const Path p = line(48.5 - 0.1 * std::cos(kPi / 6), 37 - 0.05, kPi / 6, 1, 0.2, rate);
   FrictionPatternCore core(PatternKind::Bumps2D, rate);
   core.setForceRange({kLoN, kHiN});
   std::vector<float> force(p.x.size());

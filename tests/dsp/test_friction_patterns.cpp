@@ -92,14 +92,15 @@ double level(float forceN) { return (forceN - kMinN) / (kMaxN - kMinN); }
 TEST_CASE("grating: point values on a ramp are the definition, and the box filter is its mean over the travel") {
   const double period = 2.0, duty = 0.3, edge = 0.25;
   auto def = [&](double x) { return gratingDef(frac(x / period), duty, edge / period); };
-  const auto x = ramp(-3.0, 5.0, 2.0, 48000);
+  const auto x = ramp(-3.0, 1.0, 2.0, 48000);
   auto raw = core(PatternKind::Grating, 48000, false);
   const auto f = run(raw, x, period, duty, edge);
   for (size_t i = 0; i < x.size(); i += 29) REQUIRE(f[i] == Approx(kMinN + (kMaxN - kMinN) * def(x[i])).margin(1e-6));
   auto boxed = core(PatternKind::Grating);
   const auto g = run(boxed, x, period, duty, edge);
-  // 5 mm/s over 2 mm is 2.5 Hz: harmonic 200 is at the frames' 500 Hz, past 2 * kMaxHarmonics, so
-  // no harmonic is weighted (PatternTravel.hpp): the level is the box mean itself.
+  // 1 mm/s over 2 mm is 0.5 Hz: harmonic 1000 is at the frames' 500 Hz, past twice the grating's
+  // kSharp (321 for an edge of 1/8 period, PatternTravel.hpp), so no harmonic is weighted: the
+  // level is the box mean itself.
   for (size_t i = 48; i < x.size(); i += 389)
     REQUIRE(level(g[i]) == Approx(boxMean(def, x[i - 48], x[i])).margin(2e-6));
 }
@@ -109,10 +110,11 @@ TEST_CASE("grating: integral of one period is the duty, the level is periodic an
   p.set(0.2, 0.4, 0.03, 0.0);
   CHECK(p.integralTo(0.999999999) == Approx(0.4).margin(1e-8));
   for (double x0 : {0.013, 1.5, 1e6 + 0.071}) {
-    // 0.5 mm/s: slow enough for the closed form (harmonic 200 at the frames' 500 Hz).
-    Travel a{x0, x0 + 5e-4, 1, 0.5, 1e-3}, b{x0 + 0.2 * 7, x0 + 0.2 * 7 + 5e-4, 1, 0.5, 1e-3};
+    // 0.1 mm/s: slow enough for the closed form (harmonic 1000 at the frames' 500 Hz, past twice
+    // kSharp, 294 for an edge of 0.15 period).
+    Travel a{x0, x0 + 1e-4, 1, 0.1, 1e-3}, b{x0 + 0.2 * 7, x0 + 0.2 * 7 + 1e-4, 1, 0.1, 1e-3};
     CHECK(p.level(a, true) == Approx(p.level(b, true)).margin(1e-7));
-    const double want = boxMean([](double x) { return gratingDef(frac(x / 0.2), 0.4, 0.15); }, x0, x0 + 5e-4);
+    const double want = boxMean([](double x) { return gratingDef(frac(x / 0.2), 0.4, 0.15); }, x0, x0 + 1e-4);
     CHECK(p.level(a, true) == Approx(want).margin(1e-6));
   }
 }
@@ -205,10 +207,12 @@ TEST_CASE(
   const double period = 4.0, width = 2.0, omega = width / period;
   for (bool valleys : {false, true}) {
     for (int dir : {1, -1}) {
-      const auto x = ramp(dir > 0 ? -1.0 : 9.0, dir * 10.0, 0.9, 48000);
+      // 2 mm/s over 4 mm: harmonic 1000 at the frames' 500 Hz, past twice kSharp (329 for omega
+      // 0.5, PatternTravel.hpp): the closed form.
+      const auto x = ramp(dir > 0 ? -1.0 : 4.5, dir * 2.0, 2.25, 48000);
       auto c = core(PatternKind::Bumps);
       const auto f = run(c, x, period, width, valleys ? 1 : 0);
-      for (size_t i = 48; i < x.size(); i += 397) {  // 108 travels of each run: every part of a bump
+      for (size_t i = 48; i < x.size(); i += 397) {  // 272 travels of each run: every part of a bump
         auto def = [&](double p) { return bumpDef(frac(p / period), omega, dir, valleys); };
         REQUIRE(level(f[i]) == Approx(boxMean(def, x[i - 48], x[i])).margin(2e-6));
       }
@@ -244,13 +248,15 @@ TEST_CASE("detents: the counterforce builds to the crest then drops, and turning
   // from the other side 0.33 -> 0.56).
   CHECK(level(f[static_cast<size_t>(0.15 * 48000)]) == Approx(0.8333).margin(0.01));
   CHECK(level(f[12000 + 2400]) == Approx((1 - 2.0 / 3.0) / 0.6).margin(0.01));
-  // The anti-aliased detents are the box mean of the same definition.
-  auto boxed = core(PatternKind::Detents);
-  const auto g = run(boxed, x, spacing, crest, 0);
-  for (size_t i = 48; i < 12000; i += 61)
-    REQUIRE(level(g[i]) ==
-            Approx(boxMean([&](double p) { return detentDef(frac(p / spacing), crest, 1); }, x[i - 48], x[i]))
-                .margin(2e-6));
+  // The anti-aliased detents are the box mean of the same definition where that is the closed form:
+  // creeping (0.01 mm/s over 3 mm: harmonic 150000 at the frames' 500 Hz, past twice kSharp, 40528
+  // for the drop at the crest, PatternTravel.hpp). Faster, the 64-harmonic series (rounded).
+  DetentPattern creeping;
+  creeping.set(spacing, crest, 0);
+  for (double x0 = 0.0; x0 < 3.0; x0 += 0.0371)
+    REQUIRE(
+        creeping.level(Travel{x0, x0 + 1e-5, 1, 0.01, 1e-3}, true) ==
+        Approx(boxMean([&](double p) { return detentDef(frac(p / spacing), crest, 1); }, x0, x0 + 1e-5)).margin(2e-6));
 }
 
 TEST_CASE("texture: the definition written again, the same force at every revisit, whatever came between") {
@@ -475,8 +481,9 @@ TEST_CASE("sample rates 44.1 to 192 kHz: the same grating against position, the 
   auto def = [&](double x) { return gratingDef(frac(x / period), duty, edge / period); };
   for (double sr : {44100.0, 48000.0, 88200.0, 96000.0, 192000.0}) {
     auto c = core(PatternKind::Grating, sr);
-    // 2.5 mm/s over 1 mm: slow enough for the closed form (harmonic 200 at the frames' 500 Hz).
-    const auto x = ramp(0.0, 2.5, 0.45, sr);
+    // 0.5 mm/s over 1 mm: slow enough for the closed form (harmonic 1000 at the frames' 500 Hz,
+    // past twice kSharp, 359 for an edge of 0.1 period).
+    const auto x = ramp(0.0, 0.5, 0.45, sr);
     const auto f = run(c, x, period, duty, edge);
     const size_t n = static_cast<size_t>(std::round(sr * 1e-3));
     for (size_t i = n; i < x.size(); i += 211)
