@@ -15,6 +15,7 @@
 
 #include "ForceFrameSpectrum.hpp"
 #include "FrictionPatternCore.hpp"
+#include "PlanePaths.hpp"
 
 using namespace kf::patterns;
 
@@ -88,23 +89,8 @@ double directionalSlope(const Grid& g, double x, double y, double ux, double uy)
   return ux * sx * bumpAt(y / g.sy, oy) + uy * bumpAt(x / g.sx, ox) * sy;
 }
 
-struct Path {
-  std::vector<float> x, y;
-  void append(const Path& p) {
-    x.insert(x.end(), p.x.begin(), p.x.end());
-    y.insert(y.end(), p.y.begin(), p.y.end());
-  }
-};
-
-// A line from (x0, y0) at speed mm/s along angle (rad), for seconds.
-Path line(double x0, double y0, double angle, double speed, double seconds, double rate) {
-  Path p;
-  for (int i = 0; i < static_cast<int>(seconds * rate); ++i) {
-    p.x.push_back(static_cast<float>(x0 + std::cos(angle) * speed * i / rate));
-    p.y.push_back(static_cast<float>(y0 + std::sin(angle) * speed * i / rate));
-  }
-  return p;
-}
+using kf::testpaths::line;
+using kf::testpaths::Path;
 
 std::vector<float> forces(const Path& p, double rate, bool antialias, const Grid& g = Grid{}) {
   FrictionPatternCore core(PatternKind::Bumps2D, rate);
@@ -279,8 +265,9 @@ TEST_CASE("bumps2D: along an axis the level is the 1D bumps' times the other axi
         const double seconds = std::min(0.3, 8 / speed);
         const Path axis = line(s > 0 ? -1 : 7.2, 0, s > 0 ? 0 : kPi, speed, seconds, rate);
         Path p;
-        p.x = alongX ? axis.x : std::vector<float>(axis.x.size(), float(across));
-        p.y = alongX ? std::vector<float>(axis.x.size(), float(across)) : axis.x;
+        p.x = axis.x;
+        p.y.assign(axis.x.size(), float(across));
+        if (!alongX) std::swap(p.x, p.y);
         FrictionPatternCore bumps(PatternKind::Bumps, rate);
         bumps.setForceRange({kLoN, kHiN});
         std::vector<float> f1(axis.x.size());

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "FrictionPatternCore.hpp"
+#include "PlanePaths.hpp"
 
 using namespace kf::patterns;
 
@@ -60,23 +61,8 @@ double segmentMean(const Wave& w, double x0, double y0, double x1, double y1) {
   return s / (3.0 * n);
 }
 
-struct Path {
-  std::vector<float> x, y;
-  void add(const Path& p) {
-    x.insert(x.end(), p.x.begin(), p.x.end());
-    y.insert(y.end(), p.y.begin(), p.y.end());
-  }
-};
-
-// A line from (x0, y0) at speed mm/s along angle (rad), for seconds.
-Path line(double x0, double y0, double angle, double speed, double seconds, double rate) {
-  Path p;
-  for (int i = 0; i < static_cast<int>(seconds * rate); ++i) {
-    p.x.push_back(static_cast<float>(x0 + std::cos(angle) * speed * i / rate));
-    p.y.push_back(static_cast<float>(y0 + std::sin(angle) * speed * i / rate));
-  }
-  return p;
-}
+using kf::testpaths::line;
+using kf::testpaths::Path;
 
 // Appends a straight segment from the path's end to (x, y) at speed mm/s, ending exactly there.
 void goTo(Path& p, double x, double y, double speed, double rate) {
@@ -161,7 +147,7 @@ TEST_CASE("texture2D: the definition at rest and the mean of each wave along slo
       // 25 mm/s: 0.025 mm a frame (<= 0.075 cycles of a wave); |f.v| <= 75 Hz, under the fade's
       // 250 Hz: every wave kept whole, the level the mean of each over the travel.
       Path p = rest(0.3, 0.7, 300);
-      p.add(line(0.3, 0.7, angle, 25, 0.2, rate));
+      p.append(line(0.3, 0.7, angle, 25, 0.2, rate));
       const auto got = levels(p, rate);
       double worst = 0, lo = 1, hi = 0;
       for (size_t i = 0; i < 300; ++i) worst = std::max(worst, std::fabs(got[i] - definition(ws, 0.3f, 0.7f)));
@@ -184,14 +170,14 @@ TEST_CASE("texture2D: a place feels the same at every visit, from any direction,
   // is 0: the definition at P, bit for bit the same at each visit.
   const double rate = 48000, px = 2.1, py = -1.3;
   Path p = line(px - 3, py, 0, 30, 0.1, rate);
-  p.add(rest(px, py, 200));
+  p.append(rest(px, py, 200));
   goTo(p, px + 3, py + 3, 40, rate);
   goTo(p, px, py - 4, 60, rate);
   goTo(p, px, py, 20, rate);
-  p.add(rest(px, py, 200));
+  p.append(rest(px, py, 200));
   goTo(p, px - 2, py + 2, 50, rate);
   goTo(p, px, py, 50, rate);
-  p.add(rest(px, py, 200));
+  p.append(rest(px, py, 200));
   const auto got = levels(p, rate);
   std::vector<double> atP;
   for (size_t i = 48; i < p.x.size(); ++i)
@@ -344,6 +330,6 @@ TEST_CASE("texture2D: NaN and inf positions hold, bad parameters keep the last g
   }
   // Beyond: finite and within range, at rest and moving near float's largest (frames 2e36 mm long).
   Path extreme = rest(3e38, -3e38, 100);
-  extreme.add(line(-3e38, 3e38, 1.0, 1e39, 0.01, rate));
+  extreme.append(line(-3e38, 3e38, 1.0, 1e39, 0.01, rate));
   for (double v : levels(extreme, rate)) REQUIRE((v >= 0.0 && v <= 1.0));
 }
