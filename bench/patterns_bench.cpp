@@ -37,21 +37,26 @@ struct Kind {
 // Every kind on a 0.2 mm pattern where it has one: the speed kinds (viscous, stickSlip) have none;
 // slope is given the height of 0.2 mm raised-cosine bumps (steepest slope pi / 0.2 per mm).
 const Kind kKinds[] = {
-    {"grating", PatternKind::Grating, kFineMm, 0.5, 0.02}, {"bumps", PatternKind::Bumps, kFineMm, 0.1, 0},
-    {"detents", PatternKind::Detents, kFineMm, 0.8, 0},    {"texture", PatternKind::Texture, 3, 1 / kFineMm, 11},
-    {"viscous", PatternKind::Viscous, 300, 0, 0},          {"stickSlip", PatternKind::StickSlip, 30, 10, 0},
-    {"slope", PatternKind::Slope, 0, kPi / kFineMm, 0},    {"bumps2D", PatternKind::Bumps2D, kFineMm, kFineMm, 0.1},
+    {"grating", PatternKind::Grating, kFineMm, 0.5, 0.02},
+    {"bumps", PatternKind::Bumps, kFineMm, 0.1, 0},
+    {"detents", PatternKind::Detents, kFineMm, 0.8, 0},
+    {"texture", PatternKind::Texture, 3, 1 / kFineMm, 11},
+    {"viscous", PatternKind::Viscous, 300, 0, 0},
+    {"stickSlip", PatternKind::StickSlip, 30, 10, 0},
+    {"slope", PatternKind::Slope, 0, kPi / kFineMm, 0},
+    {"bumps2D", PatternKind::Bumps2D, kFineMm, kFineMm, 0.1},
+    {"texture2D", PatternKind::Texture2D, 3, 1 / kFineMm, 11},
 };
 
-// The path at speedMmPerS for samples: x, and the second signal (y along 30 degrees for bumps2D,
-// the height under x for slope, none otherwise).
+// The path at speedMmPerS for samples: x, and the second signal (y along 30 degrees for the 2D
+// kinds, the height under x for slope, none otherwise).
 struct Path {
   std::vector<float> x, second;
 };
 
 Path path(const Kind& k, double speedMmPerS, size_t samples) {
   Path p;
-  const bool twoD = k.kind == PatternKind::Bumps2D;
+  const bool twoD = isTwoD(k.kind);
   const double vx = twoD ? speedMmPerS * std::cos(kAngleRad) : speedMmPerS;
   for (size_t i = 0; i < samples; ++i) {
     const double t = i / kRate, x = 0.013 + vx * t;

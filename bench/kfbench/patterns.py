@@ -1,5 +1,5 @@
 """The patterns part: build/bench/kf_patterns_bench (bench/patterns_bench.cpp) runs every
-FrictionPattern kind over a fine pattern (0.2 mm; bumps2D along 30 degrees) at 5 and 300 mm/s,
+FrictionPattern kind over a fine pattern (0.2 mm; bumps2D and texture2D along 30 degrees) at 5 and 300 mm/s,
 with anti-aliasing on and off interleaved in every round (fresh cores on the same path, CPU time
 of the thread), and LoudnessToFriction on noise in the same rounds; and the largest alias in the
 1 ms frames at 300 mm/s, on and off, measured as the dsp tests measure it. The alias figures are
