@@ -108,6 +108,8 @@ TEST_CASE("folding: narrow 1D bumps and a hard-edged grating, kStop from 64 to p
 TEST_CASE("folding: 1D bumps between kFull and 2 kFull (the new blend) stay below the bar") {
   // 4 mm / 2 mm bumps (omega 0.5: kSharp 329) at f1 = 4 g, g = 1000 / 4001 Hz: 4 mm/s, kStop 500,
   // h = 0.53: the closed form's harmonics past 500 fold, each below kNegligibleFold by kSharp's bound.
+  // A guard of the blend region, not a proof of the change: the old rule (the closed form from
+  // kStop 128) folds 2.1e-6 here, also below the bar (the cases above are the ones it failed).
   const int period = 4001;
   BumpPattern bumps;
   bumps.set(4, 2, false, 0);
@@ -140,7 +142,8 @@ TEST_CASE("sharpness: the bounds kSharp is derived from hold for the harmonics t
 TEST_CASE("continuity: no step in the level as the speed crosses kStop = 64, kFull and 2 kFull") {
   // At each threshold speed v (kStop = 500 Hz / (v / period)), the level over a travel ending at a
   // fixed point at v (1 -+ 1e-9): a continuous rule moves by ~ its slope in v times 1e-9 v (< 1e-6
-  // here); the old switch to the closed form at 128 stepped by the harmonics past 64 (~1e-2).
+  // here). kStop = 128 is no threshold any more (the old blend ended there, continuously); kFull and
+  // 2 kFull are the new ones, where a step would show.
   struct Case {
     const char* name;
     double period, kSharp;
