@@ -46,6 +46,11 @@ const Kind kKinds[] = {
     {"slope", PatternKind::Slope, 0, kPi / kFineMm, 0},
     {"bumps2D", PatternKind::Bumps2D, kFineMm, kFineMm, 0.1},
     {"texture2D", PatternKind::Texture2D, 3, 1 / kFineMm, 11},
+    // Coarse patterns, where the sharp ones keep the 64-harmonic series at slow speeds (kSharp):
+    // the most a pattern costs.
+    {"grating-4mm", PatternKind::Grating, 4, 0.5, 0},
+    {"bumps-10mm", PatternKind::Bumps, 10, 0.625, 0},
+    {"bumps2D-4mm", PatternKind::Bumps2D, 4, 4, 1},
 };
 
 // The path at speedMmPerS for samples: x, and the second signal (y along 30 degrees for the 2D
