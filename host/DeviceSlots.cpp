@@ -126,6 +126,13 @@ Device* peekSlot(int index) {
   return isValidSlot(index) ? gSlots[index].device.load(std::memory_order_acquire) : nullptr;
 }
 
+void haltRealtimeDevicesOnQuit() {
+  for (Slot& slot : gSlots) {
+    Device* device = slot.device.load(std::memory_order_acquire);
+    if (device != nullptr && !device->isLockstep()) device->haltInOrder();
+  }
+}
+
 void haltAllDevices() {
   gExiting.store(true);
   for (Slot& slot : gSlots)

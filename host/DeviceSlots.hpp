@@ -66,6 +66,13 @@ uint32_t generationOfSlot(int index);
 // stage is already deleting it is the one race this last-resort path accepts.
 void haltAllDevices();
 
+// The server quitting (/quit: the plugin's unload, which scsynth calls before it stops the audio
+// driver and frees the nodes): Device::haltInOrder on every realtime device in a slot, so the
+// magnet goes off now and the blocks the audio still runs send it nothing. Lockstep devices (an
+// NRT render ending) are left to FrictionOut's destructors, which record the off at render time.
+// Not for signal handlers (it takes each device's lock).
+void haltRealtimeDevicesOnQuit();
+
 // The slot a UGen's device input names, or -1 for NaN, infinities and anything outside
 // 0..kNumDeviceSlots-1 (a cast of those to int would be undefined).
 inline int slotIndexOf(float input) {

@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "DeviceSlots.hpp"
 #include "ExitSafety.hpp"
+#include "SlotDrive.hpp"
 
 InterfaceTable* ft = nullptr;
 
@@ -50,6 +52,15 @@ void postFromRt(World* world, const char* format, ...) {
 }
 
 }  // namespace kf::sc
+
+// scsynth's /quit (World_Cleanup) calls each plugin's `unload` before it stops the audio driver and
+// frees the nodes. Waiting for FrictionOut's destructors would wait for the driver's stop too
+// (JACK's deactivation): the off came 2.005 ms after the last force frame once, past the 2 ms an
+// orderly stop must meet (test_orderly_off). So the magnet and the audio drives go off here.
+C_LINKAGE SC_API_EXPORT void unload() {
+  kf::sc::haltRealtimeDevicesOnQuit();
+  kf::sc::haltAllDrives();
+}
 
 PluginLoad(KineticFriction) {
   ft = inTable;

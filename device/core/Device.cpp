@@ -399,6 +399,13 @@ std::string Device::recordingError() {
   return recorder_.error();
 }
 
+void Device::haltInOrder() {
+  std::lock_guard<PiMutex> lock(stateMutex_);  // pumps hold it: none is under way, none after
+  halted_.store(true);
+  applyOffRequestLocked(nowS());
+  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+}
+
 void Device::emergencyOff() noexcept {
   halted_.store(true);
   // A pump running on another thread may still command a force and write records: let it

@@ -114,6 +114,10 @@ class Device {
   // it (one under way on another thread is waited for, at most 50 ms). The process is on its
   // way out; nothing else is cleaned up.
   void emergencyOff() noexcept;
+  // From a non-realtime thread, the process ending in order (the server's /quit, before its audio
+  // stops): the magnet off now, the off recorded after every line before it, and no pump after
+  // it, so the frames the audio still sends are never applied.
+  void haltInOrder();
 
   // From a non-realtime thread: an extra force backend (the friction board) that gets every
   // command and drive-off the device's own backend gets, from the next frame on. Null
@@ -191,7 +195,7 @@ class Device {
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> offRequested_{false};  // requestOff()
   std::atomic<bool> closed_{false};
-  // emergencyOff(): no pump runs any more (halted_), and none is under way (pumping_).
+  // emergencyOff() and haltInOrder(): no pump runs any more (halted_), and none is under way (pumping_).
   std::atomic<bool> halted_{false};
   std::atomic<bool> pumping_{false};
 };
