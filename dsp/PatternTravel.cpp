@@ -49,12 +49,7 @@ double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u
                          double periodMm, double kSharp) {
   const double f1 = travel.speedMmPerS / periodMm;  // the fundamental's temporal frequency (Hz)
   if (!(f1 > 0.0)) return boxed;                    // at rest (or NaN): the pattern as it is
-  return bandLimitedSeriesTo(0.5 / travel.framePeriodS / f1, kSharp, boxed, mean, c, u0, u1);
-}
-
-double bandLimitedSeriesTo(double kStop, double kSharp, double boxed, double mean, const Harmonics& c, double u0,
-                           double u1) {
-  return bandLimitedSeriesTo<1>(kStop, kSharp, {PeriodicLevel{boxed, mean, &c}}, u0, u1)[0];
+  return bandLimitedSeriesTo<1>(0.5 / travel.framePeriodS / f1, kSharp, {PeriodicLevel{boxed, mean, &c}}, u0, u1)[0];
 }
 
 template <std::size_t N>

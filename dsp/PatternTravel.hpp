@@ -140,11 +140,6 @@ double sharpHarmonic(double amplitude, double power);
 // kStop): continuous in speed.
 double bandLimitedSeries(double boxed, double mean, const Harmonics& c, double u0, double u1, const Travel& travel,
                          double periodMm, double kSharp);
-// The same with kStop given: the first harmonic that may not be kept (a 2D pattern shares the
-// frames' Nyquist frequency between its axes, GridBumpsPattern). kStop NaN or inf: boxed.
-double bandLimitedSeriesTo(double kStop, double kSharp, double boxed, double mean, const Harmonics& c, double u0,
-                           double u1);
-
 // One periodic level as bandLimitedSeriesTo takes it: its mean over the travel (boxed), over a
 // period, and its harmonics.
 struct PeriodicLevel {
@@ -152,9 +147,11 @@ struct PeriodicLevel {
   double mean;
   const Harmonics* harmonics;
 };
-// N levels over the same travel at once, element i the single bandLimitedSeriesTo of levels[i]
-// (to the last bit): the per-harmonic rotations, spline gain and sinc, which depend only on the
-// travel and kStop, are computed once for all N (GridBumpsPattern: an axis's climb and height).
+// bandLimitedSeries with kStop given (the first harmonic that may not be kept: a 2D pattern shares
+// the frames' Nyquist frequency between its axes, GridBumpsPattern; NaN or inf: boxed), for N
+// levels over the same travel at once, element i as if alone (to the last bit): the per-harmonic
+// rotations, spline gain and sinc, which depend only on the travel and kStop, are computed once for
+// all N (GridBumpsPattern: an axis's climb and height).
 template <std::size_t N>
 std::array<double, N> bandLimitedSeriesTo(double kStop, double kSharp, const std::array<PeriodicLevel, N>& levels,
                                           double u0, double u1);

@@ -254,7 +254,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
     }
   } while (polled == kPollBatch);
 
-  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+  flushRecordingLocked();
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
@@ -399,21 +399,22 @@ std::string Device::recordingError() {
   return recorder_.error();
 }
 
+void Device::flushRecordingLocked() {
+  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+}
+
 void Device::haltInOrder() {
   std::lock_guard<PiMutex> lock(stateMutex_);  // pumps hold it: none is under way, none after
   halted_.store(true);
   applyOffRequestLocked(nowS());
-  if (!recorder_.flush() && recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
+  flushRecordingLocked();
 }
 
 void Device::emergencyOff() noexcept {
   halted_.store(true);
   // A pump running on another thread may still command a force and write records: let it
   // finish first, for at most 50 ms (the handler may be running on that very thread).
-  const int64_t startNs = monotonicNanosecondsFromSignal();
-  while (pumping_.load()) {
-    if (monotonicNanosecondsFromSignal() - startNs > 50000000) break;
-  }
+  spinUntilFromSignal([this] { return !pumping_.load(); }, 50000000);
   force_->driveOffFromSignal();
   // The board's off set-point is queued for its event thread; if the process dies first, the
   // board's own watchdog turns the current off 20 ms after the last frame (PROTOCOL.md).

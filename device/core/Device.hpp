@@ -146,6 +146,8 @@ class Device {
   void pumpLocked(double nowS, double scheduledS);
   // requestOff() in the pump: the frames not sent dropped, the magnet off, the off recorded.
   void applyOffRequestLocked(double nowS);
+  // Hands the recording's new lines to its writer; a recording that failed is posted, once.
+  void flushRecordingLocked();
   void threadMain();
   // The device thread caught an exception from a backend: magnet off, recording closed.
   void failThread(const char* what) noexcept;

@@ -189,9 +189,7 @@ bool RecordingWriter::writeOut(const std::string& data) {
 
 int RecordingWriter::sealFromSignal() {
   sealed_.store(true);
-  const int64_t startNs = monotonicNanosecondsFromSignal();
-  while (writesUnderWay_.load() > 0 && monotonicNanosecondsFromSignal() - startNs < 50000000) {
-  }
+  spinUntilFromSignal([this] { return writesUnderWay_.load() == 0; }, 50000000);
   return fileDescriptor();
 }
 

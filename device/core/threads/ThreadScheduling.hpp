@@ -96,6 +96,16 @@ std::thread startThreadWithAsyncSignalsBlocked(std::function<void()> work);
 // The monotonic clock in ns, callable from a signal handler (async-signal-safe).
 int64_t monotonicNanosecondsFromSignal();
 
+// Async-signal-safe: spins until done() or timeoutNs on the monotonic clock, for the exit paths
+// that wait on another thread's work and may be running on that very thread. False on timeout.
+template <class Done>
+bool spinUntilFromSignal(Done done, int64_t timeoutNs) {
+  const int64_t startNs = monotonicNanosecondsFromSignal();
+  while (!done())
+    if (monotonicNanosecondsFromSignal() - startNs > timeoutNs) return false;
+  return true;
+}
+
 // "SCHED_FIFO 66, memory locked" / "normal priority (realtime refused)" / "not started"; on
 // Windows "time-critical" for the realtime class.
 std::string describe(const ThreadScheduling& s);
