@@ -25,7 +25,7 @@
 
 #include <cstdint>
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

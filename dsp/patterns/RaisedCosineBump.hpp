@@ -16,7 +16,7 @@
 // k omega >= 2 <= 2 / (3 pi omega^2 k^3).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

@@ -10,7 +10,7 @@
 // sharpness, PatternTravel.hpp's sharpHarmonic: the smaller of the two bounds' kSharp).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

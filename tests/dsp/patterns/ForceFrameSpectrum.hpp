@@ -9,7 +9,7 @@
 #include <complex>
 #include <vector>
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::spectrum {
 

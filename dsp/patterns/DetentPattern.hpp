@@ -12,7 +12,7 @@
 // crest: as sharp as a hard edge; PatternTravel.hpp's sharpHarmonic).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

@@ -4,14 +4,14 @@
 // DetentPattern, TexturePattern, SpeedFriction). Nothing here allocates.
 #pragma once
 
-#include "DetentPattern.hpp"
-#include "GratingPattern.hpp"
-#include "GridBumpsPattern.hpp"
-#include "HeightSlopePattern.hpp"
 #include "PaperProfile.hpp"
-#include "PatternTravel.hpp"
-#include "SpeedFriction.hpp"
-#include "TexturePattern.hpp"
+#include "patterns/DetentPattern.hpp"
+#include "patterns/GratingPattern.hpp"
+#include "patterns/GridBumpsPattern.hpp"
+#include "patterns/HeightSlopePattern.hpp"
+#include "patterns/PatternTravel.hpp"
+#include "patterns/SpeedFriction.hpp"
+#include "patterns/TexturePattern.hpp"
 
 namespace kf::patterns {
 

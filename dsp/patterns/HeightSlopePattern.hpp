@@ -16,7 +16,7 @@
 // [0, 1]; held while the travel is below kMinTravelMm (the puck at rest keeps its force).
 #pragma once
 
-#include "RaisedCosineBump.hpp"
+#include "patterns/RaisedCosineBump.hpp"
 
 namespace kf::patterns {
 

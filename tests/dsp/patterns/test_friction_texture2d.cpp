@@ -1,4 +1,4 @@
-// FrictionPattern's texture2D (dsp/TexturePattern in 2D) against its definition, written again
+// FrictionPattern's texture2D (dsp/patterns/TexturePattern in 2D) against its definition, written again
 // here: 32 plane waves, per wave |f| in [lo, hi], angle and phase drawn by splitmix64 from the seed;
 // level = clamp(1/2 + a * sum_k sin(2 pi f_k.p + phi_k)), a = 1 / (6 sqrt(16)). Moving, each wave
 // is its mean over the frame's straight travel, faded on its own temporal frequency |f_k.v|.
@@ -11,8 +11,8 @@
 #include <limits>
 #include <vector>
 
-#include "FrictionPatternCore.hpp"
 #include "PlanePaths.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 using namespace kf::patterns;
 

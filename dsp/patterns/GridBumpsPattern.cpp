@@ -1,4 +1,4 @@
-#include "GridBumpsPattern.hpp"
+#include "patterns/GridBumpsPattern.hpp"
 
 namespace kf::patterns {
 

@@ -41,7 +41,7 @@
 // travel (periodicMean's short-travel case).
 #pragma once
 
-#include "RaisedCosineBump.hpp"
+#include "patterns/RaisedCosineBump.hpp"
 
 namespace kf::patterns {
 

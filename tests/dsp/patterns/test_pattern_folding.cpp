@@ -10,10 +10,10 @@
 #include <functional>
 #include <vector>
 
-#include "DetentPattern.hpp"
-#include "GratingPattern.hpp"
-#include "GridBumpsPattern.hpp"
-#include "HeightSlopePattern.hpp"
+#include "patterns/DetentPattern.hpp"
+#include "patterns/GratingPattern.hpp"
+#include "patterns/GridBumpsPattern.hpp"
+#include "patterns/HeightSlopePattern.hpp"
 
 using namespace kf::patterns;
 

@@ -1,4 +1,4 @@
-#include "DetentPattern.hpp"
+#include "patterns/DetentPattern.hpp"
 
 namespace kf::patterns {
 

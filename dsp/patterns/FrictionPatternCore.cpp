@@ -1,4 +1,4 @@
-#include "FrictionPatternCore.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 namespace kf::patterns {
 

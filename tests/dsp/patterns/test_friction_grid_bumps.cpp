@@ -1,4 +1,4 @@
-// FrictionPattern's bumps2D (dsp/GridBumpsPattern) against its definition, written again here:
+// FrictionPattern's bumps2D (dsp/patterns/GridBumpsPattern) against its definition, written again here:
 // h(x, y) = b(x) b(y), b a raised-cosine bump of width w from 0 in every spacing; the climb
 // counted per axis, level = (|ux| (pi / wx) c_x(x) b(y) + |uy| b(x) (pi / wy) c_y(y)) / (pi / w)
 // (c: the one-axis bump's climb in the sign of that velocity component, over its steepest slope).
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "ForceFrameSpectrum.hpp"
-#include "FrictionPatternCore.hpp"
 #include "PlanePaths.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 using namespace kf::patterns;
 

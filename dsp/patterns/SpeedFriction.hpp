@@ -7,7 +7,7 @@
 //   its speed falls below stickSpeed <= slipSpeed (the hysteresis between the two).
 #pragma once
 
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

@@ -1,4 +1,4 @@
-#include "RaisedCosineBump.hpp"
+#include "patterns/RaisedCosineBump.hpp"
 
 namespace kf::patterns {
 

@@ -1,4 +1,4 @@
-#include "HeightSlopePattern.hpp"
+#include "patterns/HeightSlopePattern.hpp"
 
 namespace kf::patterns {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "ForceFrameSpectrum.hpp"
-#include "FrictionPatternCore.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 using namespace kf::patterns;
 

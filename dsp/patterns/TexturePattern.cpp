@@ -1,4 +1,4 @@
-#include "TexturePattern.hpp"
+#include "patterns/TexturePattern.hpp"
 
 namespace kf::patterns {
 

@@ -1,4 +1,4 @@
-#include "SpeedFriction.hpp"
+#include "patterns/SpeedFriction.hpp"
 
 namespace kf::patterns {
 

@@ -1,4 +1,4 @@
-#include "PatternTravel.hpp"
+#include "patterns/PatternTravel.hpp"
 
 namespace kf::patterns {
 

@@ -1,4 +1,4 @@
-#include "GratingPattern.hpp"
+#include "patterns/GratingPattern.hpp"
 
 namespace kf::patterns {
 
