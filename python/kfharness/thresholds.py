@@ -34,7 +34,7 @@ var eventJson = { |e| "{" ++ e.keys.asArray.sort.collect { |k|
 		if(v.isNil) { "null" } { v.asString.asCompileString } })
 }.join(", ") ++ "}" };
 procedures.pairsDo { |name, spec|
-	%(runs)d.do { |run|
+	spec[2].do { |run|
 		var seed = %(seed)d + (run * 7919), estimates = (), procedure = spec[0].value(seed + 1);
 		observer.value(seed).runProcedure(procedure, { |p, n|
 			if(spec[1].includes(n)) { estimates[n] = p.estimate }
@@ -55,11 +55,13 @@ def _observer_code(observer):
     return ("{ |seed| FrictionObserver(%(threshold)r, %(slope)r, %(lapse)r, %(guess)r, seed) }" % observer)
 
 
-def simulate(names, runs, work_path, seed=1000, observer=OBSERVER, timeout=1800, include_paths=None):
-    """Runs each named procedure `runs` times against the observer; returns the runs' records."""
+def simulate(runs, work_path, seed=1000, observer=OBSERVER, timeout=1800, include_paths=None):
+    """Runs each procedure named in `runs` (name: number of runs) against the observer, in one
+    sclang; returns the runs' records."""
     procedures = "[" + ", ".join(
-        f"{sclang.sc_string(name)}, [{{ |seed| {PROCEDURES[name][0]} }}, {PROCEDURES[name][1]}]" for name in names) + "]"
+        f"{sclang.sc_string(name)}, [{{ |seed| {PROCEDURES[name][0]} }}, {PROCEDURES[name][1]}, {count}]"
+        for name, count in runs.items()) + "]"
     code = SCRIPT % dict(observer=_observer_code(observer), procedures=procedures, out=sclang.sc_string(work_path),
-                         runs=runs, seed=seed)
+                         seed=seed)
     sclang.run_script(code, timeout=timeout, name="thresholds", include_paths=include_paths)
     return [json.loads(line) for line in open(work_path)]
