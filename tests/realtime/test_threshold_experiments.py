@@ -1,0 +1,134 @@
+"""The ready-made threshold experiments (FrictionThreshold) on a realtime server with a simulated
+device whose hand strokes back and forth: their trials with a model observer, what each interval
+put on the device (read back from the device's recording), answers from the keys (given from code,
+as a window would) and from the puck's buttons (a replayed recording that presses them)."""
+import numpy as np
+
+from kfharness import paths, readers, sclang
+
+INTERVAL_S, GAP_S = 0.5, 0.15
+TRIAL_FIELDS = ["trial", "level", "target", "answer", "correct", "startS", "interval1S", "interval2S", "answerS"]
+
+POST_TRIAL = r"""{ |t| ("KF-TRIAL " ++ [%s].collect { |k| t[k] }.join(" ")).postln }""" % ", ".join(
+    "\\" + f for f in TRIAL_FIELDS)
+
+
+def trials(run, tag="KF-TRIAL "):
+    out = []
+    for fields in run.lines(tag):
+        row = dict(zip(TRIAL_FIELDS, fields))
+        out.append({k: (v == "true" if k == "correct" else float(v)) for k, v in row.items()})
+    return out
+
+
+def intervals_of(path):
+    """The recording's force frames split where they stop (between intervals no FrictionOut
+    runs): per interval the frames' host times, commanded forces, and the puck's x (mm) then."""
+    header, records = readers.read_session(path)
+    count_mm = float(header.get("countMm", 0.021))
+    reports = np.array([r for tag, r in records if tag == "R"])
+    frames = np.array([f for tag, f in records if tag == "F"])
+    x_mm = np.interp(frames[:, 0], reports[:, 0], np.cumsum(reports[:, 2]) * count_mm)
+    cuts = np.flatnonzero(np.diff(frames[:, 0]) > 0.05) + 1
+    return [(t, f, x) for t, f, x in zip(np.split(frames[:, 0], cuts), np.split(frames[:, 3], cuts),
+                                          np.split(x_mm, cuts))]
+
+
+def check_trial_events(rows, count):
+    assert len(rows) == count
+    assert [r["trial"] for r in rows] == list(range(1, count + 1))
+    for r in rows:
+        assert r["target"] in (1, 2) and r["answer"] in (1, 2)
+        assert r["correct"] == (r["answer"] == r["target"])
+        # Sclang's logical times: the second interval starts one interval and one gap after the
+        # first, exactly (the waits are logical), and the answer comes after both.
+        assert abs(r["interval2S"] - r["interval1S"] - (INTERVAL_S + GAP_S)) < 1e-6
+        assert r["answerS"] >= r["interval2S"] + INTERVAL_S + GAP_S - 1e-6
+
+
+def test_force_and_grating_experiments_with_an_observer(jack):
+    force_path, grating_path = paths.work_dir() / "threshold-force.kfs", paths.work_dir() / "threshold-grating.kfs"
+    run = sclang.require_ok(sclang.run_with_server(rf"""
+        var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80)), e, estimate;
+        dev.record("{force_path}");
+        e = FrictionThreshold.force(FrictionConstantStimuli([0.1, 0.4], 2, seed: 1), 0.3, {INTERVAL_S}, {GAP_S}, seed: 3);
+        estimate = e.run(dev, FrictionObserver(0.2, 3.5, 0.02, seed: 4), {POST_TRIAL});
+        "KF-FORCE-ESTIMATE %".format(estimate.threshold.notNil).postln;
+        dev.record(nil);
+        0.2.wait;
+        dev.record("{grating_path}");
+        e = FrictionThreshold.grating(FrictionStaircase(2, 2, [0.2], \log, 10, 3), 2, 0.5, 0.14, 0.8,
+            {INTERVAL_S}, {GAP_S}, seed: 5);
+        e.run(dev, FrictionObserver(1, 3.5, 0.02, seed: 6), {POST_TRIAL.replace("KF-TRIAL", "KF-GRATING")},
+            {{ |est| "KF-ONEND %".format(est.threshold.round(1e-9)).postln }});
+        dev.record(nil);
+        0.2.wait;
+        "KF-EVENT %".format(e.asEvent[\kind]).postln;
+        dev.close;
+    """, jack, name="threshold", timeout=120))
+    force = trials(run)
+    check_trial_events(force, 4)
+    assert sorted(r["level"] for r in force) == [0.1, 0.1, 0.4, 0.4]
+    assert run.lines("KF-FORCE-ESTIMATE ") == [["true"]]
+    # Each interval held the force it should: 0.3 N in the reference, 0.3 N + level in the target
+    # (the median of its frames: the slew limit's 2000 N/s reaches it within 0.2 ms).
+    parts = intervals_of(force_path)
+    assert len(parts) == 8, [len(p[0]) for p in parts]
+    for i, (times, commanded, _) in enumerate(parts):
+        trial = force[i // 2]
+        want = 0.3 + (trial["level"] if i % 2 + 1 == trial["target"] else 0)
+        assert abs(np.median(commanded) - want) < 1e-6, (i, np.median(commanded), want)
+        # Each interval lasts intervalS on the device too (one 1 ms frame per ms; the synth's start
+        # and end fall on blocks: a block either way).
+        assert abs(len(times) * 1e-3 - INTERVAL_S) < 0.01, (i, len(times))
+    grating = trials(run, "KF-GRATING ")
+    check_trial_events(grating, 3)
+    assert run.lines("KF-ONEND ") and run.lines("KF-EVENT ") == [["grating"]]
+    # Each interval's grating: the period is twice the travel between the force's switches
+    # (duty 0.5), 2 mm in the reference and 2 + level mm in the target, within 15 % (the
+    # switches fall on 1 ms frames: at <= 80 mm/s, 0.08 mm of a half period of >= 1 mm).
+    for i, (times, commanded, x) in enumerate(intervals_of(grating_path)):
+        trial = grating[i // 2]
+        want = 2 + (trial["level"] if i % 2 + 1 == trial["target"] else 0)
+        high = commanded > 0.47
+        switches = np.flatnonzero(np.diff(high.astype(int)))
+        travel = np.abs(np.diff(x[switches]))
+        assert len(travel) >= 6, (i, len(travel))
+        assert abs(2 * np.median(travel) / want - 1) < 0.15, (i, 2 * np.median(travel), want)
+
+
+def test_answers_from_keys_and_from_the_puck_buttons(jack):
+    # Buttons: a recording whose reports press the left button at 2.4 s and the right at 4.6 s,
+    # replayed; the experiment's trials each wait for a press after their second interval (the
+    # first trial's intervals end 1.3 s after the run starts, the second's 1.3 s after 2.4 s).
+    session = paths.work_dir() / "threshold-buttons.kfs"
+    lines = ["kf-session 1 countMm=0.021 updateRateHz=125"]
+    for i in range(1, 750):
+        t = i * 0.008
+        pressed = 1 if 2.4 <= t < 2.6 else 2 if 4.6 <= t < 4.8 else 0
+        lines.append(f"R {t:.3f} {t:.3f} 1 0 {pressed} 0")
+    session.write_text("\n".join(lines) + "\n")
+    run = sclang.require_ok(sclang.run_with_server(rf"""
+        var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80)), e, keys;
+        e = FrictionThreshold.force(FrictionStaircase(0.4, 2, [0.2], \log, 10, 2), 0.3, {INTERVAL_S}, {GAP_S}, seed: 8);
+        // Keys: the answer given from code, as the window's keyDownAction or a study's window does.
+        keys = fork {{
+            loop {{ 0.1.wait; e.answer(2) }}
+        }};
+        e.run(dev, \keys, {POST_TRIAL});
+        keys.stop;
+        dev.close;
+        dev = FrictionDevice.replay(s, "{session}", 1);
+        e = FrictionThreshold.force(FrictionStaircase(0.4, 2, [0.2], \log, 10, 2), 0.3, {INTERVAL_S}, {GAP_S}, seed: 9);
+        e.run(dev, \buttons, {POST_TRIAL.replace("KF-TRIAL", "KF-BUTTON")});
+        dev.close;
+    """, jack, name="threshold-answers", timeout=120))
+    keys = trials(run)
+    check_trial_events(keys, 2)
+    assert [r["answer"] for r in keys] == [2, 2]
+    buttons = trials(run, "KF-BUTTON ")
+    check_trial_events(buttons, 2)
+    assert [r["answer"] for r in buttons] == [1, 2], buttons
+    # The first press comes at 2.4 s of the replay, after the first trial's 1.3 s of intervals:
+    # the trial waited for it (the replay opened shortly before the run started).
+    assert buttons[0]["answerS"] > 2 * (INTERVAL_S + GAP_S)
