@@ -4,6 +4,7 @@
 // Input: device (slot index).
 #include <algorithm>
 
+#include "AudioClock.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 

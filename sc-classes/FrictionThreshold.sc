@@ -72,7 +72,7 @@ FrictionThreshold {
 	// s from the run's start). out: the first of two output channels (the asynchrony's sound).
 	// Returns the procedure's estimate (and passes it to onEnd).
 	run { |device, answers = \keys, onTrial, onEnd, out = 0|
-		var where = "FrictionThreshold.run", server, def, buffer, startS, level, estimate;
+		var where = "FrictionThreshold.run", server, def, synth, buffer, startS, level, estimate;
 		if(thisThread.isKindOf(Routine).not) { Error("%: call it inside a Routine (fork)".format(where)).throw };
 		if(device.isKindOf(FrictionDevice).not) {
 			Error("%: device must be a FrictionDevice, got %".format(where, device)).throw
@@ -86,19 +86,16 @@ FrictionThreshold {
 		answered = Condition(false);
 		this.prStartAnswers(answers, device);
 		server.sync;
+		server.bind { synth = Synth(def.name, [\out, out, \bufnum, buffer !? _.bufnum ? 0]) };
 		startS = thisThread.seconds;
 		while { (level = procedure.next).notNil } {
 			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
 				target: target, startS: thisThread.seconds - startS);
 			[1, 2].do { |interval|
-				var synth;
 				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
-				server.bind {
-					synth = Synth(def.name, [\level, if(interval == target) { level } { 0 }, \out, out,
-						\bufnum, buffer !? _.bufnum ? 0])
-				};
+				server.bind { synth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
 				intervalS.wait;
-				server.bind { synth.free };
+				server.bind { synth.set(\active, 0) };
 				gapS.wait
 			};
 			trial[\answer] = this.prAwaitAnswer(answers, level, target);
@@ -107,6 +104,7 @@ FrictionThreshold {
 			procedure.respond(level, trial[\correct]);
 			onTrial.value(trial)
 		};
+		server.bind { synth.free };
 		this.prStopAnswers;
 		buffer !? { buffer.free };
 		estimate = procedure.estimate;
