@@ -21,11 +21,12 @@ FrictionThresholdStimuli {
 			// (b) the pilot: the sound delayed by the device's audioDelay (with the force) plus the
 			// level (ms) in the target: sound that far behind the force.
 			\asynchrony, {
-				var delayS = if(device.isKindOf(FrictionDevice)) { device.audioDelay } { FrictionPilot.paperAudioDelayS };
+				var delayS = if(device.isKindOf(FrictionDevice)) { device.audioDelay } {
+					FrictionPilot.paperAudioDelayS };
 				SynthDef(name, {
-					var active = \active.kr(0);
-					var p = FrictionPilot.ar(index, \bufnum.kr(0), settings[\samplesPerMm], 0, active, settings[\amp] * active,
-						(delayS + (\level.kr(0) / 1000)).clip(0, maxAsynchronyS), maxAudioDelay: maxAsynchronyS);
+					var active = \active.kr(0), delay = (delayS + (\level.kr(0) / 1000)).clip(0, maxAsynchronyS);
+					var p = FrictionPilot.ar(index, \bufnum.kr(0), settings[\samplesPerMm], 0, active,
+						settings[\amp] * active, delay, maxAudioDelay: maxAsynchronyS);
 					Out.ar(\out.kr(0), p[\delayedAudio] ! 2)
 				})
 			},
