@@ -105,6 +105,8 @@ FrictionThreshold {
 			onTrial.value(trial)
 		};
 		server.bind { synth.free };
+		// The bundles play server.latency after they are sent: the synth is gone when run returns.
+		(server.latency ? 0).wait;
 		this.prStopAnswers;
 		buffer !? { buffer.free };
 		estimate = procedure.estimate;

@@ -65,8 +65,6 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         e = FrictionThreshold.force(FrictionConstantStimuli([0.1, 0.4], 2, seed: 1), 0.3, {INTERVAL_S}, {GAP_S}, seed: 3);
         estimate = e.run(dev, FrictionObserver(0.2, 3.5, 0.02, seed: 4), {POST_TRIAL});
         "KF-FORCE-ESTIMATE %".format(estimate.threshold.notNil).postln;
-        // The run's last bundles play s.latency after it returns.
-        (s.latency + 0.1).wait;
         dev.record(nil);
         0.2.wait;
         dev.record("{grating_path}");
@@ -74,7 +72,6 @@ def test_force_and_grating_experiments_with_an_observer(jack):
             {INTERVAL_S}, {GAP_S}, seed: 5);
         e.run(dev, FrictionObserver(1, 3.5, 0.02, seed: 6), {POST_TRIAL.replace("KF-TRIAL", "KF-GRATING")},
             {{ |est| "KF-ONEND %".format(est.threshold.round(1e-9)).postln }});
-        (s.latency + 0.1).wait;
         dev.record(nil);
         0.2.wait;
         "KF-EVENT %".format(e.asEvent[\kind]).postln;
