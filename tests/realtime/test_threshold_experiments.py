@@ -24,8 +24,8 @@ def trials(run, tag="KF-TRIAL "):
 def intervals_of(path):
     """The recording's force frames split into intervals: one synth plays a run and requests 0 N
     between intervals (the frames read the device's minimum, 0.14 N), 0.2 N or more during them
-    (the tests' forces). Per interval: the frames' host times, commanded forces, and the puck's x
-    (mm) then."""
+    (the tests' forces). Per interval: the frames' host times (when the device thread sent them
+    to the magnet), commanded forces, and the puck's x (mm) then."""
     header, records = readers.read_session(path)
     count_mm = float(header.get("countMm", 0.021))
     reports = np.array([r for tag, r in records if tag == "R"])
@@ -77,6 +77,14 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         "KF-EVENT %".format(e.asEvent[\kind]).postln;
         dev.close;
     """), jack, name="threshold", timeout=120))
+    # How long an interval lasted at the magnet: the span of its frames' host times (the device
+    # thread's clock when it sent each). Its start and end each fall on a block and a frame at an
+    # edge may not count (4.7 ms together), but on a loaded machine far more: late wake-ups of the
+    # device thread, frames skipped after them, JACK's dummy driver late. Measured here with two
+    # other builds running (load 4 on 2 cores): up to 25 ms short in host time (65 ms in audio
+    # time). A FrictionOut per interval instead of one synth per run cut intervals by 100 ms (its
+    # stale last frame raised the device's release latency). 75 ms tells the two apart.
+    span_tolerance_s = 0.075
     force = trials(run)
     check_trial_events(force, 4)
     assert sorted(r["level"] for r in force) == [0.1, 0.1, 0.4, 0.4]
@@ -89,10 +97,7 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         trial = force[i // 2]
         want = 0.3 + (trial["level"] if i % 2 + 1 == trial["target"] else 0)
         assert abs(np.median(commanded) - want) < 1e-6, (i, np.median(commanded), want)
-        # Each interval lasts intervalS on the device too: one 1 ms frame per ms; its start and end
-        # each fall on a block (1.33 ms at 48 kHz / 64), and a frame straddling an edge may not
-        # count: 2 x (1.33 + 1) = 4.7 ms at most.
-        assert abs(len(times) * 1e-3 - INTERVAL_S) < 0.0047, (i, len(times))
+        assert abs(times[-1] - times[0] + 1e-3 - INTERVAL_S) < span_tolerance_s, (i, times[-1] - times[0])
     grating = trials(run, "KF-GRATING ")
     check_trial_events(grating, 3)
     assert run.lines("KF-ONEND ") and run.lines("KF-EVENT ") == [["grating"]]
@@ -101,7 +106,7 @@ def test_force_and_grating_experiments_with_an_observer(jack):
     parts = intervals_of(grating_path)
     assert len(parts) == 6
     for i, (times, commanded, x) in enumerate(parts):
-        assert abs(len(times) * 1e-3 - INTERVAL_S) < 0.0047, (i, len(times))
+        assert abs(times[-1] - times[0] + 1e-3 - INTERVAL_S) < span_tolerance_s, (i, times[-1] - times[0])
         # (A frame at an interval's edge, or over a grating edge, is a mean of the two: in between.)
         low, high = np.percentile(commanded, [5, 95])
         assert abs(low - 0.2) < 0.005 and abs(high - 0.3) < 0.005, (i, low, high)
