@@ -148,7 +148,7 @@ def tables(th, table):
                  f"{e['cramer_rao_sd_log10']:.4f}")
                 for name, e in th["procedures"].items()]
     fits = table(["trials of", "trials per run", "our fit: bias (log10)", "sd", "psignifit: bias (log10)", "sd",
-                  "median |ours - psignifit| (log10)", "Cramer-Rao sd (log10)"], fit_rows)
+                  "median abs. log10(ours / psignifit)", "Cramer-Rao sd (log10)"], fit_rows)
     return procedures, fits
 
 

@@ -74,7 +74,7 @@ def test_observer_answers_follow_its_function():
 
 # Seeded runs per procedure and the tolerance of the mean of their log10 estimates: 4 standard
 # errors of that mean (chance of a false failure 6e-5), from the run-to-run sd of log10 estimates
-# the bench measured over 200 runs (bench/REPORT.md, "Threshold procedures", at f53337d: QUEST+
+# the bench measured over 200 runs (bench/REPORT.md, "Threshold procedures", at e88ffef: QUEST+
 # 0.053 after 48 trials, constant stimuli 0.029 after 280, staircases 0.073 and 0.050 after 80),
 # plus the bias the theory allows: none for QUEST+ (a posterior mean) and the constant stimuli
 # (maximum likelihood: consistent); for the staircases, the mean of reversals reaches Levitt's
