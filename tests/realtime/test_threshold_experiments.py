@@ -1,7 +1,7 @@
 """The ready-made threshold experiments (FrictionThreshold) on a realtime server with a simulated
 device whose hand strokes back and forth: their trials with a model observer, what each interval
-put on the device (read back from the device's recording), answers from the keys (given from code,
-as a window would) and from the puck's buttons (a replayed recording that presses them)."""
+put on the device (read back from the device's recording), answers from the keys (the experiment's
+window given a key) and from the puck's buttons (a replayed recording that presses them)."""
 import numpy as np
 
 from kfharness import paths, readers, sclang
@@ -127,9 +127,13 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
     run = sclang.require_ok(sclang.run_with_server(on_tempo_clock(rf"""
         var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80)), e, keys;
         e = FrictionThreshold.force(FrictionStaircase(0.4, 2, [0.2], \log, 10, 2), 0.3, {INTERVAL_S}, {GAP_S}, seed: 8);
-        // Keys: the answer given from code, as the window's keyDownAction or a study's window does.
+        // Keys: the experiment's window (Qt, offscreen) gets the key 2, as a participant presses it.
         keys = fork {{
-            loop {{ 0.1.wait; e.answer(2) }}
+            loop {{
+                0.1.wait;
+                defer {{ Window.allWindows.detect {{ |w| w.name == "Which interval? 1 or 2" }} !? {{ |w|
+                    w.view.keyDown($2) }} }}
+            }}
         }};
         e.run(dev, \keys, {POST_TRIAL});
         keys.stop;
