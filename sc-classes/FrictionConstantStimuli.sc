@@ -11,6 +11,14 @@ FrictionConstantStimuli {
 		^super.new.prInit(levels, repeats, seed, grid)
 	}
 
+	// The grid fitted when none is given: 80 thresholds from half the lowest level to twice the
+	// highest (log scale), slopes 1 to 8, lapse rates 0 to 0.05. Its p(correct) per level is worked
+	// out once per grid: runs that share one (simulations) pass it as grid.
+	*defaultGrid { |levels|
+		^FrictionPsychometricGrid(FrictionPsychometric.logLevels(levels.minItem / 2, levels.maxItem * 2, 80),
+			#[1, 1.5, 2, 2.5, 3, 3.5, 4, 5, 6, 8], #[0, 0.01, 0.02, 0.03, 0.04, 0.05])
+	}
+
 	prInit { |argLevels, argRepeats, argSeed, argGrid|
 		var where = "FrictionConstantStimuli";
 		if(argLevels.isSequenceableCollection.not or: { argLevels.isEmpty }) {
@@ -23,10 +31,7 @@ FrictionConstantStimuli {
 		levels = argLevels.asArray;
 		repeats = argRepeats;
 		seed = argSeed ?? { 2147483647.rand };
-		grid = argGrid ?? {
-			FrictionPsychometricGrid(FrictionPsychometric.logLevels(levels.minItem / 2, levels.maxItem * 2, 80),
-				#[1, 1.5, 2, 2.5, 3, 3.5, 4, 5, 6, 8], #[0, 0.01, 0.02, 0.03, 0.04, 0.05])
-		};
+		grid = argGrid ?? { this.class.defaultGrid(levels) };
 		order = FrictionObserver.randomSource(seed).next({ (levels ! repeats).flatten.scramble });
 		trials = [];
 	}

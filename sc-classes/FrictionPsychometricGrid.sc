@@ -6,7 +6,7 @@ FrictionPsychometricGrid {
 	var <thresholds, <slopes, <lapses, <guess;
 	// Per grid point: its threshold, slope and lapse (Arrays of the grid's size).
 	var <thresholdOf, <slopeOf, <lapseOf;
-	var <logPosterior, probabilitiesAt;
+	var <logPosterior, probabilitiesAt, logSignalsAt;
 
 	*new { |thresholds, slopes, lapses, guess = 0.5|
 		^super.new.prInit(thresholds, slopes, lapses, guess)
@@ -26,6 +26,7 @@ FrictionPsychometricGrid {
 			thresholdOf.add(t); slopeOf.add(b); lapseOf.add(l)
 		} } };
 		probabilitiesAt = Dictionary.new;
+		logSignalsAt = Dictionary.new;
 		this.reset
 	}
 
@@ -69,15 +70,26 @@ FrictionPsychometricGrid {
 	// The posterior (an Array summing to 1).
 	posterior { ^logPosterior.exp }
 
-	// The log-likelihood of counts: correct[i] of total[i] trials right at levels[i] (the
-	// grid's own posterior is not used).
+	// The log-likelihood of counts: correct[i] of total[i] trials right at levels[i], for every grid
+	// point (a Signal: float sums, made of primitive calls; a few ulp of a log-likelihood do not
+	// move its maximum). The grid's own posterior is not used.
 	logLikelihoodOf { |levels, correct, total|
-		var sum = 0;
+		var sum = Signal.newClear(this.size);
 		levels.do { |level, i|
-			var p = this.probabilities(level);
-			sum = sum + (this.prLogOf(p) * correct[i]) + (this.prLogOf(1 - p) * (total[i] - correct[i]))
+			var logs = this.prLogSignalsAt(level);
+			sum = sum + (logs[0] * correct[i]) + (logs[1] * (total[i] - correct[i]))
 		};
 		^sum
+	}
+
+	// [log p, log(1 - p)] at level for every grid point, as Signals, kept per level.
+	prLogSignalsAt { |level|
+		^logSignalsAt[level] ?? {
+			var p = this.probabilities(level);
+			var logs = [Signal.newFrom(this.prLogOf(p)), Signal.newFrom(this.prLogOf(1 - p))];
+			logSignalsAt[level] = logs;
+			logs
+		}
 	}
 
 	// An Event of the parameters: \mean (posterior means, and the threshold's posterior sd) or

@@ -21,7 +21,9 @@ CONSTANT_LEVELS = "[0.45, 0.6, 0.75, 0.9, 1.1, 1.35, 1.7]"
 
 # name: (sclang making the procedure from `seed`, the checkpoints: numbers of trials).
 PROCEDURES = {
-    "constant": (f"FrictionConstantStimuli({CONSTANT_LEVELS}, 40, seed)", [70, 140, 280]),
+    # One grid for all runs: its p(correct) per level is worked out once.
+    "constant": (f"FrictionConstantStimuli({CONSTANT_LEVELS}, 40, seed, ~kfGrid ?? {{ ~kfGrid = "
+                 f"FrictionConstantStimuli.defaultGrid({CONSTANT_LEVELS}) }})", [70, 140, 280]),
     "staircase 1-up-2-down": ("FrictionStaircase(2, 2, [0.2, 0.1, 0.05], \\log, 1000, 80)", [20, 40, 80]),
     "staircase 1-up-3-down": ("FrictionStaircase(2, 3, [0.2, 0.1, 0.05], \\log, 1000, 80)", [20, 40, 80]),
     "questplus": (f"FrictionQuestPlus({QUEST_LEVELS}, maxTrials: 48)", [12, 24, 48]),
