@@ -72,7 +72,7 @@ FrictionThreshold {
 	// s from the run's start). out: the first of two output channels (the asynchrony's sound).
 	// Returns the procedure's estimate (and passes it to onEnd).
 	run { |device, answers = \keys, onTrial, onEnd, out = 0|
-		var where = "FrictionThreshold.run", server, def, synth, buffer, startS, level, estimate;
+		var where = "FrictionThreshold.run", server, def, synth, buffer, loaded, startS, level, estimate;
 		if(thisThread.isKindOf(Routine).not) { Error("%: call it inside a Routine (fork)".format(where)).throw };
 		if(device.isKindOf(FrictionDevice).not) {
 			Error("%: device must be a FrictionDevice, got %".format(where, device)).throw
@@ -82,7 +82,12 @@ FrictionThreshold {
 		};
 		server = FrictionCheck.serverRunning(device.server, where);
 		def = FrictionThresholdStimuli.synthDef(kind, device, settings).add;
-		if(kind == \asynchrony) { buffer = FrictionPilot.loadSignal(server) };
+		if(kind == \asynchrony) {
+			// The signal is sent in parts: the run starts once all of it is on the server.
+			loaded = Condition(false);
+			buffer = FrictionPilot.loadSignal(server, { loaded.test = true; loaded.signal });
+			loaded.wait
+		};
 		answered = Condition(false);
 		this.prStartAnswers(answers, device);
 		server.sync;

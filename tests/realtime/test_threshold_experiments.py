@@ -75,6 +75,9 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         dev.record(nil);
         0.2.wait;
         "KF-EVENT %".format(e.asEvent[\kind]).postln;
+        e = FrictionThreshold.asynchrony(FrictionQuestPlus([5, 10, 20, 40], maxTrials: 2), \mapping2, 0.3,
+            {INTERVAL_S}, {GAP_S}, seed: 7);
+        e.run(dev, FrictionObserver(15, 3.5, 0.02, seed: 8), {POST_TRIAL.replace("KF-TRIAL", "KF-ASYNC")});
         dev.close;
     """), jack, name="threshold", timeout=120))
     # How long an interval lasted at the magnet: the span of its frames' host times (the device
@@ -98,6 +101,8 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         want = 0.3 + (trial["level"] if i % 2 + 1 == trial["target"] else 0)
         assert abs(np.median(commanded) - want) < 1e-6, (i, np.median(commanded), want)
         assert abs(times[-1] - times[0] + 1e-3 - INTERVAL_S) < span_tolerance_s, (i, times[-1] - times[0])
+    # The asynchrony experiment: its trials (what it plays: test_threshold_stimuli_nrt.py).
+    check_trial_events(trials(run, "KF-ASYNC "), 2)
     grating = trials(run, "KF-GRATING ")
     check_trial_events(grating, 3)
     assert run.lines("KF-ONEND ") and run.lines("KF-EVENT ") == [["grating"]]
