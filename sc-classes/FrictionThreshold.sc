@@ -8,6 +8,8 @@
 // (how late the sound may come after the force, ms) and *grating (a grating period difference, mm).
 FrictionThreshold {
 	var <kind, <procedure, <settings, <intervalS, <gapS, <seed;
+	// false: with \keys, no window of its own; the answers come through `answer` (a study's window).
+	var <>showKeysWindow = true;
 	var rng, answered, givenAnswer, keysWindow, buttonsResponder, buttonsSynth;
 
 	// base: the reference's force (N) above which the target adds the level.
@@ -143,14 +145,14 @@ FrictionThreshold {
 	prStartAnswers { |answers, device|
 		switch(answers,
 			\keys, {
-				defer {
+				if(showKeysWindow) { defer {
 					keysWindow = Window("Which interval? 1 or 2", Rect(100, 100, 320, 80)).front;
 					StaticText(keysWindow, keysWindow.view.bounds.insetBy(10)).string_(
 						"Press 1 if the first interval was the different one, 2 if the second.");
 					keysWindow.view.keyDownAction = { |view, char|
 						case { char == $1 } { this.answer(1) } { char == $2 } { this.answer(2) }
 					}
-				}
+				} }
 			},
 			\buttons, {
 				buttonsResponder = OSCFunc({ |msg| this.answer(msg[3].asInteger) }, '/kfThresholdButton',

@@ -142,6 +142,18 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
         }};
         e.run(dev, \keys, {POST_TRIAL});
         keys.stop;
+        // No window of its own: the answer through `answer`, as a study's window gives it.
+        e = FrictionThreshold.force(FrictionStaircase(0.4, 2, [0.2], \log, 10, 1), 0.3, {INTERVAL_S}, {GAP_S}, seed: 10);
+        e.showKeysWindow = false;
+        keys = fork {{
+            loop {{
+                0.1.wait;
+                "KF-WINDOWS %".format(Window.allWindows.count {{ |w| w.name == "Which interval? 1 or 2" }}).postln;
+                e.answer(1)
+            }}
+        }};
+        e.run(dev, \keys, {POST_TRIAL.replace("KF-TRIAL", "KF-CODE")});
+        keys.stop;
         dev.close;
         dev = FrictionDevice.replay(s, "{session}", 1);
         e = FrictionThreshold.force(FrictionStaircase(0.4, 2, [0.2], \log, 10, 2), 0.3, {INTERVAL_S}, {GAP_S}, seed: 9);
@@ -151,6 +163,9 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
     keys = trials(run)
     check_trial_events(keys, 2)
     assert [r["answer"] for r in keys] == [2, 2]
+    code = trials(run, "KF-CODE ")
+    check_trial_events(code, 1)
+    assert code[0]["answer"] == 1 and {w[0] for w in run.lines("KF-WINDOWS ")} == {"0"}
     buttons = trials(run, "KF-BUTTON ")
     check_trial_events(buttons, 2)
     assert [r["answer"] for r in buttons] == [1, 2], buttons
