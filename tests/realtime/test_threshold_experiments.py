@@ -148,7 +148,7 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
         keys = fork {{
             loop {{
                 0.1.wait;
-                "KF-WINDOWS %".format(Window.allWindows.count {{ |w| w.name == "Which interval? 1 or 2" }}).postln;
+                defer {{ "KF-WINDOWS %".format(Window.allWindows.count {{ |w| w.name == "Which interval? 1 or 2" }}).postln }};
                 e.answer(1)
             }}
         }};
