@@ -7,5 +7,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+# The references of the thresholds part (bench/kfbench/thresholds.py): Debian's QUEST+ and psignifit.
+source scripts/packages.sh
+kf_install_missing python3-questplus psignifit
 source scripts/env.sh
 exec "$KF_PYTHON" bench/run.py "$@"

@@ -9,6 +9,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+# The references the threshold tests compare with (tests/scenes/test_threshold_procedures.py):
+# Debian's QUEST+ and psignifit. For the tests and the bench only: the main jobs do not need them.
+source scripts/packages.sh
+kf_install_missing python3-questplus psignifit
 source scripts/env.sh
 scripts/check.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
