@@ -50,14 +50,16 @@ def chown_tree(path, uid):
 
 
 class User:
-    """Runs commands as `uid` (0: root), with a login's environment: PATH, HOME, LANG."""
+    """Runs commands as `uid` (0: root), with a login's environment: PATH, HOME, LANG. Its HOMEs
+    are made in `base` (removed with it)."""
 
-    def __init__(self, uid):
+    def __init__(self, uid, base):
         self.uid = uid
+        self.base = Path(base)
         self.name = "root" if uid == 0 else f"uid {uid}"
 
     def fresh_home(self):
-        home = Path(tempfile.mkdtemp(prefix=f"kf-home-{self.uid}-"))
+        home = Path(tempfile.mkdtemp(prefix=f"home-{self.uid}-", dir=self.base))
         chown_tree(home, self.uid)
         return home
 

@@ -22,6 +22,7 @@ What the test does with each of the README's blocks, by section:
 A block in any other section fails the test until this test says what to do with it."""
 import os
 import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -66,7 +67,8 @@ def copy():
     path = fresh_copy()
     if os.geteuid() == 0:
         chown_tree(path, UNPRIVILEGED_UID)
-    return path
+    yield path
+    shutil.rmtree(path.parent)  # the copy with its build and the HOMEs beside it: hundreds of MB
 
 
 def users():
@@ -90,7 +92,7 @@ def check_found(found, classes_dir, what):
 def test_the_readmes_lines_install_and_run_as_written(copy, uid):
     if os.geteuid() != 0 and uid != os.geteuid():
         pytest.skip("switching users needs root")
-    user = User(uid if os.geteuid() == 0 else os.geteuid())
+    user = User(uid if os.geteuid() == 0 else os.geteuid(), copy.parent)
 
     # The main job, as the first block writes it.
     (first,) = blocks_of("first")
