@@ -24,6 +24,7 @@ OTHER_LEVEL = 0.25  # what OtherExtensionDC outputs
 
 def user_home():
     """A HOME with the other extension in its Extensions folder (Linux's default place)."""
+    assert OTHER_PLUGIN.is_file(), f"{OTHER_PLUGIN} not built (the OtherExtension target of tests/install)"
     home = Path(tempfile.mkdtemp(prefix="kf-home-", dir=paths.work_dir()))
     other = home / ".local" / "share" / "SuperCollider" / "Extensions" / "OtherExtension"
     (other / "plugins").mkdir(parents=True)
@@ -54,9 +55,12 @@ def test_another_extensions_plugin_loads_beside_ours():
     assert Path(lines["KF-EXTENSIONS"]) == home / ".local/share/SuperCollider/Extensions"
     options = shlex.split(lines["KF-OPTIONS"])
     print("server options:", " ".join(options))
+    server_env = {**{k: v for k, v in os.environ.items() if k not in env}, "HOME": str(home)}
+    if sclang.server_preload():  # a sanitized plugin (scripts/check.sh sanitize-plugin)
+        server_env["LD_PRELOAD"] = sclang.server_preload()
     run = subprocess.run(["scsynth", "-N", str(score_path), "_", str(wav_path), "48000", "WAV", "float", *options],
                          stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                         timeout=120, env={**{k: v for k, v in os.environ.items() if k not in env}, "HOME": str(home)})
+                         timeout=120, env=server_env)
     assert run.returncode == 0, run.stdout[-3000:]
     assert "not installed" not in run.stdout, f"a plugin did not load:\n{run.stdout[-3000:]}"
     data, _ = readers.read_wav(wav_path)
