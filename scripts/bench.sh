@@ -6,9 +6,6 @@
 #   scripts/bench.sh --only timing --only spatial
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
-# The references of the thresholds part (bench/kfbench/thresholds.py): Debian's QUEST+ and psignifit.
-source scripts/packages.sh
-kf_install_missing python3-questplus psignifit
+scripts/setup.sh --all
 source scripts/env.sh
 exec "$KF_PYTHON" bench/run.py "$@"

@@ -8,11 +8,7 @@
 # Extra arguments go to ctest, e.g. scripts/test.sh -R scenes/
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
-# The references the threshold tests compare with (tests/scenes/test_threshold_procedures.py):
-# Debian's QUEST+ and psignifit. For the tests and the bench only: the main jobs do not need them.
-source scripts/packages.sh
-kf_install_missing python3-questplus psignifit
+scripts/setup.sh --all
 source scripts/env.sh
 scripts/check.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"

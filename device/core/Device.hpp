@@ -144,8 +144,9 @@ class Device {
   };
 
   void pumpLocked(double nowS, double scheduledS);
-  // requestOff() in the pump: the frames not sent dropped, the magnet off, the off recorded.
-  void applyOffRequestLocked(double nowS);
+  // requestOff() in the pump (and haltInOrder): the frames not sent dropped, the magnet off, the
+  // off recorded with its cause.
+  void applyOffRequestLocked(double nowS, OffCause cause);
   // Hands the recording's new lines to its writer; a recording that failed is posted, once.
   void flushRecordingLocked();
   void threadMain();

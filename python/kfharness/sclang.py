@@ -70,15 +70,22 @@ def _script_files(code, name):
     return key, code_path
 
 
-def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="script"):
+def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="script", env=None):
     """Runs `code` (synchronous sclang, no server) headless; returns its output. The code succeeds
-    when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok)."""
+    when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok).
+    `env`: extra environment variables (a HOME of its own, say; None removes one)."""
     key, code_path = _script_files(code, name)
     script = paths.work_dir() / f"{key}.scd"
     script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path), program=server_program_code()))
+    run_env = environment()
+    for name, value in (env or {}).items():
+        if value is None:
+            run_env.pop(name, None)
+        else:
+            run_env[name] = value
     proc = subprocess.run(["sclang", "-l", str(config(include_paths)), str(script)],
                           stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          env=environment(), timeout=timeout, text=True, errors="replace")
+                          env=run_env, timeout=timeout, text=True, errors="replace")
     out = proc.stdout
     if expect_ok:
         assert "KF-SCRIPT-OK" in out and proc.returncode == 0, f"sclang failed:\n{out[-4000:]}"

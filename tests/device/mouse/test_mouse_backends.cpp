@@ -122,7 +122,7 @@ TEST_CASE("hidapi backend: a real mouse's whole recording, in real time, sums to
   CHECK(c.measuredRateHz < 1000);
 }
 
-TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid]") {
+TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid][wallclock]") {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.endS = 7.0;
@@ -280,8 +280,8 @@ TEST_CASE("evdev backend: SYN_DROPPED is counted, the broken packet dropped, the
   CHECK(flagged <= api->lastHandle->syncDropped());
 }
 
-TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on request resumes", "[mouse]", FakeHidApi,
-                   FakeEvdevApi) {
+TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on request resumes", "[mouse][wallclock]",
+                   FakeHidApi, FakeEvdevApi) {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.unplugAtS = 0.3;
