@@ -284,20 +284,24 @@ FrictionDevice {
 	}
 
 	prForget { |newState|
-		var held = slots[server];
+		var held = slots[server], holdsBuses = state != \quit;
 		if(held.notNil and: { held[index] === this }) { held[index] = nil };
 		state = newState;
-		busSynths.do { |node| if(server.serverRunning) { node.free } };
+		// A node may be gone already (s.freeAll just before): freed without the server's complaint.
+		if(server.serverRunning and: { busSynths.notEmpty }) {
+			server.sendBundle(nil, ['/error', -1], *busSynths.values.collect { |node| ['/n_free', node.nodeID] })
+		};
 		busSynths = IdentityDictionary.new;
-		forceBus !? { forceBus.free };
+		[forceBus, positionBus].do { |bus| if(holdsBuses and: { bus.notNil }) { bus.free } };
 		forceBus = nil;
-		positionBus !? { positionBus.free };
 		positionBus = nil;
 	}
 
 	// The writer of forceBus (at the tail: it sends the sum played into the bus to the device)
 	// and the reader of positionBus (at the head: the puck for every synth after it), each started
-	// once its bus exists: one synth per role, claimed at once so that it is never started twice.
+	// once its bus exists: one synth per role, claimed at once so that it is never started twice,
+	// and let go when the server ends it (Cmd-., s.freeAll, a quit), so that ServerTree starts it
+	// again, and only then.
 	prStartBusSynths {
 		[
 			[\writer, forceBus, \addToTail, \kfForceWriter,
@@ -310,6 +314,7 @@ FrictionDevice {
 			if(bus.notNil and: { busSynths[role].isNil }) {
 				node = Synth.basicNew(defName, server);
 				busSynths[role] = node;
+				node.onFree { if(busSynths[role] === node) { busSynths.removeAt(role) } };
 				forkIfNeeded {
 					SynthDef(defName, graph).add;
 					server.sync;
@@ -328,20 +333,38 @@ FrictionDevice {
 		FrictionAnswers.failAll(srv, "the server quit");
 	}
 
+	// One device that cannot be opened again never stops the others, nor the rest of SC's boot
+	// sequence (ServerBoot functions run one after another: an error would leave the server
+	// without its default group).
 	*prServerBoot { |srv|
-		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prReopen } } };
+		slots[srv] !? { |held|
+			held.do { |dev|
+				dev !? {
+					try { dev.prReopen } { |error|
+						"FrictionDevice: % was not opened again after the boot: %".format(dev,
+							error.errorString.replace("ERROR: ", "")).error;
+						dev.prForget(\failed);
+					}
+				}
+			}
+		};
 	}
 
 	*prServerTree { |srv|
 		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prRestoreWriter } } };
 	}
 
+	// The server freed the nodes; SC's quit made new bus allocators, so the buses are no longer
+	// held either (prForget must not free their numbers: they may be someone else's now).
 	prQuit { state = \quit; busSynths = IdentityDictionary.new }
 
 	prReopen {
 		if(state != \quit) { ^this };
-		forceBus !? { server.audioBusAllocator.reserve(forceBus.index, 1, false) };
-		positionBus !? { server.controlBusAllocator.reserve(positionBus.index, 4, false) };
+		// The same Bus objects get channels again from the new allocators, as JITLib's proxies do:
+		// whoever holds forceBus or positionBus follows (their numbers may change), and nothing
+		// allocated after the boot can share them. (Reserving the old numbers is not possible:
+		// SC 3.13's ContiguousBlockAllocator:reserve ignores the audio allocator's offset.)
+		[forceBus, positionBus].do { |bus| bus !? { bus.alloc } };
 		state = \opening;
 		FrictionAnswers.sendSequence(server, index, this.prOpenSteps, {
 			state = \open;
@@ -352,12 +375,10 @@ FrictionDevice {
 		}, false);
 	}
 
-	// After Cmd-. (all nodes freed): the force writer and the position reader again.
+	// After Cmd-. or s.freeAll (their nodes ended) and after a boot: the force writer and the
+	// position reader again, those not running (a re-open answered before ServerTree started them).
 	prRestoreWriter {
-		if(state == \open) {
-			busSynths = IdentityDictionary.new;
-			this.prStartBusSynths;
-		};
+		if(state == \open) { this.prStartBusSynths };
 	}
 
 	// In a ProxySpace (~dev = FrictionDevice.sim(s)), the proxy plays the puck's position and

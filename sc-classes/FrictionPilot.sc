@@ -8,7 +8,7 @@ FrictionPilot {
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
-	var <buffer, <synth, <defName, monitorBus, quitAction;
+	var <buffer, <synth, <defName, monitorBus, monitorAllocator, quitAction;
 
 	*initClass {
 		var pilot = KineticFriction.paperPilot, mapping = KineticFriction.paperMapping;
@@ -291,8 +291,17 @@ FrictionPilot {
 
 	// 5 control channels the playing synth writes (position mm, speed mm/s, requested force N,
 	// commanded force N, 1 while running), for FrictionView. Kept for the pilot's life, so a
-	// view keeps reading it across free and play.
-	monitorBus { ^monitorBus ?? { monitorBus = Bus.control(this.server, 5) } }
+	// view keeps reading it across free and play. SC's quit (and a boot's login) makes new bus
+	// allocators, which hold none of the old numbers: the same Bus gets channels again from the
+	// new one, so that nothing allocated after a reboot shares them.
+	monitorBus {
+		var allocator = this.server.controlBusAllocator;
+		if(monitorBus.isNil) { monitorBus = Bus.control(this.server, 5) } {
+			if(monitorAllocator !== allocator) { monitorBus.alloc }
+		};
+		monitorAllocator = allocator;
+		^monitorBus
+	}
 
 	isPlaying { ^synth.notNil }
 
@@ -302,7 +311,7 @@ FrictionPilot {
 	free {
 		synth !? { synth.free };
 		synth = nil;
-		monitorBus !? { monitorBus.setn(0 ! 5) };
+		monitorBus !? { this.monitorBus.setn(0 ! 5) };
 		CmdPeriod.remove(this);
 		quitAction !? { ServerQuit.remove(quitAction, this.server) };
 		quitAction = nil;
