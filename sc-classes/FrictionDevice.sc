@@ -1,8 +1,9 @@
 // One device slot of a server: a simulated friction device, a replay of a recorded session, or
 // hardware: a real mouse (hidapi or evdev, FrictionDeviceMouse.sc) as the puck's sensor, and the
 // friction board (libusb, FrictionDeviceBoard.sc) driving its magnet. Every command has a ...Msg
-// twin that returns the OSC message, so the same device can be used in a Score (pass server nil
-// to only describe it). The server's answers to the commands are FrictionAnswers' business.
+// twin that returns the OSC message, so the same device can be used in a Score: describeSim,
+// describeReplay and describeMouse make a device without opening it. A nil server is
+// Server.default, as everywhere in SC. The server's answers to the commands are FrictionAnswers'.
 FrictionDevice {
 	classvar <oldSpecNames;
 	// The devices sclang holds open, by server and slot.
@@ -57,26 +58,27 @@ FrictionDevice {
 		^if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default }
 	}
 
-	// hand: a FrictionHand (nil: the puck stays put). profile: an Event of spec or simulation
-	// settings by name (e.g. (maxForceN: 1.0, puckMassKg: 0.2)); nil: the paper's numbers.
-	// replace: true closes a device open in the slot; false (the default) refuses the slot.
+	// server: a running Server (nil: Server.default). hand: a FrictionHand (nil: the puck stays
+	// put). profile: an Event of spec or simulation settings by name (e.g. (maxForceN: 1.0,
+	// puckMassKg: 0.2)); nil: the paper's numbers. replace: true closes a device open in the slot;
+	// false (the default) refuses the slot.
 	*sim { |server, index = 0, hand, profile, replace = false|
-		if(hand.notNil and: { hand.isKindOf(FrictionHand).not }) {
-			Error("FrictionDevice.sim: hand must be a FrictionHand or nil, got %".format(hand)).throw
-		};
-		^this.new.prInit(server, index, \sim, hand, profile, replace).prOpen
+		^this.prSim(server ? Server.default, index, hand, profile, replace, "sim").prOpen
+	}
+	// The same device described only, on no server: its ...Msg methods for a Score.
+	*describeSim { |index = 0, hand, profile, replace = false|
+		^this.prSim(nil, index, hand, profile, replace, "describeSim")
 	}
 
 	// path: a kf-session recording (FrictionDevice.record) or a hid-recorder .hid file.
 	*replay { |server, path, index = 0, profile, replace = false|
-		if(path.isString.not) {
-			Error("FrictionDevice.replay: path must be a String, got %".format(path)).throw
-		};
-		path = path.standardizePath;
-		if(server.notNil and: { File.exists(path).not }) {
-			Error("FrictionDevice.replay: no such file: %".format(path)).throw
-		};
-		^this.new.prInit(server, index, \replay, path, profile, replace).prOpen
+		path = this.prReplayPath(path, "replay");
+		if(File.exists(path).not) { Error("FrictionDevice.replay: no such file: %".format(path)).throw };
+		^this.new.prInit(server ? Server.default, index, \replay, path, profile, replace).prOpen
+	}
+	// Described only (for a Score, which may write the file before it plays it).
+	*describeReplay { |path, index = 0, profile, replace = false|
+		^this.new.prInit(nil, index, \replay, this.prReplayPath(path, "describeReplay"), profile, replace)
 	}
 
 	// A real mouse and the friction board with its calibration, opened as one device: one answer
@@ -90,7 +92,7 @@ FrictionDevice {
 	// failed part is undone by one kfClose; a composite would repeat the mouse's and the board's
 	// arguments and stages in the plugin for the same outcome. See ARCHITECTURE.md.
 	*hardware { |server, mouse, board, profile, calibration, index = 0, backend, grab = false, replace = false|
-		^this.new.prInitMouse(server, index, mouse, backend, profile, grab, replace)
+		^this.new.prInitMouse(server ? Server.default, index, mouse, backend, profile, grab, replace)
 		.prInitBoard(board, calibration, "FrictionDevice.hardware").prOpen
 	}
 
@@ -206,6 +208,18 @@ FrictionDevice {
 	closeMsg { ^['/cmd', \kfClose, index] }
 
 	printOn { |stream| stream << this.class.name << "(" << kind << ", " << index << ")" }
+
+	*prSim { |server, index, hand, profile, replace, method|
+		if(hand.notNil and: { hand.isKindOf(FrictionHand).not }) {
+			Error("FrictionDevice.%: hand must be a FrictionHand or nil, got %".format(method, hand)).throw
+		};
+		^this.new.prInit(server, index, \sim, hand, profile, replace)
+	}
+
+	*prReplayPath { |path, method|
+		if(path.isString.not) { Error("FrictionDevice.%: path must be a String, got %".format(method, path)).throw };
+		^path.standardizePath
+	}
 
 	// kind: \sim, \replay or \mouse, the class method that opens it (and names its errors).
 	prInit { |argServer, argIndex, argKind, argSource, profile, argReplace = false|

@@ -160,8 +160,8 @@ FrictionPilot {
 
 	// ---- Scores (NRT) ----
 
-	// A Score that renders the pilot for device (a FrictionDevice, usually FrictionDevice.sim(nil,
-	// index, hand) or .replay(nil, path)): opens it, loads the signal, plays the pilot with
+	// A Score that renders the pilot for device (a FrictionDevice, usually FrictionDevice.describeSim(
+	// index, hand) or .describeReplay(path)): opens it, loads the signal, plays the pilot with
 	// mapping (a name of Table 1 or samples per mm) and friction (0 off, 1 on) for duration s,
 	// then closes the device. Output channels 0, 1: the delayed audio (times amp); with
 	// recordBus (e.g. 2), 6 more channels (recordChannelNames). recordPath: also write a
@@ -170,7 +170,7 @@ FrictionPilot {
 		recordBus, recordPath, bufnum = 0, signal, nodeID = 1000|
 		var spm = FrictionCheck.samplesPerMm(mapping, "FrictionPilot.score"), def, msgs;
 		if(device.isKindOf(FrictionDevice).not) {
-			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.sim(nil, 0, hand)), "
+			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.describeSim(0, hand)), "
 				"got %".format(device)).throw
 		};
 		duration = duration ?? {

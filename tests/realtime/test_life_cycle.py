@@ -19,13 +19,18 @@ def test_a_rejected_open_is_an_error_and_a_taken_slot_is_refused_unless_replaced
         try { bad = FrictionDevice.sim(s, 0, profile: (noSuchSetting: 1)) } { |e|
             ("KF-REJECTED " ++ e.errorString).postln };
         "KF-ALL-AFTER-REJECT %".format(FrictionDevice.all.size).postln;
+        // A nil server is Server.default, as everywhere in SC.
+        x = FrictionDevice.sim(nil, 5);
+        "KF-NIL-SERVER % %".format(x.server === Server.default, x.isOpen).postln;
+        x.close;
+        x = 0;
         // 2. A taken slot: refused in sclang ...
         a = FrictionDevice.sim(s, 0, FrictionHand.speeds([[40, 5]]));
         try { FrictionDevice.sim(s, 0) } { |e| ("KF-TAKEN " ++ e.errorString).postln };
         // ... and by the server, for any client that sends the open itself.
         OSCdef(\kfFail, { |msg| ("KF-SERVER-FAIL " ++ msg[3..].collect { |c| c.asInteger.asAscii }.join).postln },
             '/kfFail');
-        s.sendMsg(*FrictionDevice.sim(nil, 0).openMsg);
+        s.sendMsg(*FrictionDevice.describeSim(0).openMsg);
         s.sync;
         0.2.wait;
         "KF-A-OPEN % %".format(a.isOpen, FrictionDevice.at(s, 0) === a).postln;
@@ -51,6 +56,7 @@ def test_a_rejected_open_is_an_error_and_a_taken_slot_is_refused_unless_replaced
     assert rejected and "unknown setting" in " ".join(rejected[0]) and "noSuchSetting" in " ".join(rejected[0])
     assert " ".join(rejected[0]).count("kfOpenSim") == 1, f"the command is named once: {rejected[0]}"
     assert values(run, "KF-ALL-AFTER-REJECT ") == [["0"]]
+    assert values(run, "KF-NIL-SERVER ") == [["true", "true"]]
     assert "is taken" in " ".join(run.lines("KF-TAKEN ")[0])
     assert "taken" in " ".join(run.lines("KF-SERVER-FAIL ")[0])
     assert values(run, "KF-A-OPEN ") == [["true", "true"]]
