@@ -8,7 +8,7 @@ each piece's value is posted as "-> value", as the IDE does. After each piece th
 person would before the next: a short pause; for a boot (or reboot) to finish, ServerTree
 included; and for the routines the piece started (fork, Routine.play) to end, at most
 FORK_WAIT_MAX_S (a routine still running then is one a person leaves running). A block gets
-~1.5 s. Blocks of a file run in order, so later ones see the ~variables and synths of earlier
+BLOCK_TIME_S. Blocks of a file run in order, so later ones see the ~variables and synths of earlier
 ones; after the last block of a file, s.freeAll and every device slot is closed (FREE_EACH_BLOCK =
 True frees nodes after every block instead).
 
@@ -47,7 +47,7 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
 
 Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
 A block's output is what is posted from its start to the end of its file: an NRT render or a
-server reply may come after the block's 1.5 s on a loaded machine. The test markers of earlier
+server reply may come after the block's time on a loaded machine. The test markers of earlier
 versions ("// posts:", "// expect error:", "// writes:") are refused, so that none is left unread.
 test_broken_examples_are_reported shows that each rule fails a broken example.
 """
@@ -65,7 +65,7 @@ from kfharness.jack import JackServer
 
 HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or paths.REPO_DIR / "HelpSource")
 PIECE_PAUSE_S = 0.3
-BLOCK_TIME_S = 1.5
+BLOCK_TIME_S = 1.2
 # A person waits for a fork's waits; one still running after this is left running.
 FORK_WAIT_MAX_S = 10.0
 # A boot takes ~1 s here; a server not back after this is a failure.
@@ -80,7 +80,7 @@ FREE_EACH_BLOCK = False
 # and sclang): a run is mostly the examples' pauses, not work, so they share two cores well.
 SHARDS = 3
 TEMP_NAME = re.compile(r'defaultTempDir\s*\+/\+\s*"([^"]+)"')
-CODE_BLOCK = re.compile(r"^code::\s*$", re.M)
+CODE_BLOCK = re.compile(r"^code::[ \t]*$(.*?)^::", re.M | re.S)
 LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 
 RUNNER = r"""
@@ -186,7 +186,7 @@ nodesBesidesDefault = {
 
 "KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
 files.do { |path, f|
-	var doc = SCDoc.parseFileFull(path), blocks, known = routinesQueued.();
+	var doc = SCDoc.parseFileFull(path), blocks, known = routinesQueued.(), fileStart = Main.elapsedTime;
 	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%".format(path).postln } {
 		blocks = codeBlocks.(doc);
 		"KF-HELP-FILE %% (%% blocks)".format(path, blocks.size).postln;
@@ -235,7 +235,7 @@ files.do { |path, f|
 		Window.allWindows.do(_.close);
 		0.2.wait;
 		if(serverAlive.().not) { restart.() };
-		"KF-HELP-FILE-DONE %%".format(path).postln;
+		"KF-HELP-FILE-DONE %% in %% s".format(path, (Main.elapsedTime - fileStart).round(0.1)).postln;
 	};
 };
 "KF-HELP-ALL-DONE".postln;
@@ -454,6 +454,17 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
     return run, examples, problems, notes
 
 
+def temp_names(path):
+    """The files in Platform.defaultTempDir the examples of `path` that run name (not those that
+    need hardware)."""
+    blocks = [b for b in CODE_BLOCK.findall(path.read_text()) if not b.strip().startswith("// needs ")]
+    return set(name for b in blocks for name in TEMP_NAME.findall(b))
+
+
+def blocks_in(path):
+    return len(CODE_BLOCK.findall(path.read_text()))
+
+
 def shards_of(files, count):
     """`files` in lists to run side by side: the guides in one, in guide_order; the class help
     files in count - 1 more, each in the sorted order. Files naming the same file in
@@ -462,20 +473,20 @@ def shards_of(files, count):
     guides = guide_order(files)
     groups = []  # [(temp names, files)]
     for f in [f for f in files if not is_guide(f)]:
-        names = set(TEMP_NAME.findall(f.read_text()))
+        names = temp_names(f)
         joined = [g for g in groups if g[0] & names]
         merged = (names.union(*(g[0] for g in joined)), [x for g in joined for x in g[1]] + [f])
         groups = [g for g in groups if g not in joined] + [merged]
-    guide_names = set(n for f in guides for n in TEMP_NAME.findall(f.read_text()))
+    guide_names = set().union(*map(temp_names, guides))
     shards = [[] for _ in range(count - 1)]
     weight = [0] * (count - 1)
-    for names, group in sorted(groups, key=lambda g: -sum(CODE_BLOCK.subn("", x.read_text())[1] for x in g[1])):
+    for names, group in sorted(groups, key=lambda g: -sum(map(blocks_in, g[1]))):
         if names & guide_names:
             guides += group  # it shares a temp file with a guide: after them, on their server
             continue
         i = weight.index(min(weight))
         shards[i] += group
-        weight[i] += sum(CODE_BLOCK.subn("", x.read_text())[1] for x in group)
+        weight[i] += sum(map(blocks_in, group))
     return [shard for shard in [guides] + [sorted(shard) for shard in shards] if shard]
 
 
@@ -486,7 +497,7 @@ def test_help_shards_keep_files_sharing_a_temp_file_together():
     owner = {}
     for i, shard in enumerate(shards):
         for f in shard:
-            for name in TEMP_NAME.findall(f.read_text()):
+            for name in temp_names(f):
                 assert owner.setdefault(name, i) == i, f"{name} is used by files in two shards"
     guides = [f for f in files if is_guide(f)]
     assert guides and shards[0][:len(guides)] == guide_order(files), "the guides run first, in one session"
