@@ -3,6 +3,8 @@ Cmd-., reboot and ProxySpace, as SuperCollider users expect them.
 
 Each test prints its measured figures on a line starting with KF-FIGURE.
 """
+import re
+
 import numpy as np
 
 from kfharness import paths, readers, sclang
@@ -113,11 +115,13 @@ def test_pilot_and_force_writer_recover_from_cmd_period(jack):
 # user evaluates it: the device's forceBus and positionBus and their bus synths, a FrictionPilot
 # (its synth, buffer and monitorBus) with a FrictionView of it, a FrictionViewMonitor reading the
 # device's own buses, and a device whose re-open throws (made so by giving it a hand it cannot
-# send). After the boot: no error but that device's, the default group, every device open again
-# with its buses working, and nothing allocated after the boot sharing a bus with them.
+# send). A user's ServerBoot function of this server allocates buses first (SC runs a server's
+# own functions before those for all servers), so the device's buses get other numbers. After the
+# boot: no error but that device's, the default group, every device open again with its buses
+# working, read at their new numbers, and nothing allocated after the boot sharing a bus with them.
 REBOOT = r"""
     var dev, bad, pilotDev, pilot, view, monitor, busesOf, fb, pb, before, x0, x1, force, strays, overlaps = 0;
-    var nodeOne = false, waited = 0;
+    var nodeOne = false, waited = 0, userBoot, userBuses, numbersBefore;
     bad = FrictionDevice.sim(s, 0, FrictionHand.speeds([[30, 20]]));
     dev = FrictionDevice.sim(s, 1, FrictionHand.speeds([[30, 20]]));
     pilotDev = FrictionDevice.sim(s, 2, FrictionHand.speeds([[20, 20]]));
@@ -131,6 +135,9 @@ REBOOT = r"""
     1.0.wait;
     "KF-BEFORE % % % %".format(dev.isOpen, pilot.isPlaying, view.monitor.running, monitor.frameCount > 0).postln;
     bad.instVarPut(\source, \notAHand);
+    numbersBefore = [fb.index, pb.index, pilot.monitorBus.index];
+    userBoot = { userBuses = [Bus.audio(s, 2), Bus.control(s, 3)] };
+    ServerBoot.add(userBoot, s);
     "KF-REBOOTING".postln;
     s.reboot;
     // As a person waits for the boot to finish (ServerTree included).
@@ -143,12 +150,14 @@ REBOOT = r"""
     0.2.wait;
     "KF-AFTER-REBOOT % % % % %".format(nodeOne, dev.isOpen, FrictionDevice.at(s, 1) === dev, pilotDev.isOpen,
         bad.isOpen).postln;
+    ServerBoot.remove(userBoot, s);
     "KF-SAME-BUSES % %".format(dev.forceBus === fb, dev.positionBus === pb).postln;
     // Buses allocated after the boot, as a user's code would: none shares a channel with the
     // device's or the pilot's.
-    strays = [Bus.audio(s, 1), Bus.control(s, 4), Bus.control(s, 5), Bus.audio(s, 2), Bus.control(s, 1)];
+    strays = userBuses ++ [Bus.audio(s, 1), Bus.control(s, 4), Bus.control(s, 5), Bus.audio(s, 2), Bus.control(s, 1)];
     pilot.play;
     s.sync;
+    "KF-NUMBERS % %".format(numbersBefore, [fb.index, pb.index, pilot.monitorBus.index]).postln;
     busesOf = [dev.forceBus, dev.positionBus, pilot.monitorBus];
     busesOf.do { |a|
         strays.do { |b|
@@ -198,6 +207,9 @@ def test_a_reboot_reopens_every_device_with_what_it_holds(jack):
     assert values(run, "KF-AFTER-REBOOT ") == [["true", "true", "true", "true", "false"]], "the default group, the devices"
     assert values(run, "KF-SAME-BUSES ") == [["true", "true"]]
     assert values(run, "KF-OVERLAPS ") == [["0"]], run.lines("KF-SHARED ")
+    numbers = [[int(n) for n in re.findall(r"\d+", part)] for part in run.output.split("KF-NUMBERS ")[1].splitlines()[0].split("] [")]
+    print(f"KF-FIGURE bus_numbers_before_and_after_reboot {numbers}")
+    assert all(a != b for a, b in zip(*numbers)), f"the user's boot function moves every bus: {numbers}"
     x0, x1 = (float(v) for v in run.lines("KF-POSITION-BUS ")[0])
     print(f"KF-FIGURE x_mm_on_position_bus_after_reboot {x0} {x1}")
     assert x1 > x0 + 5, "the re-opened simulation moves the puck, and positionBus shows it"
