@@ -147,7 +147,8 @@ waitLikeAPerson = { |known, path, b|
 	while { (s.serverRunning.not or: { treePending }) and: { waited < %(boot_wait)f } } {
 		0.1.wait; waited = waited + 0.1
 	};
-	if(waited >= %(boot_wait)f) { "KF-HELP-BOOT-TIMEOUT %% %%".format(path, b).postln };
+	// (Reported once: a boot that stopped before ServerTree is not waited for again.)
+	if(waited >= %(boot_wait)f) { "KF-HELP-BOOT-TIMEOUT %% %%".format(path, b).postln; treePending = false };
 	if(waited > 0 and: { s.serverRunning }) { s.sync };
 	waited = 0;
 	while { note.(); started.any { |r| r.state != 6 } and: { waited < %(fork_wait)f } } {
