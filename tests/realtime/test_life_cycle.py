@@ -112,7 +112,8 @@ def test_pilot_and_force_writer_recover_from_cmd_period(jack):
 
 
 # Everything a device and the classes around it can hold on the server, through s.reboot as a
-# user evaluates it: the device's forceBus and positionBus and their bus synths, a FrictionPilot
+# user evaluates it: the device's forceBus and positionBus and their bus synths, its audio drive
+# (FrictionDevice.loadDrive: the calibration the server holds for FrictionDrive), a FrictionPilot
 # (its synth, buffer and monitorBus) with a FrictionView of it, a FrictionViewMonitor reading the
 # device's own buses, and a device whose re-open throws (made so by giving it a hand it cannot
 # send). A user's ServerBoot function of this server allocates buses first (SC runs a server's
@@ -121,11 +122,19 @@ def test_pilot_and_force_writer_recover_from_cmd_period(jack):
 # working, read at their new numbers, and nothing allocated after the boot sharing a bus with them.
 REBOOT = r"""
     var dev, bad, pilotDev, pilot, view, monitor, busesOf, fb, pb, before, x0, x1, force, strays, overlaps = 0;
-    var nodeOne = false, waited = 0, userBoot, userBuses, numbersBefore;
+    var nodeOne = false, waited = 0, userBoot, userBuses, numbersBefore, drivePath, driveBus, drive;
     bad = FrictionDevice.sim(s, 0, FrictionHand.speeds([[30, 20]]));
     dev = FrictionDevice.sim(s, 1, FrictionHand.speeds([[30, 20]]));
     pilotDev = FrictionDevice.sim(s, 2, FrictionHand.speeds([[20, 20]]));
     fb = dev.forceBus;
+    // An audio drive: the guide's circuit (10 V full scale, 0.5 A/V) and magnet table.
+    FrictionCalibration([[0, 0.14], [0.25, 0.77], [1, 1.4]], "magnet-1").write(@DIR@ +/+ "kf-lc-magnet.txt");
+    drivePath = @DIR@ +/+ "kf-lc-drive.txt";
+    File.use(drivePath, "w", { |f|
+        f.write("kf-drive 1\nmagnetTable kf-lc-magnet.txt\nfullScaleCurrentA 2\ntransconductanceAPerV 0.5\n"
+            "outputFullScaleV 10\noutputSign 1\nmaxSafeCurrentA 2\ncurrentSourceLatencyS 0.00002\nmagnetLagS 0.0004\n")
+    });
+    dev.loadDrive(drivePath);
     pb = dev.positionBus;
     bad.forceBus;
     pilot = FrictionPilot(pilotDev, \mapping2, amp: 0).play;
@@ -173,12 +182,17 @@ REBOOT = r"""
     0.5.wait;
     pb.getn(4, { |v| x1 = v[0] });
     { Out.ar(fb, DC.ar(0.5)) }.play;
+    // The drive, loaded again with the device, drives the 0.5 N.
+    driveBus = Bus.control(s, 1);
+    { Out.kr(driveBus, A2K.kr(FrictionDrive.ar(1))) }.play;
     0.5.wait;
+    driveBus.getn(1, { |v| drive = v[0] });
     dev.statusValues({ |v| force = v[\lastForceN] });
     s.sync;
     0.3.wait;
     "KF-POSITION-BUS % %".format(x0, x1).postln;
     "KF-FORCE-BUS %".format(force).postln;
+    "KF-DRIVE % %".format(dev.driveSetup.notNil, drive).postln;
     // The monitor of the device's buses reads them again, the pilot's view its new frames.
     before = monitor.frameCount;
     0.5.wait;
@@ -188,13 +202,15 @@ REBOOT = r"""
     s.freeAll;
     [dev, pilotDev].do(_.close);
     strays.do(_.free);
+    driveBus.free;
     s.sync;
     "KF-DONE".postln;
 """
 
 
 def test_a_reboot_reopens_every_device_with_what_it_holds(jack):
-    run = sclang.require_ok(sclang.run_with_server(REBOOT, jack, name="reboot", timeout=180))
+    run = sclang.require_ok(sclang.run_with_server(REBOOT.replace("@DIR@", sclang.sc_string(paths.work_dir())), jack,
+                                                   name="reboot", timeout=180))
     print(f"log {run.log_path}")
     assert values(run, "KF-BEFORE ") == [["true", "true", "true", "true"]]
     after = run.output.split("KF-REBOOTING")[1]
@@ -215,6 +231,10 @@ def test_a_reboot_reopens_every_device_with_what_it_holds(jack):
     assert x1 > x0 + 5, "the re-opened simulation moves the puck, and positionBus shows it"
     force = float(run.lines("KF-FORCE-BUS ")[0][0])
     assert abs(force - 0.5) < 1e-3, f"0.5 N played into forceBus reaches the device: {force}"
+    # 0.5 N by the table is 1/7 of full scale (2 A), 0.286 A, 0.571 V of 10 V full scale.
+    has_drive, drive = run.lines("KF-DRIVE ")[0]
+    assert has_drive == "true" and abs(float(drive) - (0.5 - 0.14) / (0.77 - 0.14) * 0.25 * 2 / 0.5 / 10) < 1e-3, drive
+    assert "FrictionDrive:" not in run.output, "no drive posts: one is loaded for the device"
     frames, monitor_x, monitor_force = (float(v) for v in run.lines("KF-MONITOR ")[0])
     assert frames >= 5 and monitor_x > 5 and abs(monitor_force - 0.5) < 0.05, (frames, monitor_x, monitor_force)
     assert values(run, "KF-PILOT-VIEW ") == [["true", "true"]]
