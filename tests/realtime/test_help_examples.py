@@ -165,7 +165,8 @@ hasDefaultGroup = {
 };
 // The nodes on the server but the root and the default groups (one per client), as [id, defName or \group].
 nodesBesidesDefault = {
-	var cond = Condition(false), nodes = List.new, reply;
+	var nodes = List.new, reply;
+	// The reply comes before /synced: once synced it is in (or lost: then no node is reported).
 	reply = OSCFunc({ |msg|
 		var i = 2, walk;
 		walk = {
@@ -177,11 +178,10 @@ nodesBesidesDefault = {
 			}
 		};
 		walk.();
-		cond.test = true; cond.signal;
 	}, '/g_queryTree.reply', s.addr).oneShot;
 	s.sendMsg('/g_queryTree', 0, 0);
 	s.sync;
-	cond.wait;
+	reply.free;
 	nodes.reject { |n| n[0] == 0 or: { s.defaultGroups.any { |g| g.nodeID == n[0] } } }
 };
 
