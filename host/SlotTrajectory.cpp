@@ -41,7 +41,7 @@ void SlotTrajectory::requestPosition(double xMm, double yMm) {
 
 void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* reports, int numReports, bool lockstep,
                                double lockstepOriginS) {
-  const bool continuous = valid_ && lastBlock_ == clock.block - 1;
+  const bool continuous = continuesAt(clock.block);
   reportsTaken_ += numReports;
   // The references catch up with the previous block, rendered as an audio-rate reader did.
   if (continuous)

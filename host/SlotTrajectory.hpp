@@ -57,6 +57,8 @@ class SlotTrajectory {
 
   // Whether this block has been taken already.
   bool hasBlock(int64_t block) const { return valid_ && lastBlock_ == block; }
+  // Whether the block before this one was taken: a reader has been reading without a gap.
+  bool continuesAt(int64_t block) const { return valid_ && lastBlock_ == block - 1; }
 
   // The first reader of a block: `reports` are all the reports popped this block (oldest
   // first). lockstep: device time + lockstepOriginS is audio time; realtime: mapped.

@@ -295,10 +295,10 @@ void Device::close() {
   recorder_.close();
 }
 
-int Device::popReports(MouseReport* out, int capacity) {
+int Device::popReports(MouseReport* out, int capacity, bool measureDelay) {
   int popped = 0;
   while (popped < capacity && reportQueue_.pop(out[popped])) ++popped;
-  if (!lockstep_ && popped > 0) {
+  if (!lockstep_ && measureDelay && popped > 0) {
     const double now = nowS();
     for (int i = 0; i < popped; ++i) telemetry_.reportLatency.record(now - out[i].hostTimeS);
   }

@@ -57,7 +57,7 @@ def log(msg):
 
 
 def score_code(speed, seconds):
-    devices = "\n".join(f"        dev{i} = FrictionDevice.sim(nil, {i}, hand, {HAND});" for i in range(len(PATTERNS)))
+    devices = "\n".join(f"        dev{i} = FrictionDevice.describeSim({i}, hand, {HAND});" for i in range(len(PATTERNS)))
     names = ", ".join(f"dev{i}" for i in range(len(PATTERNS)))
     outs = ",\n".join(f"""                {{ var m = FrictionMouseIn.ar({i}), x = m[0];
                    var pilot = SpatialBufRd.ar(1, 0, x, {PILOT_SPM});
