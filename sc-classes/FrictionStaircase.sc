@@ -7,7 +7,7 @@
 // reversals (their geometric mean for \log).
 FrictionStaircase {
 	var <start, <down, <stepSizes, <stepType, <reversals, <maxTrials, <minLevel, <maxLevel, <estimateReversals;
-	var <level, <trials, <reversalLevels, direction, rightInRow = 0;
+	var nextLevel, <trials, <reversalLevels, direction, rightInRow = 0;
 
 	*new { |start = 1, down = 2, stepSizes = #[0.2, 0.1, 0.05], stepType = \log, reversals = 12,
 		maxTrials = 100, minLevel, maxLevel, estimateReversals = 8|
@@ -52,7 +52,7 @@ FrictionStaircase {
 		estimateReversals = argEstimate;
 		minLevel = argMin ?? { if(stepType == \log) { 0 } { -inf } };
 		maxLevel = argMax ? inf;
-		level = start.clip(minLevel, maxLevel);
+		nextLevel = start.clip(minLevel, maxLevel);
 		trials = [];
 		reversalLevels = [];
 	}
@@ -62,12 +62,15 @@ FrictionStaircase {
 
 	isFinished { ^reversalLevels.size >= reversals or: { trials.size >= maxTrials } }
 
-	next { ^if(this.isFinished) { nil } { level } }
+	// The level of the next trial (also after the last one).
+	level { ^nextLevel }
 
-	respond { |argLevel, correct|
+	next { ^if(this.isFinished) { nil } { nextLevel } }
+
+	respond { |level, correct|
 		var move;
 		FrictionCheck.boolean(correct, "correct", "FrictionStaircase.respond");
-		trials = trials.add((level: argLevel, correct: correct));
+		trials = trials.add((level: level, correct: correct));
 		if(correct) {
 			rightInRow = rightInRow + 1;
 			if(rightInRow >= down) { rightInRow = 0; move = -1 }
@@ -76,9 +79,9 @@ FrictionStaircase {
 			move = 1
 		};
 		move !? {
-			if(direction.notNil and: { move != direction }) { reversalLevels = reversalLevels.add(argLevel) };
+			if(direction.notNil and: { move != direction }) { reversalLevels = reversalLevels.add(level) };
 			direction = move;
-			level = this.prStep(argLevel, move).clip(minLevel, maxLevel)
+			nextLevel = this.prStep(level, move).clip(minLevel, maxLevel)
 		}
 	}
 
