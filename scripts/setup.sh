@@ -12,6 +12,7 @@ PACKAGES=(
   python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
+  qemu-system-x86 linux-image-amd64 busybox-static udev systemd  # tests/kernel: the QEMU guest (python/kfharness/guest.py)
 )
 source scripts/packages.sh
 kf_install_missing "${PACKAGES[@]}"
