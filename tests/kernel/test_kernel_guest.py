@@ -88,3 +88,15 @@ def test_case(guest_run, case):
         pytest.fail(f"'{case}' did not run in the guest\nconsole:\n{guest_run.console_tail()}")
     failures = cases[case]
     assert not failures, "\n\n".join(failures)
+
+
+# The rig's own failures, without the test program: each must fail the run with its reason.
+def test_a_guest_that_cannot_boot_fails_with_the_reason(tmp_path):
+    # 24 MiB do not hold the kernel and the initramfs: the guest never reaches its /init.
+    run = guest.run(guest.GuestSpec(programs=[("true", ["/usr/bin/true"])], memory_mb=24, timeout_s=60), tmp_path)
+    assert run.failure and "the guest did not boot" in run.failure, run.failure
+
+
+def test_a_module_the_kernel_does_not_have_fails_before_booting(tmp_path):
+    run = guest.run(guest.GuestSpec(programs=[("true", ["/usr/bin/true"])], modules=["kf-no-such-module"]), tmp_path)
+    assert run.failure and "module kf-no-such-module is not in /lib/modules/" in run.failure, run.failure
