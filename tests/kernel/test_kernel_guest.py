@@ -46,6 +46,8 @@ def guest_run():
         files=[Path(os.environ["KF_TEST_DATA_DIR"]) / "hid"], qemu_args=QEMU_DEVICES)
     run = guest.run(spec, ARTEFACTS)
     (ARTEFACTS / "console.log").write_text(run.console)
+    (ARTEFACTS / "run.txt").write_text(f"kernel {run.kernel}\nboot_s {run.boot_s:.1f}\nwall_s {run.wall_s:.1f}\n"
+                                       f"failure {run.failure}\nlogs {run.logs}\nexits {run.exits}\n")
     for name, data in run.files.items():
         (ARTEFACTS / name).write_bytes(data)
     figures = run.files.get("figures.txt", b"").decode()
