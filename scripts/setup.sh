@@ -31,6 +31,7 @@ PACKAGES=(
   python3-scipy python3-questplus psignifit  # the threshold fit and its references (tests, bench)
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
+  qemu-system-x86 linux-image-amd64 busybox-static udev systemd  # tests/kernel: the QEMU guest (python/kfharness/guest.py)
 )
 source scripts/packages.sh
 if $all; then
