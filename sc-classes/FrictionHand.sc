@@ -62,7 +62,7 @@ FrictionHand {
 		if(tiers.isInteger.not or: { tiers < 1 } or: { tiers > 100 }) {
 			Error("FrictionHand.explore: tiers must be an Integer from 1 to 100, got %".format(tiers)).throw
 		};
-		[	ierS, tierS, \maxPushN, maxPushN, \gainNSPerM, gainNSPerM, daptS, adaptS].pairsDo { |name, v|
+		[\tierS, tierS, \maxPushN, maxPushN, \gainNSPerM, gainNSPerM, \adaptS, adaptS].pairsDo { |name, v|
 			if(v <= 0) { Error("FrictionHand.explore: % must be > 0, got %".format(name, v)).throw }
 		};
 		^this.newCopyArgs(7, values.collect(_.asFloat))
