@@ -37,7 +37,10 @@ double ExploringHand::push(double timeS, double stepS, double positionMm, double
   // How far the puck falls short of the intended speed along the heading (m/s; < 0: too fast).
   const double shortfallMPerS = (intendedSpeedMmPerS(timeS) - direction_ * speedMmPerS) * 1e-3;
   const double correctionN = s.gainNSPerM * shortfallMPerS;
-  expectedResistanceN_ = std::clamp(expectedResistanceN_ + correctionN * stepS / s.adaptS, 0.0, s.maxPushN);
+  // It learns the surface only while it moves the way it heads: a turn's shortfall is the turn's,
+  // not the surface's resistance.
+  if (direction_ * speedMmPerS > 0.0)
+    expectedResistanceN_ = std::clamp(expectedResistanceN_ + correctionN * stepS / s.adaptS, 0.0, s.maxPushN);
   return direction_ * std::clamp(expectedResistanceN_ + correctionN, -s.maxPushN, s.maxPushN);
 }
 

@@ -108,9 +108,10 @@ TEST_CASE("explore: friction that is high in part of the strip binds the puck th
     const double inOff = meanSpeed(off, fromS + 0.5, fromS + 2.0, 10.0, 16.0);
     const double inOn = meanSpeed(on, fromS + 0.5, fromS + 2.0, 10.0, 16.0);
     INFO("step from " << fromS << " s: " << inOff << " mm/s off, " << inOn << " mm/s on");
-    // 0.36 N more than learnt, against a gain of 10 N per m/s: up to 36 mm/s slower, less the
-    // part the participant learns while crossing.
-    CHECK(inOn < 0.85 * inOff);
+    // 0.36 N more than learnt against a gain of 10 N per m/s is 36 mm/s slower once settled
+    // (within m / gain = 10 ms), less what the participant learns while crossing: at least a
+    // third of it.
+    CHECK(inOn < inOff - 12.0);
   }
   // Dwelling: more of the time is spent in the fragment with friction on.
   auto timeIn = [](const std::vector<Sample>& samples) {
