@@ -15,13 +15,13 @@
 namespace kf {
 
 struct ExploreSettings {
-  double fromMm = 0.0, toMm = 0.0;             // the strip, fromMm < toMm
-  double slowMmPerS = 0.0, fastMmPerS = 0.0;   // the intended speeds, 0 < slow <= fast
-  double tiers = 1.0;                          // speed steps from slow to fast, whole, 1..100
-  double tierS = 0.0;                          // time at each speed step, > 0
-  double maxPushN = 0.0;                       // the strongest push, > 0
-  double gainNSPerM = 0.0;                     // push per speed shortfall (N per m/s), > 0
-  double adaptS = 0.0;                         // time constant of learning the resistance, > 0
+  double fromMm = 0.0, toMm = 0.0;            // the strip, fromMm < toMm
+  double slowMmPerS = 0.0, fastMmPerS = 0.0;  // the intended speeds, 0 < slow <= fast
+  double tiers = 1.0;                         // speed steps from slow to fast, whole, 1..100
+  double tierS = 0.0;                         // time at each speed step, > 0
+  double maxPushN = 0.0;                      // the strongest push, > 0
+  double gainNSPerM = 0.0;                    // push per speed shortfall (N per m/s), > 0
+  double adaptS = 0.0;                        // time constant of learning the resistance, > 0
 
   // Finite, within the bounds above and SettingBounds' hand bounds (positions, speeds, force).
   bool isValid() const;

@@ -46,8 +46,7 @@ std::vector<Sample> run(const ExploreSettings& settings, double durationS,
 }
 
 // Mean |speed| (mm/s) over the samples in [fromS, toS) whose position is in [loMm, hiMm].
-double meanSpeed(const std::vector<Sample>& samples, double fromS, double toS, double loMm = -1e9,
-                 double hiMm = 1e9) {
+double meanSpeed(const std::vector<Sample>& samples, double fromS, double toS, double loMm = -1e9, double hiMm = 1e9) {
   double sum = 0.0;
   int n = 0;
   for (const Sample& s : samples)
@@ -63,12 +62,12 @@ double meanSpeed(const std::vector<Sample>& samples, double fromS, double toS, d
 TEST_CASE("explore: settings out of their bounds are refused", "[sim]") {
   CHECK(HandScript::exploring(participant()).isValid());
   std::vector<std::function<void(ExploreSettings&)>> breaks = {
-      [](ExploreSettings& s) { s.toMm = s.fromMm; },        [](ExploreSettings& s) { s.slowMmPerS = 0.0; },
-      [](ExploreSettings& s) { s.fastMmPerS = 10.0; },      [](ExploreSettings& s) { s.fastMmPerS = 2e5; },
-      [](ExploreSettings& s) { s.tiers = 2.5; },            [](ExploreSettings& s) { s.tiers = 101.0; },
-      [](ExploreSettings& s) { s.tierS = 0.0; },            [](ExploreSettings& s) { s.maxPushN = 0.0; },
-      [](ExploreSettings& s) { s.maxPushN = 101.0; },       [](ExploreSettings& s) { s.gainNSPerM = -1.0; },
-      [](ExploreSettings& s) { s.adaptS = 0.0; },           [](ExploreSettings& s) { s.fromMm = NAN; },
+      [](ExploreSettings& s) { s.toMm = s.fromMm; },   [](ExploreSettings& s) { s.slowMmPerS = 0.0; },
+      [](ExploreSettings& s) { s.fastMmPerS = 10.0; }, [](ExploreSettings& s) { s.fastMmPerS = 2e5; },
+      [](ExploreSettings& s) { s.tiers = 2.5; },       [](ExploreSettings& s) { s.tiers = 101.0; },
+      [](ExploreSettings& s) { s.tierS = 0.0; },       [](ExploreSettings& s) { s.maxPushN = 0.0; },
+      [](ExploreSettings& s) { s.maxPushN = 101.0; },  [](ExploreSettings& s) { s.gainNSPerM = -1.0; },
+      [](ExploreSettings& s) { s.adaptS = 0.0; },      [](ExploreSettings& s) { s.fromMm = NAN; },
       [](ExploreSettings& s) { s.toMm = INFINITY; },
   };
   for (const auto& broken : breaks) {
