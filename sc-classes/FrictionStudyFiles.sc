@@ -47,7 +47,9 @@ FrictionStudyFiles {
 		if(folder.isString.not or: { folder.isEmpty }) {
 			Error("%: folder must be a path (String), got %".format(where, folder)).throw
 		};
-		File.mkdir(folder);
+		try { File.mkdir(folder) } { |error|
+			Error("%: the folder % cannot be written (%)".format(where, folder, error.errorString)).throw
+		};
 		probe = folder +/+ ".kf-write-probe";
 		file = File(probe, "w");
 		if(file.isOpen.not) { Error("%: the folder % cannot be written".format(where, folder)).throw };

@@ -5,8 +5,9 @@
 // latencies in use), session.csv (start, resume, finish, abort), answers.csv (one line per answer,
 // written and flushed as it is given), and per condition a folder NN-name (NN its place in the
 // order) with device.kfsession (the device recording), audio.wav (the participant's audio as
-// heard) and events.csv (prepare, start, pause, resume, done, end... with times). A condition cut
-// short (a crash, a kill, repeat) keeps its folder as NN-name-attemptK and runs again.
+// heard) and events.csv (prepare, start, pause, resume, done, end... with times in s from its
+// prepare line). A condition cut short (a crash, a kill, repeat) keeps its folder as it was and
+// runs again into NN-name-attemptK (K = 2, 3, ...): the last attempt is the condition's.
 //
 // Everything is checked before the first participant sees anything (the study, the code, the
 // folder, the server, the channels, the device): a refusal is an Error with the reason.
@@ -17,7 +18,7 @@ FrictionStudySession {
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
-	var ending, answerValue, listenSynth, recorder, conditionT0, pausedS = 0, pauseT0, routine;
+	var ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0, routine;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -98,14 +99,15 @@ FrictionStudySession {
 		this.prPlay;
 	}
 
-	// A line in the condition's events.csv, with the time since its start.
+	// A line in the condition's events.csv, with the time since its prepare line.
 	log { |event, detail = ""|
 		conditionDir !? {
 			FrictionStudyFiles.appendCsv(conditionDir +/+ "events.csv",
-				[(Main.elapsedTime - (conditionT0 ? Main.elapsedTime)).round(0.001), event, detail,
-					FrictionStudyFiles.now], eventsHeader)
+				[this.prLogTime, event, detail, FrictionStudyFiles.now], eventsHeader)
 		}
 	}
+
+	prLogTime { ^(Main.elapsedTime - (preparedT0 ? Main.elapsedTime)).round(0.001) }
 
 	printOn { |stream| stream << this.class.name << "(" << participant.cs << ", " << state << ")" }
 
@@ -151,12 +153,13 @@ FrictionStudySession {
 	}
 
 	prRunCondition {
-		var s = condition.settings, questionStart;
-		conditionT0 = Main.elapsedTime;
+		var s = condition.settings;
+		preparedT0 = Main.elapsedTime;
+		conditionT0 = nil;
 		pausedS = 0;
 		paused = false;
-		conditionDir = this.prConditionDir(position);
-		attempt = this.prKeepAttempts(conditionDir);
+		attempt = this.prLastAttempt(position) + 1;
+		conditionDir = this.prConditionDir(position, attempt);
 		File.mkdir(conditionDir);
 		this.log(\prepare, condition.name);
 		state = \preparing;
@@ -209,14 +212,13 @@ FrictionStudySession {
 			if(ending != \abort) {
 				question = q;
 				answerValue = nil;
-				questionStart = this.elapsedS;
 				participantWindow !? { participantWindow.ask(q) };
 				experimenterWindow !? { experimenterWindow.refresh };
 				if(simulated.notNil) { this.answer(simulated.answer(q, this.prStats), \simulated) };
 				while { answerValue.isNil and: { ending != \abort } } { 0.05.wait };
 				if(answerValue.notNil) {
 					FrictionStudyFiles.appendCsv(folder +/+ "answers.csv", [participant, position + 1, condition.name,
-						attempt, q.key, q.kind, answerValue[0], answerValue[1], this.elapsedS.round(0.001),
+						attempt, q.key, q.kind, answerValue[0], answerValue[1], this.prLogTime,
 						FrictionStudyFiles.now], answersHeader);
 					this.log(\answer, q.key);
 				};
@@ -244,14 +246,17 @@ FrictionStudySession {
 			coverage: coverage.fraction, friction: stats[\friction], audio: stats[\audio])
 	}
 
-	prConditionDir { |k| ^folder +/+ "%-%".format((k + 1).asString.padLeft(2, "0"), order[k].name) }
+	// The folder of attempt (1, 2, ...) of the condition at k in the order.
+	prConditionDir { |k, attempt = 1|
+		var dir = folder +/+ "%-%".format((k + 1).asString.padLeft(2, "0"), order[k].name);
+		^if(attempt > 1) { dir ++ "-attempt" ++ attempt } { dir }
+	}
 
-	// A folder left by an earlier attempt is kept as dir-attemptK; the attempt number now.
-	prKeepAttempts { |dir|
-		var k = 1;
-		while { File.exists(dir ++ "-attempt" ++ k) } { k = k + 1 };
-		if(File.exists(dir)) { File.rename(dir, dir ++ "-attempt" ++ k); ^k };
-		^k - 1
+	// The last attempt made at the condition at k (0: none).
+	prLastAttempt { |k|
+		var n = 0;
+		while { File.exists(this.prConditionDir(k, n + 1)) } { n = n + 1 };
+		^n
 	}
 
 	prSessionLog { |event, detail|
@@ -298,7 +303,7 @@ FrictionStudySession {
 		// The first condition without its end: the one the session was in.
 		position = order.size;
 		order.do { |c, k|
-			var events = this.prConditionDir(k) +/+ "events.csv";
+			var events = this.prConditionDir(k, this.prLastAttempt(k)) +/+ "events.csv";
 			if(position == order.size and: {
 				File.exists(events).not or: { File.readAllString(events).contains("\"end\"").not }
 			}) { position = k }
@@ -321,6 +326,16 @@ FrictionStudySession {
 			Error("%: participant code % already has a session in %; resume it (FrictionStudy.resume) or choose "
 				"another code".format(where, participant, folder)).throw
 		};
+		if(argDevice.notNil == argSimulated.notNil) {
+			Error("%: give either device (an open FrictionDevice) or simulated (a FrictionStudySimParticipant)".format(
+				where)).throw
+		};
+		if(argDevice.notNil and: { argDevice.isKindOf(FrictionDevice).not or: { argDevice.isOpen.not } }) {
+			Error("%: device must be an open FrictionDevice, got %".format(where, argDevice)).throw
+		};
+		if(argSimulated.notNil and: { argSimulated.isKindOf(FrictionStudySimParticipant).not }) {
+			Error("%: simulated must be a FrictionStudySimParticipant, got %".format(where, argSimulated)).throw
+		};
 		if(argServer.isKindOf(Server).not) { Error("%: server must be a Server, got %".format(where, argServer)).throw };
 		FrictionCheck.serverRunning(argServer, where);
 		[\participantOut, argParticipantOut, \experimenterOut, argExperimenterOut].pairsDo { |name, bus|
@@ -335,16 +350,6 @@ FrictionStudySession {
 			Error("%: the server has % output channels; the pairs at % and % need % (set "
 				"s.options.numOutputBusChannels and reboot)".format(where, channels, argParticipantOut,
 					argExperimenterOut, max(argParticipantOut, argExperimenterOut) + 2)).throw
-		};
-		if(argDevice.notNil == argSimulated.notNil) {
-			Error("%: give either device (an open FrictionDevice) or simulated (a FrictionStudySimParticipant)".format(
-				where)).throw
-		};
-		if(argDevice.notNil and: { argDevice.isKindOf(FrictionDevice).not or: { argDevice.isOpen.not } }) {
-			Error("%: device must be an open FrictionDevice, got %".format(where, argDevice)).throw
-		};
-		if(argSimulated.notNil and: { argSimulated.isKindOf(FrictionStudySimParticipant).not }) {
-			Error("%: simulated must be a FrictionStudySimParticipant, got %".format(where, argSimulated)).throw
 		};
 		if(argIndex.isInteger.not or: { argIndex < 0 }) {
 			Error("%: participantIndex must be an Integer >= 0, got %".format(where, argIndex)).throw

@@ -36,7 +36,7 @@ class Condition:
     settings: dict         # the scene (mapping, friction, audio, origin, ...)
     area_mm: tuple         # the fragment's part on the surface
     events: list = field(default_factory=list)
-    attempts: int = 0      # earlier attempts kept beside it (a crash, a repeat)
+    attempts: int = 0      # earlier attempts kept beside it (a crash, a kill, a repeat)
 
     def event_time(self, name):
         times = [float(e["timeS"]) for e in self.events if e["event"] == name]
@@ -127,13 +127,17 @@ class StudySession:
         by_name = {c["name"]: c for c in self.manifest["study"]["conditions"]}
         self.conditions = []
         for position, name in enumerate(self.manifest["order"], start=1):
-            folder = self.folder / f"{position:02d}-{name}"
+            # Attempt 1 is NN-name, then NN-name-attempt2, ...: the last is the condition's.
+            base = self.folder / f"{position:02d}-{name}"
+            n = 1
+            while (self.folder / f"{base.name}-attempt{n + 1}").exists():
+                n += 1
+            folder = base if n == 1 else self.folder / f"{base.name}-attempt{n}"
             scene = by_name[name]["scene"]
             spm = mapping_samples_per_mm(scene["mapping"])
             width = min(24000 / spm, float(scene["surfaceMm"]))
             origin = float(scene["origin"])
-            condition = Condition(position, name, folder, scene, (origin, origin + width),
-                                  attempts=len(list(self.folder.glob(f"{position:02d}-{name}-attempt*"))))
+            condition = Condition(position, name, folder, scene, (origin, origin + width), attempts=n - 1)
             if (folder / "events.csv").exists():
                 condition.events = read_csv(folder / "events.csv")
             self.conditions.append(condition)

@@ -55,8 +55,8 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     run = run_study(out, args.participants, args.explore_s)
-    for line in run.lines("KF-STUDY-SESSION"):
-        print(line, flush=True)
+    for fields in run.lines("KF-STUDY-SESSION"):
+        print("session", " ".join(fields), flush=True)
     sclang.require_ok(run, "the study")
     summary = study_report.write_report(out / "sessions", out)
     print(f"{len(summary['sessions'])} sessions, report {out / 'report.md'} ({time.monotonic() - t0:.0f} s)")

@@ -26,10 +26,11 @@ def test_bad_input_is_refused_before_anything_starts(jack):
     root = paths.work_dir() / "study-refusals"
     shutil.rmtree(root, ignore_errors=True)
     (root / "P1").mkdir(parents=True)
-    code = STUDY + sclang.fill(r"""
+    code = sclang.fill(r"""
 var root = @ROOT@, sim = FrictionStudySimParticipant(1, 2), refused = { |tag, f|
 	try { f.value; "KF-ACCEPTED %".format(tag).postln } { |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
 };
+""" + STUDY + r"""
 refused.(\noConditions, { FrictionStudy("empty", []) });
 refused.(\unknownParameter, { FrictionStudyCondition(\a, (mapping: \mapping1, frictionn: true)) });
 refused.(\badMapping, { FrictionStudyCondition(\a, (mapping: -3)) });
@@ -41,7 +42,7 @@ refused.(\badCode, { ~study.run("P 3/..", root, s, simulated: sim, windows: fals
 refused.(\noDevice, { ~study.run("P3", root, s, windows: false) });
 """, ROOT=sclang.sc_string(str(root)))
     run = sclang.require_ok(sclang.run_with_server(code, jack, timeout=60, name="study-refusals"))
-    refused = {line.split()[1]: line for line in run.lines("KF-REFUSED")}
+    refused = {fields[0]: " ".join(fields[1:]) for fields in run.lines("KF-REFUSED")}
     assert not run.lines("KF-ACCEPTED"), run.lines("KF-ACCEPTED")
     expected = {
         "noConditions": "needs at least one condition",
@@ -78,10 +79,10 @@ def test_a_killed_session_resumes_with_nothing_lost(jack):
     pids.unlink(missing_ok=True)
     # Run 1: the session starts; the test kills scsynth and sclang once the second condition runs.
     first = STUDY + sclang.fill(r"""
-var session = ~study.run("P7", @ROOT@, s, 0, 11, simulated: FrictionStudySimParticipant(3, 2.5), windows: false,
+~session = ~study.run("P7", @ROOT@, s, 0, 11, simulated: FrictionStudySimParticipant(3, 2.5), windows: false,
 	experimenterOut: 2);
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
-while { session.isOver.not } { 0.1.wait };
+while { ~session.isOver.not } { 0.1.wait };
 "KF-NOT-KILLED".postln;
 """, ROOT=sclang.sc_string(str(root)), PIDS=sclang.sc_string(str(pids)))
     result = {}
@@ -116,25 +117,24 @@ while { session.isOver.not } { 0.1.wait };
 
     # Run 2: resume from sclang; the second condition runs again, the first is kept as it was.
     second = STUDY + sclang.fill(r"""
-var session = ~study.resume(@SESSION@, s, simulated: FrictionStudySimParticipant(3, 2.5), windows: false);
-while { session.isOver.not } { 0.1.wait };
-"KF-RESUMED % %".format(session.state, session.position).postln;
+~session = ~study.resume(@SESSION@, s, simulated: FrictionStudySimParticipant(3, 2.5), windows: false);
+while { ~session.isOver.not } { 0.1.wait };
+"KF-RESUMED % %".format(~session.state, ~session.position).postln;
 """, SESSION=sclang.sc_string(str(session)))
     run = sclang.require_ok(sclang.run_with_server(second, jack, timeout=120, name="study-resume",
                                                    server_options={"numOutputBusChannels": 4}))
-    assert run.lines("KF-RESUMED") == ["KF-RESUMED finished 2"], run.output[-3000:]
+    assert run.lines("KF-RESUMED") == [["finished", "2"]], run.output[-3000:]
     assert (session / "answers.csv").read_bytes().startswith(answers_before)
     rows = read_rows(session / "answers.csv")
     assert [(r["condition"], r["question"], r["attempt"]) for r in rows] == [
-        ("first", "say", "0"), ("first", "hold", "0"), ("second", "say", "1"), ("second", "hold", "1")]
-    assert events_of(session / "02-second")[-1] == "end"
-    # The killed attempt is kept whole beside it.
-    attempt = session / "02-second-attempt1"
-    assert events_of(attempt) == killed
-    assert (attempt / "device.kfsession").read_text() == killed_recording
+        ("first", "say", "1"), ("first", "hold", "1"), ("second", "say", "2"), ("second", "hold", "2")]
+    # The killed attempt is kept whole; the second attempt ran beside it.
+    assert events_of(session / "02-second") == killed
+    assert (session / "02-second" / "device.kfsession").read_text() == killed_recording
+    assert events_of(session / "02-second-attempt2")[-1] == "end"
     log = [row["event"] for row in read_rows(session / "session.csv")]
     assert log == ["start", "resume", "finish"], log
-    for folder in ("01-first", "02-second"):
+    for folder in ("01-first", "02-second-attempt2"):
         data, rate = readers.read_wav(session / folder / "audio.wav")
         assert rate == jack.sample_rate and data.shape[1] == 2 and len(data) > rate, folder
         assert readers.Session(session / folder / "device.kfsession").frames.shape[0] > 1000, folder
