@@ -1,8 +1,10 @@
 // What of a condition has been explored: a map of the fragment on the surface (positionBins
 // parts of areaMm) against the speed range (speedBins parts of [slowMmPerS, fastMmPerS], on a log
 // scale: the paper's "from quite slow to fast"). A cell is covered once the puck has been seen in
-// it; the criterion is met when the fraction covered reaches criterion. The report
-// (python/kfharness/study_report.py) computes the same map from the device recording.
+// it, or has passed through it between two positions seen (a frame every 10 ms misses parts of
+// 0.6 mm at mapping 1's speeds otherwise); the criterion is met when the fraction covered reaches
+// criterion. The report (python/kfharness/study_session.py, coverage) computes the same map from
+// the device recording.
 FrictionStudyCoverage {
 	var <areaMm, <slowMmPerS, <fastMmPerS, <positionBins, <speedBins, <criterion;
 	var <cells, <count = 0;
@@ -11,23 +13,36 @@ FrictionStudyCoverage {
 		^super.newCopyArgs(areaMm, slowMmPerS, fastMmPerS, positionBins, speedBins, criterion).prInit
 	}
 
-	// The cell (positionIndex, speedIndex) of a position (mm) and speed (mm/s), or nil outside.
-	cellOf { |positionMm, speedMmPerS|
-		var p, v, speed = speedMmPerS.abs;
-		if(positionMm < areaMm[0] or: { positionMm >= areaMm[1] }) { ^nil };
+	// The speed's row (from 0, slow), or nil outside the speed range.
+	speedIndexOf { |speedMmPerS|
+		var speed = speedMmPerS.abs;
 		if(speed < slowMmPerS or: { speed >= fastMmPerS }) { ^nil };
-		p = ((positionMm - areaMm[0]) / (areaMm[1] - areaMm[0]) * positionBins).floor.asInteger;
-		v = ((speed / slowMmPerS).log / (fastMmPerS / slowMmPerS).log * speedBins).floor.asInteger;
-		^[p.clip(0, positionBins - 1), v.clip(0, speedBins - 1)]
+		^((speed / slowMmPerS).log / (fastMmPerS / slowMmPerS).log * speedBins).floor.asInteger.clip(0, speedBins - 1)
 	}
 
-	// Notes the puck at positionMm moving at speedMmPerS; true when this covered a new cell.
-	add { |positionMm, speedMmPerS|
-		var cell = this.cellOf(positionMm, speedMmPerS);
-		if(cell.isNil or: { cells[cell[0]][cell[1]] }) { ^false };
-		cells[cell[0]][cell[1]] = true;
-		count = count + 1;
-		^true
+	// The position's column (from 0), or nil outside the area.
+	positionIndexOf { |positionMm|
+		if(positionMm < areaMm[0] or: { positionMm >= areaMm[1] }) { ^nil };
+		^((positionMm - areaMm[0]) / (areaMm[1] - areaMm[0]) * positionBins).floor.asInteger.clip(0, positionBins - 1)
+	}
+
+	// The cell [positionIndex, speedIndex] of a position (mm) and speed (mm/s), or nil outside.
+	cellOf { |positionMm, speedMmPerS|
+		var p = this.positionIndexOf(positionMm), v = this.speedIndexOf(speedMmPerS);
+		^if(p.isNil or: { v.isNil }) { nil } { [p, v] }
+	}
+
+	// Notes the puck moving at speedMmPerS from fromMm to toMm (the positions of two frames in a
+	// row): every column between them is covered at that speed. The number of new cells.
+	add { |fromMm, toMm, speedMmPerS|
+		var v = this.speedIndexOf(speedMmPerS), lo, hi, added = 0;
+		if(v.isNil or: { max(fromMm, toMm) < areaMm[0] } or: { min(fromMm, toMm) >= areaMm[1] }) { ^0 };
+		lo = this.prColumn(min(fromMm, toMm));
+		hi = this.prColumn(max(fromMm, toMm));
+		(lo .. hi).do { |p|
+			if(cells[p][v].not) { cells[p][v] = true; count = count + 1; added = added + 1 }
+		};
+		^added
 	}
 
 	fraction { ^count / (positionBins * speedBins) }
@@ -37,6 +52,13 @@ FrictionStudyCoverage {
 	speedFraction { ^(0 .. speedBins - 1).count { |v| cells.any { |row| row[v] } } / speedBins }
 
 	reset { cells = Array.fill(positionBins, { Array.fill(speedBins, false) }); count = 0 }
+
+	// The column of a position, clipped into the area.
+	prColumn { |positionMm|
+		if(positionMm < areaMm[0]) { ^0 };
+		if(positionMm >= areaMm[1]) { ^positionBins - 1 };
+		^this.positionIndexOf(positionMm)
+	}
 
 	asEvent {
 		^(areaMm: areaMm, slowMmPerS: slowMmPerS, fastMmPerS: fastMmPerS, positionBins: positionBins,

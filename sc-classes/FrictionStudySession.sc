@@ -18,7 +18,7 @@ FrictionStudySession {
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
-	var ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0, routine;
+	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0, routine;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -180,7 +180,9 @@ FrictionStudySession {
 		this.log(\recordAudio);
 		coverage = study.coverageFor(condition);
 		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: s[\friction], audio: s[\audio]);
-		monitor = FrictionViewMonitor.pilot(pilot, 30, 6, { |m| this.prFrame(m) });
+		// 50 frames a second; the cells between two frames are covered too (FrictionStudyCoverage).
+		lastPositionMm = nil;
+		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m, resumed| this.prFrame(m, resumed) });
 		participantWindow !? { participantWindow.showInstruction(condition.instruction) };
 		experimenterWindow !? { experimenterWindow.showCondition };
 		ending = nil;
@@ -230,9 +232,11 @@ FrictionStudySession {
 		^\end
 	}
 
-	prFrame { |m|
+	prFrame { |m, resumed|
 		var area = condition.areaMm;
-		coverage.add(m.positionMm, m.speedMmPerS);
+		if(resumed == true) { lastPositionMm = nil };
+		coverage.add(lastPositionMm ? m.positionMm, m.positionMm, m.speedMmPerS);
+		lastPositionMm = m.positionMm;
 		if(m.positionMm >= area[0] and: { m.positionMm < area[1] }) {
 			stats[\speedSum] = stats[\speedSum] + m.speedMmPerS.abs;
 			stats[\speedCount] = stats[\speedCount] + 1;

@@ -69,7 +69,7 @@ FrictionStudySimParticipant {
 		// the surface, and the speeds it calls slow and fast (the paper's device: 2.6 to 334 mm/s).
 		settings = Routine {
 			thisThread.randSeed = seed;
-			(maxPushN: rrand(1.5, 2.2), gainNSPerM: rrand(6.0, 12.0), adaptS: rrand(0.4, 0.9),
+			(maxPushN: rrand(1.5, 2.2), gainNSPerM: rrand(6.0, 12.0), adaptS: rrand(2.0, 4.0),
 				slowMmPerS: rrand(5.0, 8.0), fastMmPerS: rrand(220.0, 300.0), tiers: 6).yield
 		}.next;
 	}

@@ -37,9 +37,12 @@ double ExploringHand::push(double timeS, double stepS, double positionMm, double
   // How far the puck falls short of the intended speed along the heading (m/s; < 0: too fast).
   const double shortfallMPerS = (intendedSpeedMmPerS(timeS) - direction_ * speedMmPerS) * 1e-3;
   const double correctionN = s.gainNSPerM * shortfallMPerS;
-  // It learns the surface only while it moves the way it heads: a turn's shortfall is the turn's,
-  // not the surface's resistance.
-  if (direction_ * speedMmPerS > 0.0)
+  // It learns the surface only while it moves the way it heads (a turn's shortfall is the turn's,
+  // not the surface's resistance), and where the puck is held it presses harder and harder, by its
+  // strongest push per adaptS, until the puck slides: it dwells where friction binds it.
+  if (speedMmPerS == 0.0)
+    expectedResistanceN_ = std::min(expectedResistanceN_ + s.maxPushN * stepS / s.adaptS, s.maxPushN);
+  else if (direction_ * speedMmPerS > 0.0)
     expectedResistanceN_ = std::clamp(expectedResistanceN_ + correctionN * stepS / s.adaptS, 0.0, s.maxPushN);
   return direction_ * std::clamp(expectedResistanceN_ + correctionN, -s.maxPushN, s.maxPushN);
 }

@@ -9,7 +9,9 @@
 // what a fingertip pushes (maxPushN). The expected resistance is the shortfall's integral with
 // the time constant adaptS (a hand adapts within about a second, not within a millisecond): a
 // constant friction is learnt and then no longer slows the puck, while friction that changes
-// along the strip faster than that binds the puck where it is high, so it dwells there.
+// along the strip faster than that binds the puck where it is high, so it dwells there. Where the
+// puck is held (friction above the push), the participant presses harder, by maxPushN per adaptS,
+// until it slides, as a hand does.
 #pragma once
 
 namespace kf {

@@ -101,15 +101,28 @@ class Condition:
 
 
 def coverage(x, speed, area_mm, settings):
-    """The map FrictionStudyCoverage keeps: positionBins x speedBins, True where visited."""
+    """The map FrictionStudyCoverage keeps (positionBins x speedBins, True where covered): a cell
+    is covered when the puck moved through its part of the area at its speed, between two samples
+    in a row as well as at one."""
     bins_x, bins_v = int(settings["positionBins"]), int(settings["speedBins"])
     slow, fast = float(settings["slowMmPerS"]), float(settings["fastMmPerS"])
+    lo_mm, hi_mm = area_mm
     cells = np.zeros((bins_x, bins_v), dtype=bool)
+    if len(x) == 0:
+        return cells
     v = np.abs(speed)
-    ok = (x >= area_mm[0]) & (x < area_mm[1]) & (v >= slow) & (v < fast)
-    p = np.clip(((x[ok] - area_mm[0]) / (area_mm[1] - area_mm[0]) * bins_x).astype(int), 0, bins_x - 1)
-    k = np.clip((np.log(v[ok] / slow) / np.log(fast / slow) * bins_v).astype(int), 0, bins_v - 1)
-    cells[p, k] = True
+    row = np.floor(np.log(np.maximum(v, 1e-12) / slow) / np.log(fast / slow) * bins_v).astype(int)
+    moving = (v >= slow) & (v < fast)
+    start = np.concatenate([x[:1], x[:-1]])
+    a, b = np.minimum(start, x), np.maximum(start, x)
+    crossing = moving & (b >= lo_mm) & (a < hi_mm)
+
+    def column(mm):
+        return np.clip(np.floor((np.clip(mm, lo_mm, hi_mm) - lo_mm) / (hi_mm - lo_mm) * bins_x).astype(int),
+                       0, bins_x - 1)
+
+    for first, last, k in zip(column(a[crossing]), column(b[crossing]), np.clip(row[crossing], 0, bins_v - 1)):
+        cells[first:last + 1, k] = True
     return cells
 
 
