@@ -8,10 +8,11 @@ FrictionStudyParticipantWindow {
 
 	*new { |session, bounds| ^super.newCopyArgs(session).prInit(bounds) }
 
-	// Shows text (an instruction) with the done button.
-	showInstruction { |text|
+	// Shows text (an instruction) with the done button, labelled button.
+	showInstruction { |text, button = "I am done exploring"|
 		mode = \explore;
 		textView.string = text;
+		doneButton.states = [[button, Color.white, Color(0.15, 0.45, 0.25)]];
 		this.prShowAnswer(nil);
 		doneButton.visible = true;
 	}
@@ -19,7 +20,9 @@ FrictionStudyParticipantWindow {
 	// Shows question (a FrictionStudyQuestion) and the controls to answer it.
 	ask { |question|
 		mode = \question;
-		textView.string = question.text;
+		textView.string = question.text ++ if(question.kind == \rating and: { question.options[2..3].any(_.notEmpty) }) {
+			"\n\n% = %,  % = %".format(question.options[0], question.options[2], question.options[1], question.options[3])
+		} { "" };
 		doneButton.visible = false;
 		this.prShowAnswer(question);
 	}

@@ -59,7 +59,10 @@ FrictionStudySession {
 	// ---- control: from the windows, keys, or code ----
 
 	// The participant (or by: \window, \key, \button, \code) is done exploring.
-	done { |by = \participant| if(state == \running and: { paused.not }) { endedBy = by; ending = \done } }
+	// During the introduction, it ends the introduction.
+	done { |by = \participant|
+		if((state == \running and: { paused.not }) or: { state == \introduction }) { endedBy = by; ending = \done }
+	}
 	// The experimenter ends the condition (its questions follow).
 	next { this.done(\experimenter) }
 	// The condition runs again from its start (what it wrote is kept as an attempt).
@@ -147,7 +150,7 @@ FrictionStudySession {
 	prIntroduction {
 		state = \introduction;
 		ending = nil;
-		participantWindow.showInstruction(study.introduction);
+		participantWindow.showInstruction(study.introduction, "I am ready to begin");
 		while { ending.isNil } { 0.05.wait };
 		if(ending == \abort) { state = \aborted; this.prSessionLog(\abort, "introduction") };
 	}
