@@ -54,7 +54,9 @@ FrictionHand {
 				Error("FrictionHand.explore: arguments must be finite numbers, got %".format(values)).throw
 			}
 		};
-		if(fromMm >= toMm) { Error("FrictionHand.explore: fromMm (%) must be below toMm (%)".format(fromMm, toMm)).throw };
+		if(fromMm >= toMm) {
+			Error("FrictionHand.explore: fromMm (%) must be below toMm (%)".format(fromMm, toMm)).throw
+		};
 		if(slowMmPerS <= 0 or: { fastMmPerS < slowMmPerS }) {
 			Error("FrictionHand.explore: speeds must be 0 < slowMmPerS <= fastMmPerS, got % and %".format(
 				slowMmPerS, fastMmPerS)).throw
@@ -92,7 +94,8 @@ FrictionHand {
 	}
 
 	printOn { |stream|
-		stream << this.class.name << "(" << [\path, \speeds, \force, \path2D, \line, \circle, \raster, \explore][kind] << ")"
+		var kinds = [\path, \speeds, \force, \path2D, \line, \circle, \raster, \explore];
+		stream << this.class.name << "(" << kinds[kind] << ")"
 	}
 
 	*prCheckTuples { |tuples, method, shape, size, ascending|

@@ -55,7 +55,9 @@ FrictionStudyCondition {
 		if(this.settings[\surfaceMm].isNumber.not or: { this.settings[\surfaceMm] <= 0 }) {
 			Error("%: surfaceMm must be > 0, got %".format(where, this.settings[\surfaceMm])).throw
 		};
-		if(instruction.isString.not) { Error("%: instruction must be a String, got %".format(where, instruction)).throw };
+		if(instruction.isString.not) {
+			Error("%: instruction must be a String, got %".format(where, instruction)).throw
+		};
 		if(questions.isSequenceableCollection.not or: { questions.any { |q| q.isKindOf(FrictionStudyQuestion).not } }) {
 			Error("%: questions must be an Array of FrictionStudyQuestion, got %".format(where, questions)).throw
 		};

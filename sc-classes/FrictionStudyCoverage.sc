@@ -72,7 +72,8 @@ FrictionStudyCoverage {
 		};
 		if(slowMmPerS.isNumber.not or: { slowMmPerS <= 0 } or: { fastMmPerS.isNumber.not }
 			or: { fastMmPerS <= slowMmPerS }) {
-			Error("%: speeds must be 0 < slowMmPerS < fastMmPerS, got % and %".format(where, slowMmPerS, fastMmPerS)).throw
+			Error("%: speeds must be 0 < slowMmPerS < fastMmPerS, got % and %".format(where, slowMmPerS,
+				fastMmPerS)).throw
 		};
 		[\positionBins, positionBins, \speedBins, speedBins].pairsDo { |name, n|
 			if(n.isInteger.not or: { n < 1 } or: { n > 100 }) {

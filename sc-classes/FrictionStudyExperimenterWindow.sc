@@ -40,8 +40,8 @@ FrictionStudyExperimenterWindow {
 		met = c.notNil and: { c.isMet };
 		cueText.string = if(c.isNil) { "coverage: -" } {
 			"coverage % % (area % %, speeds % %; criterion % %)%".format((c.fraction * 100).round(1), "%",
-				(c.areaFraction * 100).round(1), "%", (c.speedFraction * 100).round(1), "%", (c.criterion * 100).round(1),
-				"%", if(met) { ": MET" } { "" })
+				(c.areaFraction * 100).round(1), "%", (c.speedFraction * 100).round(1), "%",
+				(c.criterion * 100).round(1), "%", if(met) { ": MET" } { "" })
 		};
 		cueText.background = if(met) { metColor } { Color.gray(0.95) };
 		pauseButton.value = s.paused.binaryValue;

@@ -19,9 +19,10 @@ FrictionStudyParticipantWindow {
 
 	// Shows question (a FrictionStudyQuestion) and the controls to answer it.
 	ask { |question|
+		var o = question.options;
 		mode = \question;
-		textView.string = question.text ++ if(question.kind == \rating and: { question.options[2..3].any(_.notEmpty) }) {
-			"\n\n% = %,  % = %".format(question.options[0], question.options[2], question.options[1], question.options[3])
+		textView.string = question.text ++ if(question.kind == \rating and: { o[2..3].any(_.notEmpty) }) {
+			"\n\n% = %,  % = %".format(o[0], o[2], o[1], o[3])
 		} { "" };
 		doneButton.visible = false;
 		this.prShowAnswer(question);

@@ -51,7 +51,8 @@ FrictionStudyQuestion {
 		if(kind == \rating and: {
 			options[0].isInteger.not or: { options[1].isInteger.not } or: { options[0] >= options[1] }
 		}) {
-			Error("%: lo and hi must be whole numbers with lo < hi, got % and %".format(where, options[0], options[1])).throw
+			Error("%: lo and hi must be whole numbers with lo < hi, got % and %".format(where, options[0],
+				options[1])).throw
 		};
 		if(kind == \choice and: {
 			options.isSequenceableCollection.not or: { options.size < 2 } or: { options.any { |o| o.isString.not } }

@@ -18,7 +18,8 @@ FrictionStudySession {
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
-	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0, routine;
+	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
+	var routine;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -80,7 +81,9 @@ FrictionStudySession {
 	}
 	// The answer to the question asked now (checked by it; an Error if it does not fit).
 	answer { |value, source = \participant|
-		if(state != \questions or: { question.isNil }) { Error("FrictionStudySession: no question is asked now").throw };
+		if(state != \questions or: { question.isNil }) {
+			Error("FrictionStudySession: no question is asked now").throw
+		};
 		answerValue = [question.check(value), source];
 	}
 
@@ -196,7 +199,9 @@ FrictionStudySession {
 		while { ending.isNil } {
 			0.05.wait;
 			if(paused.not) {
-				if(simulated.notNil and: { simulated.isDone(coverage, this.elapsedS, condition) }) { this.done(\participant) };
+				if(simulated.notNil and: { simulated.isDone(coverage, this.elapsedS, condition) }) {
+					this.done(\participant)
+				};
 				if(ending.isNil and: { this.elapsedS >= condition.maxTimeS }) { ending = \maxTime; endedBy = \time };
 			};
 		};
@@ -325,7 +330,8 @@ FrictionStudySession {
 		if(argStudy.isKindOf(FrictionStudy).not) { Error("%: study must be a FrictionStudy".format(where)).throw };
 		participant = argParticipant.asString;
 		if(participant.isEmpty or: { participant.every { |c| c.isAlphaNum or: { "_-".includes(c) } }.not }) {
-			Error("%: the participant code must be letters, digits, _ and -, got %".format(where, argParticipant.cs)).throw
+			Error("%: the participant code must be letters, digits, _ and -, got %".format(where,
+				argParticipant.cs)).throw
 		};
 		FrictionStudyFiles.checkWritable(root, where);
 		folder = root.standardizePath +/+ participant;
@@ -343,10 +349,14 @@ FrictionStudySession {
 		if(argSimulated.notNil and: { argSimulated.isKindOf(FrictionStudySimParticipant).not }) {
 			Error("%: simulated must be a FrictionStudySimParticipant, got %".format(where, argSimulated)).throw
 		};
-		if(argServer.isKindOf(Server).not) { Error("%: server must be a Server, got %".format(where, argServer)).throw };
+		if(argServer.isKindOf(Server).not) {
+			Error("%: server must be a Server, got %".format(where, argServer)).throw
+		};
 		FrictionCheck.serverRunning(argServer, where);
 		[\participantOut, argParticipantOut, \experimenterOut, argExperimenterOut].pairsDo { |name, bus|
-			if(bus.isInteger.not or: { bus < 0 }) { Error("%: % must be an Integer >= 0, got %".format(where, name, bus)).throw }
+			if(bus.isInteger.not or: { bus < 0 }) {
+				Error("%: % must be an Integer >= 0, got %".format(where, name, bus)).throw
+			}
 		};
 		if((argParticipantOut - argExperimenterOut).abs < 2) {
 			Error("%: the participant's pair (%, %) and the experimenter's (%, %) overlap".format(where,
@@ -361,7 +371,9 @@ FrictionStudySession {
 		if(argIndex.isInteger.not or: { argIndex < 0 }) {
 			Error("%: participantIndex must be an Integer >= 0, got %".format(where, argIndex)).throw
 		};
-		if(argSeed.notNil and: { argSeed.isInteger.not }) { Error("%: seed must be an Integer or nil".format(where)).throw };
+		if(argSeed.notNil and: { argSeed.isInteger.not }) {
+			Error("%: seed must be an Integer or nil".format(where)).throw
+		};
 		study = argStudy;
 		server = argServer;
 		participantIndex = argIndex;

@@ -61,7 +61,9 @@ FrictionStudySimParticipant {
 	printOn { |stream| stream << this.class.name << "(" << seed << ")" }
 
 	prInit {
-		if(seed.isInteger.not) { Error("FrictionStudySimParticipant: seed must be an Integer, got %".format(seed)).throw };
+		if(seed.isInteger.not) {
+			Error("FrictionStudySimParticipant: seed must be an Integer, got %".format(seed)).throw
+		};
 		if(exploreS.notNil and: { exploreS.isNumber.not or: { exploreS <= 0 } or: { exploreS == inf } }) {
 			Error("FrictionStudySimParticipant: exploreS must be a finite number > 0, got %".format(exploreS)).throw
 		};

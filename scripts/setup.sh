@@ -10,6 +10,7 @@ PACKAGES=(
   supercollider-dev supercollider-server supercollider-supernova supercollider-language
   libhidapi-dev libusb-1.0-0-dev catch2 libsndfile1-dev jackd2
   python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
+  python3-scipy  # the study report's paired t test (python/kfharness/study_report.py)
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
 )

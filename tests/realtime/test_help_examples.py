@@ -249,7 +249,9 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
     run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
                                                piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
                                                free_each_block=str(FREE_EACH_BLOCK).lower()),
-                                 jack, name="help", timeout=timeout, booted=booted)
+                                 jack, name="help", timeout=timeout, booted=booted,
+                                 # The study's examples: the participant's pair and the experimenter's.
+                                 server_options={"numOutputBusChannels": 4})
     examples, in_file, current, notes, problems = [], [], None, [], []
     where, temp_dir, finished, in_stack = "(before the first example)", "/tmp", False, False
     for line in run.output.splitlines():
