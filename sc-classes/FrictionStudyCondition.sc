@@ -1,10 +1,16 @@
 // One condition of a FrictionStudy: a scene (the paper's pilot signal under a mapping, friction
 // on or off, audio on or off), the instruction shown to the participant, how it ends (the
-// participant's "done", or maxTimeS) and the questions asked after it.
+// participant's "done", or maxTimeS) and the questions asked after it. Or a threshold condition
+// (*threshold): a forced-choice experiment (FrictionThreshold) run on the device, each of its
+// trials a row of the session's trials.csv.
 FrictionStudyCondition {
 	// The scene's settings and their defaults; any other key is refused.
 	classvar <sceneDefaults;
 	var <name, <scene, <instruction, <questions, <maxTimeS;
+	// A threshold condition's: a Function that makes the experiment (a new one for each run: its
+	// procedure keeps the trials), how a person answers (\keys, \buttons) and a Function of a seed
+	// that makes the model observer answering for a simulated participant.
+	var <makeExperiment, <answers, <makeObserver;
 
 	*initClass {
 		// mapping: a name of Table 1 or samples per mm; origin: where the fragment begins (mm);
@@ -15,6 +21,30 @@ FrictionStudyCondition {
 
 	*new { |name, scene, instruction = "", questions, maxTimeS = 300|
 		^super.newCopyArgs(name, scene, instruction, questions ? [], maxTimeS).prCheck
+	}
+
+	// A threshold condition: makeExperiment.value gives an object that runs inside a Routine with
+	// run(device, answers, onTrial, onEnd, out) (FrictionThreshold: a procedure's trials, each
+	// passed to onTrial as an Event) and returns the estimate. answers: \keys or \buttons for a
+	// person; makeObserver.value(seed): the answers of a simulated participant (FrictionObserver).
+	*threshold { |name, makeExperiment, instruction = "", questions, maxTimeS = 1800, answers = \keys, makeObserver|
+		var c = this.new(name, (mapping: \mapping2, surfaceMm: 40), instruction, questions, maxTimeS);
+		if(makeExperiment.isFunction.not) {
+			Error("FrictionStudyCondition.threshold(%): makeExperiment must be a Function".format(name)).throw
+		};
+		if(answers != \keys and: { answers != \buttons }) {
+			Error("FrictionStudyCondition.threshold(%): answers must be \\keys or \\buttons, got %".format(name,
+				answers)).throw
+		};
+		^c.prThreshold(makeExperiment, answers, makeObserver)
+	}
+
+	isThreshold { ^makeExperiment.notNil }
+
+	prThreshold { |argMake, argAnswers, argObserver|
+		makeExperiment = argMake;
+		answers = argAnswers;
+		makeObserver = argObserver;
 	}
 
 	// The scene with every default filled in.
@@ -30,7 +60,7 @@ FrictionStudyCondition {
 
 	asEvent {
 		^(name: name, scene: this.settings, instruction: instruction, maxTimeS: maxTimeS,
-			questions: questions.collect(_.asEvent))
+			questions: questions.collect(_.asEvent), threshold: this.isThreshold, answers: answers)
 	}
 
 	printOn { |stream| stream << this.class.name << "(" << name.cs << ")" }

@@ -12,7 +12,7 @@
 // Everything is checked before the first participant sees anything (the study, the code, the
 // folder, the server, the channels, the device): a refusal is an Error with the reason.
 FrictionStudySession {
-	classvar <answersHeader, <eventsHeader;
+	classvar <answersHeader, <eventsHeader, <trialsHeader;
 	var <study, <participant, <folder, <server, <participantIndex, <seed, <device, <simulated, <windows;
 	var <participantOut, <experimenterOut, <deviceIndex;
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
@@ -24,6 +24,8 @@ FrictionStudySession {
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
 		eventsHeader = #[timeS, event, detail, wallTime];
+		trialsHeader = #[participant, position, condition, attempt, trial, level, target, answer, correct, startS,
+			interval1S, interval2S, answerS, wallTime];
 	}
 
 	// study: a FrictionStudy. participant: a code (letters, digits, _ and -), never used before in
@@ -174,6 +176,7 @@ FrictionStudySession {
 		} { device };
 		conditionDevice.record(conditionDir +/+ "device.kfsession");
 		this.log(\recordDevice);
+		if(condition.isThreshold) { ^this.prRunThreshold };
 		pilot = FrictionPilot(conditionDevice, s[\mapping], s[\friction], s[\origin], if(s[\audio]) { s[\amp] } { 0 },
 			participantOut);
 		pilot.play;
@@ -217,6 +220,11 @@ FrictionStudySession {
 		if(simulated.notNil) { conditionDevice.close };
 		server.sync;
 		if(ending == \repeat or: { ending == \abort }) { ^ending };
+		^this.prQuestions
+	}
+
+	// The questions after a condition, each answer written and flushed as it is given.
+	prQuestions {
 		state = \questions;
 		condition.questions.do { |q|
 			if(ending != \abort) {
@@ -238,6 +246,50 @@ FrictionStudySession {
 		if(ending == \abort) { this.log(\abort); ^\abort };
 		this.log(\end, condition.name);
 		^\end
+	}
+
+	// A threshold condition: the experiment's trials (each a line of trials.csv, flushed), its
+	// estimate in the events, then the questions. The experiment plays on the participant's pair.
+	prRunThreshold {
+		var experiment = condition.makeExperiment.value, estimate, how;
+		how = if(simulated.notNil) { condition.makeObserver.value(simulated.seed) } { condition.answers };
+		if(how.isNil) { Error("threshold condition %: no makeObserver for a simulated participant".format(
+			condition.name)).throw };
+		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
+		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
+		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
+		server.sync;
+		while { recorder.isRecording.not } { 0.01.wait };
+		this.log(\recordAudio);
+		coverage = study.coverageFor(condition);
+		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: true, audio: true);
+		participantWindow !? {
+			participantWindow.showInstruction(condition.instruction);
+			participantWindow.doneButton.visible = false;  // the experiment ends it
+		};
+		experimenterWindow !? { experimenterWindow.refresh };
+		ending = nil;
+		endedBy = nil;
+		conditionT0 = Main.elapsedTime;
+		state = \running;
+		this.log(\start, condition.name);
+		estimate = experiment.run(conditionDevice, how, { |trial|
+			FrictionStudyFiles.appendCsv(folder +/+ "trials.csv", [participant, position + 1, condition.name, attempt]
+				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
+					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
+			this.log(\trial, trial[\trial]);
+		}, nil, participantOut);
+		endedBy = \procedure;
+		this.log(\done, \procedure);
+		this.log(\estimate, FrictionStudyFiles.json(estimate));
+		state = \stopping;
+		recorder.stopRecording;
+		listenSynth.free;
+		server.sync;
+		conditionDevice.stopRecording;
+		if(simulated.notNil) { conditionDevice.close };
+		server.sync;
+		^this.prQuestions
 	}
 
 	prFrame { |m, resumed|

@@ -205,8 +205,12 @@ def write_report(root, out_dir):
                for a in session_answers]
         trials = session.folder / "trials.csv"
         if trials.exists():
-            from . import psychometric
-            md += ["", psychometric.report_section(trials, out_dir, name=session.participant)]
+            try:
+                from . import psychometric  # the threshold procedures' fit (issue 38, "procs")
+            except ImportError:
+                md += ["", f"Threshold trials in `{trials}`: the fit needs kfharness.psychometric."]
+            else:
+                md += ["", psychometric.report_section(trials, out_dir, name=session.participant)]
         md.append("")
 
     by_mapping = {}
