@@ -1,7 +1,7 @@
 // The exploring participant (sim/ExploringHand): it sweeps its strip from slow to fast, keeps to
 // the strip, learns a constant friction away, and is bound where friction is high.
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <functional>
 #include <vector>
