@@ -77,11 +77,14 @@ class Condition:
         r = session.reports
         if len(r) < SPEED_REPORTS + 2:
             return np.zeros(0), np.zeros(0), np.zeros(0)
-        t = r[:, 0] - r[0, 0] + (self.event_time("recordDevice") or 0.0)
+        # The mouse's own timestamps (deviceTimeS): one report every 8 ms, where the device thread's
+        # hostTimeS gives several reports handled in one pump the same time.
+        t = r[:, 1] - r[0, 1] + (self.event_time("recordDevice") or 0.0)
         x = np.cumsum(r[:, 2]) * count_mm
         k = SPEED_REPORTS
         speed = np.full_like(x, np.nan)
-        speed[k:] = (x[k:] - x[:-k]) / (t[k:] - t[:-k])
+        dt = t[k:] - t[:-k]
+        speed[k:] = np.where(dt > 0, (x[k:] - x[:-k]) / np.where(dt > 0, dt, 1.0), np.nan)
         keep = ~np.isnan(speed) & (t >= (self.start_s or 0.0)) & (t <= (self.stop_s or np.inf))
         return t[keep], x[keep], speed[keep]
 
@@ -111,8 +114,8 @@ def coverage(x, speed, area_mm, settings):
     if len(x) == 0:
         return cells
     v = np.abs(speed)
-    row = np.floor(np.log(np.maximum(v, 1e-12) / slow) / np.log(fast / slow) * bins_v).astype(int)
     moving = (v >= slow) & (v < fast)
+    row = np.floor(np.log(np.where(moving, v, slow) / slow) / np.log(fast / slow) * bins_v).astype(int)
     start = np.concatenate([x[:1], x[:-1]])
     a, b = np.minimum(start, x), np.maximum(start, x)
     crossing = moving & (b >= lo_mm) & (a < hi_mm)

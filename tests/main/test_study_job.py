@@ -66,7 +66,7 @@ def test_the_study_job_writes_five_sessions_and_their_report():
         png_size(OUT / name)
 
     # The binds statistic, computed again from the per-participant speeds: the report's t is the
-    # paired t of the differences, and friction on is slower over all mappings.
+    # paired t of the differences.
     pairs = rows(OUT / "binds.csv")
     assert len(pairs) == 15
     tests = {r["group"]: r for r in rows(OUT / "binds-test.csv")}
@@ -77,5 +77,9 @@ def test_the_study_job_writes_five_sessions_and_their_report():
     t = d.mean() / (d.std(ddof=1) / np.sqrt(len(d)))
     overall = tests["all mappings"]
     assert int(overall["n"]) == 5 and abs(float(overall["t"]) - t) < 1e-9 * abs(t)
-    # Measured at 3 s (scripts/study.sh --explore-s 3): t(4) = 8.5, p = 0.001.
-    assert d.mean() > 0 and float(overall["p"]) < 0.05, overall
+    # Mapping 1's 6 mm of 0.5 N bind every simulated participant's typical speed there (the
+    # participants learn a constant resistance within 2 to 4 s, but each crossing of the fragment
+    # is shorter than that). Mapping 3's bumps are another matter (stick and slip: released past a
+    # peak, the puck slides fast to the next), so no sign is asserted over all mappings.
+    mapping1 = [float(p["difference"]) for p in pairs if p["mapping"] == "mapping1"]
+    assert np.mean(mapping1) > 0 and float(tests["mapping1"]["t"]) > 0, tests["mapping1"]
