@@ -76,13 +76,16 @@ def _speed_figure(rows_by_mapping, path):
                                     or [np.zeros(0)])
             speeds = speeds[speeds > 0]
             if len(speeds):
-                ax.hist(speeds, bins=bins, density=True, histtype="step", color=color, lw=1.5,
+                # The share of the time in each bin (bins equal on the log axis; a density per mm/s
+                # would blow up the narrow slow bins).
+                ax.hist(speeds, bins=bins, weights=np.full(len(speeds), 1.0 / len(speeds)), histtype="step",
+                        color=color, lw=1.5,
                         label=f"friction {'on' if friction else 'off'} (median {np.median(speeds):.0f} mm/s)")
         ax.set_xscale("log")
         ax.set_title(mapping)
         ax.set_xlabel("speed in the fragment (mm/s)")
         ax.legend(fontsize=7)
-    axes[0][0].set_ylabel("density")
+    axes[0][0].set_ylabel("share of the time in the fragment")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)

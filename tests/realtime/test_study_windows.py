@@ -1,6 +1,6 @@
 """The two windows of a FrictionStudy session, as the participant and the experimenter use them:
 on a virtual X display (Xvfb), driven from code (the done button, the space key, typing, the
-rating and choice buttons, pause and go on), with screenshots (Image.fromWindow) whose pixels are
+rating and choice buttons, pause and go on, repeat), with screenshots (Image.fromWindow) whose pixels are
 checked: the participant's window shows the instruction, the question and its controls and
 nothing else (no coverage, no live view); the experimenter's shows the live view and the coverage
 map, whose filled part is the fraction covered. The experimenter's output pair carries what the
@@ -58,6 +58,10 @@ listen.record(dir +/+ "experimenter.wav", 2, 2);
 session.experimenterWindow.pauseButton.valueAction = 1;
 0.5.wait;
 session.experimenterWindow.pauseButton.valueAction = 0;
+0.5.wait;
+// The experimenter has the condition repeated: it runs again into a second attempt's folder.
+session.experimenterWindow.repeatButton.valueAction = 0;
+wait.({ session.attempt == 2 and: { session.state == \running } });
 2.wait;
 session.experimenterWindow.refresh;
 "KF-COVERAGE % %".format(session.coverage.count, session.coverage.fraction).postln;
@@ -152,13 +156,15 @@ def test_the_windows_driven_as_people_would(jack, display):
     assert [(a["question"], a["answer"], a["source"]) for a in answers] == [
         ("say", 'sticky, like "syrup"', "participant"), ("hold", "4", "participant"),
         ("which", "touch", "participant")]
-    events = [(e["event"], e["detail"]) for e in rows(folder / "01-explore" / "events.csv")]
-    assert [e for e, _ in events] == ["prepare", "recordDevice", "recordAudio", "start", "pause", "resume", "done",
-                                      "coverage", "answer", "answer", "answer", "end"], events
-    assert ("done", "key") in events
+    first = [e["event"] for e in rows(folder / "01-explore" / "events.csv")]
+    assert first == ["prepare", "recordDevice", "recordAudio", "start", "pause", "resume", "repeat", "coverage"], first
+    events = [(e["event"], e["detail"]) for e in rows(folder / "01-explore-attempt2" / "events.csv")]
+    assert [e for e, _ in events] == ["prepare", "recordDevice", "recordAudio", "start", "done", "coverage", "answer",
+                                      "answer", "answer", "end"], events
+    assert ("done", "key") in events and all(a["attempt"] == "2" for a in answers)
 
     # The experimenter hears the participant: its pair carries the same audio as heard.
-    heard, rate = readers.read_wav(folder / "01-explore" / "audio.wav")
+    heard, rate = readers.read_wav(folder / "01-explore-attempt2" / "audio.wav")
     listened, _ = readers.read_wav(ARTEFACTS / "experimenter.wav")
     assert np.abs(listened).max() > 0.2
     assert np.abs(listened).max() == pytest.approx(np.abs(heard).max(), rel=0.05)
