@@ -194,6 +194,14 @@ def write_report(root, out_dir):
                       f"{'on' if row['audio'] else 'off'} | {row['duration_s']:.1f} | {row['ended_by']} | "
                       f"{100 * row['coverage_live']:.0f} % | {100 * row['coverage_recording']:.0f} % | "
                       f"{row['median_speed_inside']:.1f} | {row['time_inside_s']:.1f} | {c.attempts} |")
+        mine = [r for r in rows if r["participant"] == session.participant]
+        if mine:
+            speeds_png = f"speeds-{session.participant}.png"
+            by = {}
+            for r in mine:
+                by.setdefault(r["mapping"], []).append(r)
+            _speed_figure(by, out_dir / speeds_png)
+            md += ["", "Speeds in the fragment, friction off against on:", "", f"![speeds]({speeds_png})"]
         if measured:
             cov_png = f"coverage-{session.participant}.png"
             _coverage_figure(session, measured, out_dir / cov_png)

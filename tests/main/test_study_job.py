@@ -44,8 +44,9 @@ def test_the_study_job_writes_five_sessions_and_their_report():
         assert s.finished and s.manifest["order"] == CONDITIONS
         assert [c.complete and c.attempts == 0 for c in s.conditions] == [True] * 6
         for c in s.conditions:
-            # Ended by the participant: when covered enough, or after its 3 s of exploring.
-            assert c.ended_by == "participant" and 0.5 < c.duration_s < EXPLORE_S + 0.5, (s.participant, c.name)
+            # Ended by the participant: when covered enough, or after its 3 s of exploring (checked
+            # every 0.05 s; 1 s for sclang's clock to wake up late on a busy machine).
+            assert c.ended_by == "participant" and 0.5 < c.duration_s < EXPLORE_S + 1.0, (s.participant, c.name)
             assert (c.folder / "audio.wav").stat().st_size > 0 and (c.folder / "device.kfsession").stat().st_size > 0
         assert {(a["condition"], a["question"]) for a in s.answers} == {
             (c, q) for c in CONDITIONS for q in (["audio"] if c.endswith("off") else ["touch", "relation"])}
@@ -58,10 +59,11 @@ def test_the_study_job_writes_five_sessions_and_their_report():
         assert f"![{r['condition']}]({r['figure3']})" in report
         assert png_size(OUT / r["figure3"]) == (540, 810)  # 9 x 6 in at 90 dpi
         # The map the experimenter saw (50 frames a second) and the one from the recording (125
-        # reports a second) differ by the cells one sees and the other misses at the map's edges:
-        # measured up to 0.11 apart for mapping 1's 6 mm (0.6 mm columns), a few % elsewhere.
+        # reports a second, speeds over 40 ms) differ by the cells one sees and the other misses at
+        # the map's edges and at speed steps: measured at most 0.083 apart over three runs of this
+        # job (90 conditions); 0.17 once in a full run, mapping 1's 6 mm crossed at 250 mm/s.
         assert abs(float(r["coverage_live"]) - float(r["coverage_recording"])) < 0.15, r
-    for name in ["speeds.png"] + [f"coverage-P{i}.png" for i in range(1, 6)]:
+    for name in ["speeds.png"] + [f"{kind}-P{i}.png" for i in range(1, 6) for kind in ("coverage", "speeds")]:
         assert f"({name})" in report
         png_size(OUT / name)
 

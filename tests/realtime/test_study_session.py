@@ -93,7 +93,8 @@ while { ~session.isOver.not } { 0.1.wait };
     while time.monotonic() < deadline and not (second_events.exists() and "start" in second_events.read_text()):
         time.sleep(0.05)
     assert second_events.exists(), "the second condition never started"
-    time.sleep(0.8)  # mid-condition: 0.8 s into 2.5 s of exploring
+    # Mid-condition: 0.6 s into its 2.5 s of exploring (1.9 s to spare for a slow wake-up here).
+    time.sleep(0.6)
     sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
     os.kill(scsynth_pid, signal.SIGKILL)
     os.kill(sclang_pid, signal.SIGKILL)
@@ -112,7 +113,8 @@ while { ~session.isOver.not } { 0.1.wait };
     killed = events_of(session / "02-second")
     assert "start" in killed and "end" not in killed, killed
     killed_recording = (session / "02-second" / "device.kfsession").read_text()
-    assert killed_recording.count("\nR ") > 50, "the killed condition's recording lost its lines"
+    # Recorded from before the start line: at least 0.6 s of reports at 125 Hz (75), less a margin.
+    assert killed_recording.count("\nR ") > 40, "the killed condition's recording lost its lines"
 
     # Run 2: resume from sclang; the second condition runs again, the first is kept as it was.
     second = STUDY + sclang.fill(r"""
