@@ -365,7 +365,9 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
                          boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
                          free_each_block=str(FREE_EACH_BLOCK).lower())
-    run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted)
+    run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
+                                 # The study's examples: the participant's pair and the experimenter's.
+                                 server_options={"numOutputBusChannels": 4})
     examples, in_file, current, notes, problems = [], [], None, [], []
     where, temp_dir, finished, in_stack = "(before the first example)", "/tmp", False, False
     for line in run.output.splitlines():
