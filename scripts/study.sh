@@ -9,5 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+# The report's paired t test (python/kfharness/study_report.py) and the threshold fits: scipy.
+source scripts/packages.sh
+kf_install_missing python3-scipy
 source scripts/env.sh
 "$KF_PYTHON" scripts/study/study_job.py "$@"
