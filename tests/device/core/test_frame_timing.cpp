@@ -97,7 +97,10 @@ TEST_CASE("realtime frames leave one per ms at their own time with 64-sample blo
   // on a loaded machine can hold the device thread up).
   const uint64_t skipped = r.telemetry.skippedFrames;
   REQUIRE(commands.size() + skipped == static_cast<size_t>(r.framesPushed));
-  CHECK(skipped <= r.telemetry.missedDeadlines + 1);  // at most the frames of the missed pumps
+  // A pump woken d late (k = floor(d / 1 ms) deadlines missed) finds due the frames of the
+  // k + 1 ms since the last pump's window, at most k + 2, sends one and skips at most k + 1
+  // <= 2k: so at most twice the missed deadlines in all (CI saw 29 skipped for 25 missed).
+  CHECK(skipped <= 2 * r.telemetry.missedDeadlines);
   for (size_t j = 0, frame = 0; j < commands.size(); ++j, ++frame) {
     while (frame < j + skipped && commands[j].forceN != 0.2f + 0.001f * static_cast<float>(frame % 1000)) ++frame;
     CHECK(commands[j].forceN == 0.2f + 0.001f * static_cast<float>(frame % 1000));

@@ -189,12 +189,15 @@ TEST_CASE("an exception on the device thread drives the magnet off and is posted
   std::string error;
   REQUIRE(device.startRecording(path, error));
   device.start();
+  // The thread drives the magnet off, then posts: its message says it has done both.
+  std::vector<std::string> messages;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (force->offs.load() == 0 && std::chrono::steady_clock::now() < deadline)
+  while (messages.empty() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    messages = takeMessages();
+  }
   CHECK(force->offs.load() == 1);
   CHECK(device.telemetry().lastCommandedForceN == Approx(DeviceSpec{}.minForceN));
-  const std::vector<std::string> messages = takeMessages();
   REQUIRE(messages.size() == 1);
   CHECK(contains(messages[0], "driver lost the device"));
   device.close();  // joins the ended thread
@@ -338,8 +341,10 @@ TEST_CASE("a disk that falls behind stops the recording instead of the device th
   std::string lines = "R 1\n";
   REQUIRE(writer->hand(lines));
   CHECK(lines.empty());
-  // More than the queue holds in one hand-over: as a disk that stalled for half a minute.
-  std::string flood(RecordingWriter::kQueueBytes, 'x');
+  // More than the queue holds in one hand-over, even empty: as a disk that stalled for half a
+  // minute. (A flood of exactly the queue's size fitted whenever the writer had taken "R 1"
+  // meanwhile: it writes every 10 ms, and a loaded machine let it in between.)
+  std::string flood(RecordingWriter::kQueueBytes + 1, 'x');
   flood.back() = '\n';
   CHECK_FALSE(writer->hand(flood));
   CHECK(contains(writer->error(), "MiB behind"));
