@@ -249,12 +249,22 @@ FrictionStudySession {
 	}
 
 	// A threshold condition: the experiment's trials (each a line of trials.csv, flushed), its
-	// estimate in the events, then the questions. The experiment plays on the participant's pair.
+	// estimate in the events, then the questions. The experiment plays on the participant's pair. A
+	// simulated participant answers through the condition's makeObserver, or its own observer for
+	// the experiment's kind; the experiment and the observer (its known threshold) are logged.
 	prRunThreshold {
-		var experiment = condition.makeExperiment.value, estimate, how;
-		how = if(simulated.notNil) { condition.makeObserver.value(simulated.seed) } { condition.answers };
-		if(how.isNil) { Error("threshold condition %: no makeObserver for a simulated participant".format(
-			condition.name)).throw };
+		var experiment = condition.makeExperiment.value, estimate, how, right = 0, count = 0;
+		how = if(simulated.notNil) {
+			condition.makeObserver !? { |make| make.value(simulated.seed) } ?? {
+				if(experiment.respondsTo(\kind).not) {
+					Error("threshold condition %: no makeObserver, and the experiment has no kind for the simulated "
+						"participant's observer".format(condition.name)).throw
+				};
+				simulated.observerFor(experiment.kind)
+			}
+		} { condition.answers };
+		if(experiment.respondsTo(\asEvent)) { this.log(\experiment, FrictionStudyFiles.json(experiment.asEvent)) };
+		if(how.respondsTo(\asEvent)) { this.log(\observer, FrictionStudyFiles.json(how.asEvent)) };
 		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
 		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
 		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
@@ -262,7 +272,6 @@ FrictionStudySession {
 		while { recorder.isRecording.not } { 0.01.wait };
 		this.log(\recordAudio);
 		coverage = study.coverageFor(condition);
-		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: true, audio: true);
 		participantWindow !? {
 			participantWindow.showInstruction(condition.instruction);
 			participantWindow.doneButton.visible = false;  // the experiment ends it
@@ -278,10 +287,13 @@ FrictionStudySession {
 				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
 					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
 			this.log(\trial, trial[\trial]);
+			count = count + 1;
+			if(trial[\correct] == true) { right = right + 1 };
 		}, nil, participantOut);
 		endedBy = \procedure;
 		this.log(\done, \procedure);
 		this.log(\estimate, FrictionStudyFiles.json(estimate));
+		stats = (trials: count, correct: right);
 		state = \stopping;
 		recorder.stopRecording;
 		listenSynth.free;
@@ -306,6 +318,7 @@ FrictionStudySession {
 	}
 
 	prStats {
+		if(stats[\trials].notNil) { ^stats.copy };
 		^(meanSpeedMmPerS: stats[\speedSum] / max(1, stats[\speedCount]), maxForceN: stats[\maxForceN],
 			coverage: coverage.fraction, friction: stats[\friction], audio: stats[\audio])
 	}

@@ -9,7 +9,8 @@ import signal
 import threading
 import time
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 
 # Two conditions of mapping 1 (its 6 mm), each explored for 2.5 s by a simulated participant
 # (explore-s: 6 speed steps of 0.42 s), and a free-text and a rating question after each.

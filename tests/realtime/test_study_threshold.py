@@ -72,7 +72,7 @@ def test_a_threshold_condition_writes_its_trials(jack):
     assert [(a["question"], a["source"]) for a in rows(folder / "answers.csv")] == [("how", "simulated")]
     manifest = json.loads((folder / "manifest.json").read_text())
     assert manifest["study"]["conditions"][0]["threshold"] is True
-    # The report takes the session; its threshold section is the fit's (kfharness.psychometric).
+    # The report takes the session; its threshold section is the fit's (kfstudy.psychometric).
     summary = study_report.write_report(root, root / "report")
     assert len(summary["sessions"]) == 1
     assert "Threshold" in (root / "report" / "report.md").read_text()

@@ -10,7 +10,8 @@ import re
 import numpy as np
 import pytest
 
-from kfharness import paths, psignifit_cli, psychometric, questplus_ref, sclang, thresholds
+from kfharness import paths, psignifit_cli, questplus_ref, sclang, thresholds
+from kfstudy import psychometric
 
 OBS = thresholds.OBSERVER
 
