@@ -19,6 +19,7 @@ FrictionStudySession {
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
+	var buttonsSynth, buttonsResponder;
 	var routine;
 
 	*initClass {
@@ -61,7 +62,7 @@ FrictionStudySession {
 
 	// ---- control: from the windows, keys, or code ----
 
-	// The participant (or by: \window, \key, \button, \code) is done exploring.
+	// The participant (or by: \window, \key, \button (a puck button), \code) is done exploring.
 	// During the introduction, it ends the introduction.
 	done { |by = \participant|
 		if((state == \running and: { paused.not }) or: { state == \introduction }) { endedBy = by; ending = \done }
@@ -126,6 +127,10 @@ FrictionStudySession {
 			var result;
 			try {
 				SynthDef(\frictionStudyListen, { Out.ar(\out.kr(2), In.ar(\in.kr(0), 2)) }).add;
+				// A press of any of the puck's buttons (FrictionButtons) is the participant's "done".
+				SynthDef(\frictionStudyButtons, {
+					SendReply.kr(FrictionButtons.kr(\device.kr(0)).sum > 0, '/kfStudyButton', 1)
+				}).add;
 				server.sync;
 				if(windows) {
 					participantWindow = FrictionStudyParticipantWindow(this);
@@ -182,6 +187,9 @@ FrictionStudySession {
 		pilot.play;
 		server.sync;
 		listenSynth = Synth.after(pilot.synth, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
+		buttonsSynth = Synth.tail(server, \frictionStudyButtons, [\device, conditionDevice.index]);
+		buttonsResponder = OSCFunc({ this.done(\button) }, '/kfStudyButton', server.addr,
+			argTemplate: [buttonsSynth.nodeID]);
 		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
 		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
 		server.sync;
@@ -214,6 +222,8 @@ FrictionStudySession {
 		recorder.stopRecording;
 		monitor.free;
 		listenSynth.free;
+		buttonsResponder.free;
+		buttonsSynth.free;
 		pilot.free;
 		server.sync;
 		conditionDevice.stopRecording;
