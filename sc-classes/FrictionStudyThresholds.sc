@@ -19,8 +19,9 @@
 		if(trials.isInteger.not or: { trials < 1 }) {
 			Error("FrictionStudy.thresholdConditions: trials must be an Integer >= 1, got %".format(trials)).throw
 		};
-		how = if(answers == \buttons) { "Press the left button if it was the first interval, the right if the second." } {
-			"Press 1 if it was the first interval, 2 if the second." };
+		how = if(answers == \buttons) {
+			"Press the left button if it was the first interval, the right if the second."
+		} { "Press 1 if it was the first interval, 2 if the second." };
 		quest = { |kind| FrictionQuestPlus(levels[kind], maxTrials: trials) };
 		question = FrictionStudyQuestion.text(\how, "How did you tell the two intervals apart?");
 		^[
