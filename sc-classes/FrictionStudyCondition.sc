@@ -26,7 +26,8 @@ FrictionStudyCondition {
 	// A threshold condition: makeExperiment.value gives an object that runs inside a Routine with
 	// run(device, answers, onTrial, onEnd, out) (FrictionThreshold: a procedure's trials, each
 	// passed to onTrial as an Event) and returns the estimate. answers: \keys or \buttons for a
-	// person; makeObserver.value(seed): the answers of a simulated participant (FrictionObserver).
+	// person; makeObserver.value(seed): the answers of a simulated participant (FrictionObserver);
+	// nil: the simulated participant's own observer for the experiment's kind (observerFor).
 	*threshold { |name, makeExperiment, instruction = "", questions, maxTimeS = 1800, answers = \keys, makeObserver|
 		var c = this.new(name, (mapping: \mapping2, surfaceMm: 40), instruction, questions, maxTimeS);
 		if(makeExperiment.isFunction.not) {
@@ -58,8 +59,10 @@ FrictionStudyCondition {
 		^[s[\origin], s[\origin] + min(FrictionPilot.signalFrames / this.samplesPerMm, s[\surfaceMm])]
 	}
 
+	// The condition as an Event (a session's manifest): with its area on the surface, so that the
+	// report needs nothing but the session folder.
 	asEvent {
-		^(name: name, scene: this.settings, instruction: instruction, maxTimeS: maxTimeS,
+		^(name: name, scene: this.settings, areaMm: this.areaMm, instruction: instruction, maxTimeS: maxTimeS,
 			questions: questions.collect(_.asEvent), threshold: this.isThreshold, answers: answers)
 	}
 

@@ -47,6 +47,7 @@ FrictionStudyFiles {
 		if(folder.isString.not or: { folder.isEmpty }) {
 			Error("%: folder must be a path (String), got %".format(where, folder)).throw
 		};
+		folder = folder.standardizePath;
 		try { File.mkdir(folder) } { |error|
 			Error("%: the folder % cannot be written (%)".format(where, folder, error.errorString)).throw
 		};

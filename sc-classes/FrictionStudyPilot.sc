@@ -2,9 +2,10 @@
 // friction off, then on, in that fixed order; free exploration from quite slow to fast until the
 // participant is done; the audio sensations described after the audio-only version, the touch
 // sensations and how sound and touch relate after the audio-haptic one. The words are section
-// 4.1's, addressed to the participant.
+// 4.1's, addressed to the participant. thresholds: conditions run after the pilot's six (nil: none;
+// e.g. FrictionStudy.thresholdConditions, which the paper's pilot did not have).
 + FrictionStudy {
-	*pilot { |maxTimeS = 600|
+	*pilot { |maxTimeS = 600, thresholds|
 		var intro, explore, audio, touch, relate;
 		intro = "You will be exploring a number of simple patterns, spread out sideways over the surface. "
 		"These patterns are represented in both sound and touch. Move the device while touching it only "
@@ -25,6 +26,6 @@
 					explore ++ "Afterwards you will describe the touch sensations, and how sound and touch did or did "
 					"not relate to each other. Say when you are done exploring.", [touch, relate], maxTimeS)
 			]
-		}.flatten(1), \fixed, intro)
+		}.flatten(1) ++ (thresholds ? []), \fixed, intro)
 	}
 }

@@ -19,6 +19,7 @@ FrictionStudySession {
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
+	var buttonsSynth, buttonsResponder;
 	var routine;
 
 	*initClass {
@@ -61,7 +62,7 @@ FrictionStudySession {
 
 	// ---- control: from the windows, keys, or code ----
 
-	// The participant (or by: \window, \key, \button, \code) is done exploring.
+	// The participant (or by: \window, \key, \button (a puck button), \code) is done exploring.
 	// During the introduction, it ends the introduction.
 	done { |by = \participant|
 		if((state == \running and: { paused.not }) or: { state == \introduction }) { endedBy = by; ending = \done }
@@ -126,6 +127,10 @@ FrictionStudySession {
 			var result;
 			try {
 				SynthDef(\frictionStudyListen, { Out.ar(\out.kr(2), In.ar(\in.kr(0), 2)) }).add;
+				// A press of any of the puck's buttons (FrictionButtons) is the participant's "done".
+				SynthDef(\frictionStudyButtons, {
+					SendReply.kr(FrictionButtons.kr(\device.kr(0)).sum > 0, '/kfStudyButton', 1)
+				}).add;
 				server.sync;
 				if(windows) {
 					participantWindow = FrictionStudyParticipantWindow(this);
@@ -182,6 +187,9 @@ FrictionStudySession {
 		pilot.play;
 		server.sync;
 		listenSynth = Synth.after(pilot.synth, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
+		buttonsSynth = Synth.tail(server, \frictionStudyButtons, [\device, conditionDevice.index]);
+		buttonsResponder = OSCFunc({ this.done(\button) }, '/kfStudyButton', server.addr,
+			argTemplate: [buttonsSynth.nodeID]);
 		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
 		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
 		server.sync;
@@ -214,6 +222,8 @@ FrictionStudySession {
 		recorder.stopRecording;
 		monitor.free;
 		listenSynth.free;
+		buttonsResponder.free;
+		buttonsSynth.free;
 		pilot.free;
 		server.sync;
 		conditionDevice.stopRecording;
@@ -249,12 +259,22 @@ FrictionStudySession {
 	}
 
 	// A threshold condition: the experiment's trials (each a line of trials.csv, flushed), its
-	// estimate in the events, then the questions. The experiment plays on the participant's pair.
+	// estimate in the events, then the questions. The experiment plays on the participant's pair. A
+	// simulated participant answers through the condition's makeObserver, or its own observer for
+	// the experiment's kind; the experiment and the observer (its known threshold) are logged.
 	prRunThreshold {
-		var experiment = condition.makeExperiment.value, estimate, how;
-		how = if(simulated.notNil) { condition.makeObserver.value(simulated.seed) } { condition.answers };
-		if(how.isNil) { Error("threshold condition %: no makeObserver for a simulated participant".format(
-			condition.name)).throw };
+		var experiment = condition.makeExperiment.value, estimate, how, right = 0, count = 0;
+		how = if(simulated.notNil) {
+			condition.makeObserver !? { |make| make.value(simulated.seed) } ?? {
+				if(experiment.respondsTo(\kind).not) {
+					Error("threshold condition %: no makeObserver, and the experiment has no kind for the simulated "
+						"participant's observer".format(condition.name)).throw
+				};
+				simulated.observerFor(experiment.kind)
+			}
+		} { condition.answers };
+		if(experiment.respondsTo(\asEvent)) { this.log(\experiment, FrictionStudyFiles.json(experiment.asEvent)) };
+		if(how.respondsTo(\asEvent)) { this.log(\observer, FrictionStudyFiles.json(how.asEvent)) };
 		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
 		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
 		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
@@ -262,7 +282,6 @@ FrictionStudySession {
 		while { recorder.isRecording.not } { 0.01.wait };
 		this.log(\recordAudio);
 		coverage = study.coverageFor(condition);
-		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: true, audio: true);
 		participantWindow !? {
 			participantWindow.showInstruction(condition.instruction);
 			participantWindow.doneButton.visible = false;  // the experiment ends it
@@ -278,10 +297,13 @@ FrictionStudySession {
 				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
 					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
 			this.log(\trial, trial[\trial]);
+			count = count + 1;
+			if(trial[\correct] == true) { right = right + 1 };
 		}, nil, participantOut);
 		endedBy = \procedure;
 		this.log(\done, \procedure);
 		this.log(\estimate, FrictionStudyFiles.json(estimate));
+		stats = (trials: count, correct: right);
 		state = \stopping;
 		recorder.stopRecording;
 		listenSynth.free;
@@ -306,6 +328,7 @@ FrictionStudySession {
 	}
 
 	prStats {
+		if(stats[\trials].notNil) { ^stats.copy };
 		^(meanSpeedMmPerS: stats[\speedSum] / max(1, stats[\speedCount]), maxForceN: stats[\maxForceN],
 			coverage: coverage.fraction, friction: stats[\friction], audio: stats[\audio])
 	}

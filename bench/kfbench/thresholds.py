@@ -5,7 +5,7 @@ and the same answers:
   - QUEST+: Debian's python3-questplus given our runs' answers (the level it would choose before
     each trial, its estimate after them) and run on its own RUNS times against the same observer
     (numpy's random numbers);
-  - the fits: each run's trials fitted by kfharness.psychometric and by Debian's psignifit;
+  - the fits: each run's trials fitted by kfstudy.psychometric and by Debian's psignifit;
   - the staircases: Levitt's convergence points (70.7 %, 79.4 %) of the observer's function;
   - the theory's spread: the Cramer-Rao bound of log10 threshold (Fisher information of the
     Weibull's three free parameters at the observer's values, for the levels a run used).
@@ -15,13 +15,13 @@ import time
 
 import numpy as np
 
-from kfharness import psignifit_cli, psychometric, questplus_ref, thresholds
+from kfharness import psignifit_cli, questplus_ref, thresholds
+from kfstudy import psychometric
 
 from .common import log
 
 RUNS = 200
 OBS = thresholds.OBSERVER
-LN10 = np.log(10)
 
 
 def _targets():
@@ -42,20 +42,9 @@ def _stats(estimates, target):
 
 
 def cramer_rao_sd_log10(levels):
-    """The smallest sd of an unbiased log10 threshold from trials at these levels, all three
-    parameters (log threshold, log slope, lapse) unknown, at the observer's values."""
-    x = np.asarray(levels, dtype=float)
-    t, b, g, lam = OBS["threshold"], OBS["slope"], OBS["guess"], OBS["lapse"]
-    u = (x / t) ** b
-    p = psychometric.weibull(x, t, b, g, lam)
-    grad = np.stack([-(1 - g - lam) * np.exp(-u) * u * b,             # d p / d ln t
-                     (1 - g - lam) * np.exp(-u) * u * b * np.log(x / t),  # d p / d ln b
-                     -(1 - np.exp(-u))])                               # d p / d lapse
-    info = (grad / (p * (1 - p))) @ grad.T
-    try:
-        return float(np.sqrt(np.linalg.inv(info)[0, 0]) / LN10)
-    except np.linalg.LinAlgError:
-        return float("inf")
+    """The theory's smallest sd of an unbiased log10 threshold from trials at these levels, at the
+    observer's values (kfstudy.psychometric)."""
+    return psychometric.cramer_rao_sd_log10(levels, OBS["threshold"], OBS["slope"], OBS["guess"], OBS["lapse"])
 
 
 def run(bench, runs=RUNS):

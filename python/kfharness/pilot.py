@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import nrt, profile, readers, reference
+from . import nrt, profile, reference
+from kfstudy import readers
 
 _PILOT = profile.pilot()
 _DEVICE = profile.device()

@@ -6,7 +6,7 @@ It is given the answers grouped by level (x, right, n) and a batch of preference
 F(x) = 1 - exp(-(x / alpha) ^ beta), two intervals (gamma fixed at 1/2), lambda (the lapse rate)
 free within its default limits [0, 0.05], the slope beta
 within [0.2, 20] (unbounded, sparse staircase data let it run to a step), no bootstrap (#RUNS 0): the same model and bounds as
-kfharness.psychometric.fit, so alpha is the threshold of both."""
+kfstudy.psychometric.fit, so alpha is the threshold of both."""
 import shutil
 import subprocess
 import tempfile
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import psychometric
+from kfstudy import psychometric
 
 PROGRAM = "/usr/bin/psignifit"
 PREFERENCES = """#shape Weibull

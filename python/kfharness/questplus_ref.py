@@ -55,7 +55,7 @@ def replay(levels, trial_levels, correct, grid=None):
 def simulate(levels, observer, trials, checkpoints, seed, grid=None):
     """One run of questplus against the observer (numpy's random numbers, seeded): its estimates
     at the checkpoints (numbers of trials)."""
-    from . import psychometric
+    from kfstudy import psychometric
 
     rng = np.random.default_rng(seed)
     q = make(levels, grid)

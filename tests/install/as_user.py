@@ -10,7 +10,8 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from kfharness import paths, readers
+from kfharness import paths
+from kfstudy import readers
 
 UNPRIVILEGED_UID = 65534  # nobody: no rights, no home, no group but its own
 

@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import paths, profile, readers, sclang
+from kfharness import paths, profile, sclang
+from kfstudy import readers
 
 OTHER_PLUGIN = Path(os.environ["KF_OTHER_EXTENSION_PLUGIN"])
 OTHER_CLASS = Path(__file__).parent / "other_extension" / "OtherExtensionDC.sc"

@@ -5,8 +5,9 @@ with one message and a kfStatus entry, the file is kept whole (whole lines, with
 and the server and the force frames go on at the commanded force."""
 import pytest
 
-from kfharness import paths, procs, readers, sclang, status
+from kfharness import paths, procs, sclang, status
 from kfharness.witness import Witness
+from kfstudy import readers
 
 LIMIT_BYTES = 64 * 1024
 FORCE_N = 1.0

@@ -59,7 +59,8 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack
 from pathlib import Path
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 from conftest import performer_jack
 from kfharness.jack import JackServer
 

@@ -7,7 +7,8 @@ import re
 
 import numpy as np
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 
 
 def values(run, tag):

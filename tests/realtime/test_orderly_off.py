@@ -8,7 +8,8 @@ earlier in the scene (this machine stalls 25-37 ms under a disk writer, longer t
 watchdog) is right and safe, and no concern of this test."""
 import pytest
 
-from kfharness import paths, readers, sclang, status
+from kfharness import paths, sclang, status
+from kfstudy import readers
 from kfharness.witness import Witness
 
 FORCE_N = 1.0

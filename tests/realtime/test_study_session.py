@@ -9,7 +9,8 @@ import signal
 import threading
 import time
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 
 # Two conditions of mapping 1 (its 6 mm), each explored for 2.5 s by a simulated participant
 # (explore-s: 6 speed steps of 0.42 s), and a free-text and a rating question after each.
@@ -139,3 +140,77 @@ while { ~session.isOver.not } { 0.1.wait };
         data, rate = readers.read_wav(session / folder / "audio.wav")
         assert rate == jack.sample_rate and data.shape[1] == 2 and len(data) > rate, folder
         assert readers.Session(session / folder / "device.kfsession").frames.shape[0] > 1000, folder
+
+
+# A person's session on a replayed recording whose puck's right button goes down 2.0 s after the
+# device opens (bit 2 of the reports' buttons, 0.2 s long); then a simulated participant's session
+# that the experimenter aborts 0.5 s into its second condition.
+DONE_AND_ABORT = r"""
+var root = @ROOT@, device, session, sim, aborted;
+~study = FrictionStudy("button and abort", [
+	FrictionStudyCondition(\first, (mapping: \mapping1), "Explore; press a button when done.",
+		[FrictionStudyQuestion.text(\say, "Describe it.")], 20),
+	FrictionStudyCondition(\second, (mapping: \mapping2), "Explore again.", [], 20)]);
+device = FrictionDevice.replay(s, @RECORDING@, 0);
+s.sync;
+session = ~study.run("B1", root, s, device: device, windows: false, experimenterOut: 2);
+while { session.state != \questions } { 0.05.wait };
+session.answer("pressed the right button");
+while { session.state != \running } { 0.05.wait };
+session.abort;  // the experimenter: the second condition has no use here
+while { session.isOver.not } { 0.05.wait };
+"KF-BUTTON %".format(session.state).postln;
+device.close;
+aborted = ~study.run("A1", root, s, simulated: FrictionStudySimParticipant(2, 1.5), windows: false,
+	experimenterOut: 2);
+while { aborted.position < 1 or: { aborted.state != \running } or: { aborted.elapsedS < 0.5 } } { 0.05.wait };
+aborted.abort;
+while { aborted.isOver.not } { 0.05.wait };
+// The server's count of synths comes with its status, polled every 0.7 s.
+1.0.wait;
+"KF-ABORTED % % synths".format(aborted.state, s.numSynths).postln;
+"""
+
+
+def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
+    root = paths.work_dir() / "study-button-abort"
+    shutil.rmtree(root, ignore_errors=True)
+    root.mkdir(parents=True)
+    recording = root / "presses.kfs"
+    lines = ["kf-session 1 countMm=0.021 updateRateHz=125"]
+    for i in range(1, 1000):
+        t = i * 0.008
+        lines.append(f"R {t:.3f} {t:.3f} 1 0 {2 if 2.0 <= t < 2.2 else 0} 0")
+    recording.write_text("\n".join(lines) + "\n")
+    run = sclang.require_ok(sclang.run_with_server(
+        sclang.fill(DONE_AND_ABORT, ROOT=sclang.sc_string(str(root)), RECORDING=sclang.sc_string(str(recording))),
+        jack, timeout=90, name="study-button-abort", server_options={"numOutputBusChannels": 4}))
+    assert run.lines("KF-BUTTON") == [["aborted"]], run.output[-3000:]
+
+    # The button ended the first condition: its "done" says so, at the press (2.0 s after the
+    # device opened, which the prepare line follows within a few ms; a block and a status poll
+    # late at most: 0.03 s measured, 0.5 s allowed on a busy machine).
+    events = read_rows(root / "B1" / "01-first" / "events.csv")
+    done = [e for e in events if e["event"] == "done"]
+    assert [e["detail"] for e in done] == ["button"], events
+    assert 1.9 < float(done[0]["timeS"]) < 2.5, done
+    assert [e["event"] for e in events][-2:] == ["answer", "end"]
+
+    # The abort: the session ends at once, what was written is kept and the abort logged, in the
+    # condition's events and the session's log; nothing is left playing on the server.
+    assert run.lines("KF-ABORTED") == [["aborted", "0", "synths"]], run.output[-3000:]
+    session = root / "A1"
+    log = read_rows(session / "session.csv")
+    assert [(r["event"], r["detail"]) for r in log] == [("start", ""), ("abort", "second")], log
+    assert events_of(session / "01-first")[-1] == "end"
+    second = events_of(session / "02-second")
+    assert second[second.index("start"):] == ["start", "abort", "coverage"], second
+    assert [(r["condition"], r["question"]) for r in read_rows(session / "answers.csv")] == [("first", "say")]
+    # The aborted condition's recordings are kept: the device's (0.5 s and more of reports at
+    # 125 Hz: 62, less a margin), the audio as long as the condition ran.
+    recording = readers.Session(session / "02-second" / "device.kfsession")
+    assert len(recording.reports) > 40
+    data, rate = readers.read_wav(session / "02-second" / "audio.wav")
+    assert len(data) > 0.5 * rate
+    assert not (session / "03-second").exists() and sorted(p.name for p in session.iterdir()) == [
+        "01-first", "02-second", "answers.csv", "manifest.json", "session.csv"]

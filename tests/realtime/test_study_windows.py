@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 from kfharness.xvfb import Xvfb
 
 ARTEFACTS = Path(os.environ.get("KF_TEST_ARTEFACTS_DIR") or paths.REPO_DIR / "build" / "test-artefacts") / "study_windows"

@@ -4,7 +4,8 @@ put on the device (read back from the device's recording), answers from the keys
 window given a key) and from the puck's buttons (a replayed recording that presses them)."""
 import numpy as np
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 
 INTERVAL_S, GAP_S = 0.5, 0.15
 TRIAL_FIELDS = ["trial", "level", "target", "answer", "correct", "startS", "interval1S", "interval2S", "answerS"]

@@ -2,7 +2,8 @@
 record and replay, and closed slots."""
 import numpy as np
 
-from kfharness import nrt, paths, readers, sclang
+from kfharness import nrt, paths, sclang
+from kfstudy import readers
 
 SR = 48000
 HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"

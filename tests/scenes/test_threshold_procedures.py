@@ -10,7 +10,8 @@ import re
 import numpy as np
 import pytest
 
-from kfharness import paths, psignifit_cli, psychometric, questplus_ref, sclang, thresholds
+from kfharness import paths, psignifit_cli, questplus_ref, sclang, thresholds
+from kfstudy import psychometric
 
 OBS = thresholds.OBSERVER
 
@@ -155,8 +156,9 @@ def test_report_section_from_a_trials_csv(runs):
         for cond, r in (("force", first["constant"]), ("grating", first["questplus"])):
             for i, (level, right) in enumerate(zip(r["levels"], r["correct"])):
                 w.writerow([i + 1, cond, level, "true" if right else "false"])
-    md = psychometric.report_section(path, out, "p01")
+    md, fits = psychometric.report_section(path, out, "p01", {"force": {"unit": "N"}})
     assert md.count("![](p01-") == 2 and "| force | 280 |" in md and "| grating | 48 |" in md
+    assert [(f["condition"], f["unit"], f["trials"]) for f in fits] == [("force", "N", 280), ("grating", "", 48)]
     for png in re.findall(r"!\[\]\(([^)]+)\)", md):
         assert (out / png).stat().st_size > 10000
 

@@ -4,7 +4,8 @@ the reference's, plus the level in the target; the asynchrony experiment's sound
 device's audio delay plus the level (ms) after it is switched on."""
 import numpy as np
 
-from kfharness import nrt, paths, readers
+from kfharness import nrt, paths
+from kfstudy import readers
 
 RATE = 48000
 ON_S = 0.5  # \active set to 1

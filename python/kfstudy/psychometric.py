@@ -72,8 +72,29 @@ def fit(levels, correct, guess=GUESS_2AFC, max_lapse=MAX_LAPSE):
     return out
 
 
-def plot(levels, correct, fitted, path, title=""):
-    """The answers (proportion right per level, dot area by trials) and the fitted curve."""
+def cramer_rao_sd_log10(levels, threshold, slope, guess=GUESS_2AFC, lapse=0.0):
+    """The theory's smallest sd of an unbiased log10 threshold from trials at these levels (one a
+    trial), all three parameters (log threshold, log slope, lapse) unknown, at the given values of
+    the observer: the Fisher information of the binomial answers, inverted. A fit held within
+    bounds (the lapse rate's, the slope's) can vary less than this where few trials sit on the
+    curve's flanks, and be biased."""
+    x = np.asarray(levels, dtype=float)
+    t, b, g, lam = threshold, slope, guess, lapse
+    u = (x / t) ** b
+    p = weibull(x, t, b, g, lam)
+    grad = np.stack([-(1 - g - lam) * np.exp(-u) * u * b,             # d p / d ln t
+                     (1 - g - lam) * np.exp(-u) * u * b * np.log(x / t),  # d p / d ln b
+                     -(1 - np.exp(-u))])                               # d p / d lapse
+    info = (grad / (p * (1 - p))) @ grad.T
+    try:
+        return float(np.sqrt(np.linalg.inv(info)[0, 0]) / np.log(10))
+    except np.linalg.LinAlgError:
+        return float("inf")
+
+
+def plot(levels, correct, fitted, path, title="", xlabel="level", observer=None):
+    """The answers (proportion right per level, dot area by trials) and the fitted curve; with
+    observer (a dict of threshold, slope, lapse: a simulated participant's), its curve dashed."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -84,12 +105,15 @@ def plot(levels, correct, fitted, path, title=""):
     ax.plot(curve_x, weibull(curve_x, fitted["threshold"], fitted["slope"], fitted["guess"], fitted["lapse"]),
             color="C0", label=f"Weibull: threshold {fitted['threshold']:.3g}, slope {fitted['slope']:.2g}, "
                               f"lapse {fitted['lapse']:.2g}")
+    if observer:
+        ax.plot(curve_x, weibull(curve_x, observer["threshold"], observer["slope"], fitted["guess"], observer["lapse"]),
+                color="0.4", ls="--", label=f"model observer: threshold {observer['threshold']:.3g}")
     ax.scatter(x, right / total, s=12 + 60 * total / total.max(), color="C1", zorder=3, label="answers per level")
     ax.axvline(fitted["threshold"], color="C0", ls=":")
     ax.axhline(fitted["guess"], color="0.6", lw=0.8)
     ax.set_xscale("log")
     ax.set_ylim(0, 1.02)
-    ax.set_xlabel("level")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("proportion correct")
     ax.set_title(title)
     ax.legend(loc="lower right", fontsize=8)
@@ -109,26 +133,40 @@ def read_trials(path):
     return rows
 
 
-def report_section(trials_csv, out_dir, name=None):
+def report_section(trials_csv, out_dir, name=None, conditions=None):
     """The threshold section of a report from one session's trials CSV: a PNG per condition
-    (<name>-<condition>-psychometric.png in out_dir) and the Markdown that shows them (returned,
-    with the figures' names relative to out_dir)."""
+    (<name>-<condition>-psychometric.png in out_dir) and the Markdown that shows them, with the
+    figures' names relative to out_dir. conditions: per condition name, what else is known of it
+    (an Event of the session's log): unit (of the levels), estimate (the procedure's own) and
+    observer (a simulated participant's model observer: its threshold, slope and lapse, shown
+    beside the fit). Returns (Markdown, a dict per condition: condition, unit, the fit's keys,
+    estimate and observer_threshold, nan where unknown)."""
     trials_csv, out_dir = Path(trials_csv), Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     name = name or trials_csv.stem
+    conditions = conditions or {}
     rows = read_trials(trials_csv)
-    conditions = sorted({r.get("condition") or "" for r in rows})
     lines = [f"### Thresholds: {name}", "",
-             "Maximum-likelihood Weibull, guess rate 1/2, lapse rate free in [0, 0.05] "
-             "(python/kfharness/psychometric.py).", "",
-             "| condition | trials | threshold | slope | lapse | level at 70.7 % | at 79.4 % | figure |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
-    for condition in conditions:
+             "Maximum-likelihood Weibull, guess rate 1/2, lapse rate free in [0, 0.05] (kfstudy.psychometric); "
+             "the procedure's own estimate beside it, and a simulated participant's known threshold (its model "
+             "observer's).", "",
+             "| condition | trials | threshold | slope | lapse | level at 70.7 % | at 79.4 % | procedure's estimate "
+             "| model observer's threshold | figure |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    fits = []
+    for condition in sorted({r.get("condition") or "" for r in rows}):
         chosen = [r for r in rows if (r.get("condition") or "") == condition]
         levels, correct = [r["level"] for r in chosen], [r["correct"] for r in chosen]
+        known = conditions.get(condition, {})
+        unit = known.get("unit") or ""
         fitted = fit(levels, correct)
         png = f"{name}-{condition or 'all'}-psychometric.png"
-        plot(levels, correct, fitted, out_dir / png, title=f"{name} {condition}".strip())
-        lines.append(f"| {condition or '-'} | {fitted['trials']} | {fitted['threshold']:.4g} | {fitted['slope']:.3g} "
-                     f"| {fitted['lapse']:.3f} | {fitted['level_707']:.4g} | {fitted['level_794']:.4g} | ![]({png}) |")
-    return "\n".join(lines) + "\n"
+        plot(levels, correct, fitted, out_dir / png, title=f"{name} {condition}".strip(),
+             xlabel=f"level ({unit})" if unit else "level", observer=known.get("observer"))
+        estimate = float((known.get("estimate") or {}).get("threshold") or "nan")
+        observer = float((known.get("observer") or {}).get("threshold") or "nan")
+        fits.append(dict(condition=condition, unit=unit, **fitted, estimate=estimate, observer_threshold=observer))
+        lines.append(f"| {condition or '-'} | {fitted['trials']} | {fitted['threshold']:.4g} {unit} | "
+                     f"{fitted['slope']:.3g} | {fitted['lapse']:.3f} | {fitted['level_707']:.4g} | "
+                     f"{fitted['level_794']:.4g} | {estimate:.4g} | {observer:.4g} | ![]({png}) |")
+    return "\n".join(lines) + "\n", fits

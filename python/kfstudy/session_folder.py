@@ -1,4 +1,4 @@
-"""A FrictionStudy session folder read back (FrictionStudySession.sc writes it): the manifest,
+"""A FrictionStudy session folder read back (FrictionStudySession writes it): the manifest,
 the answers, and per condition its events, device recording and audio, with the measurements the
 report makes on them (positions and speeds from the recording, coverage as FrictionStudyCoverage
 computes it live, the time inside the fragment).
@@ -9,6 +9,7 @@ each condition, just before its recording starts), so the recording's first line
 the event recordDevice. The audio's first sample is placed at the event recordAudio.
 """
 import csv
+import functools
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,6 +38,7 @@ class Condition:
     area_mm: tuple         # the fragment's part on the surface
     events: list = field(default_factory=list)
     attempts: int = 0      # earlier attempts kept beside it (a crash, a kill, a repeat)
+    is_threshold: bool = False  # a threshold experiment's trials, not free exploration
 
     def event_time(self, name):
         times = [float(e["timeS"]) for e in self.events if e["event"] == name]
@@ -45,6 +47,12 @@ class Condition:
     def event_detail(self, name):
         details = [e["detail"] for e in self.events if e["event"] == name]
         return details[-1] if details else None
+
+    def event_json(self, name):
+        """The detail of the last event name, read as JSON (the threshold conditions' experiment,
+        observer and estimate), or None."""
+        detail = self.event_detail(name)
+        return json.loads(detail) if detail else None
 
     @property
     def complete(self):
@@ -69,10 +77,17 @@ class Condition:
     def ended_by(self):
         return self.event_detail("done") or ("time" if self.event_time("maxTime") is not None else None)
 
+    @functools.cached_property
+    def recording(self):
+        """The device recording (readers.Session), read once."""
+        return readers.Session(self.folder / "device.kfsession")
+
     def track(self):
-        """(t, x, speed) of the recording between start and stop: t in s from the condition's start,
-        x in mm from where the device was when recording began, speed in mm/s (signed)."""
-        session = readers.Session(self.folder / "device.kfsession")
+        """(t, x, speed) of the recording between start and stop, one sample per report: speed in
+        mm/s (signed) over SPEED_REPORTS reports, t (s from the condition's start) and x (mm from
+        where the device was when recording began) at the middle of those reports, so that a speed
+        goes with the place where the puck moved at it."""
+        session = self.recording
         count_mm = float(session.header["countMm"])
         r = session.reports
         if len(r) < SPEED_REPORTS + 2:
@@ -82,15 +97,15 @@ class Condition:
         t = r[:, 1] - r[0, 1] + (self.event_time("recordDevice") or 0.0)
         x = np.cumsum(r[:, 2]) * count_mm
         k = SPEED_REPORTS
-        speed = np.full_like(x, np.nan)
         dt = t[k:] - t[:-k]
-        speed[k:] = np.where(dt > 0, (x[k:] - x[:-k]) / np.where(dt > 0, dt, 1.0), np.nan)
+        speed = np.where(dt > 0, (x[k:] - x[:-k]) / np.where(dt > 0, dt, 1.0), np.nan)
+        t, x = (t[k:] + t[:-k]) / 2, (x[k:] + x[:-k]) / 2
         keep = ~np.isnan(speed) & (t >= (self.start_s or 0.0)) & (t <= (self.stop_s or np.inf))
         return t[keep], x[keep], speed[keep]
 
     def forces(self):
         """(t, commanded force N) of the recording's frames, t as in track()."""
-        session = readers.Session(self.folder / "device.kfsession")
+        session = self.recording
         f = session.frames
         if len(f) == 0:
             return np.zeros(0), np.zeros(0)
@@ -150,10 +165,9 @@ class StudySession:
                 n += 1
             folder = base if n == 1 else self.folder / f"{base.name}-attempt{n}"
             scene = by_name[name]["scene"]
-            spm = mapping_samples_per_mm(scene["mapping"])
-            width = min(24000 / spm, float(scene["surfaceMm"]))
-            origin = float(scene["origin"])
-            condition = Condition(position, name, folder, scene, (origin, origin + width), attempts=n - 1)
+            area_mm = tuple(float(v) for v in by_name[name]["areaMm"])
+            condition = Condition(position, name, folder, scene, area_mm, attempts=n - 1,
+                                  is_threshold=bool(by_name[name].get("threshold")))
             if (folder / "events.csv").exists():
                 condition.events = read_csv(folder / "events.csv")
             self.conditions.append(condition)
@@ -172,13 +186,6 @@ class StudySession:
         for row in self.answers:
             last[(row["condition"], row["question"])] = row
         return list(last.values())
-
-
-def mapping_samples_per_mm(mapping):
-    from . import profile
-    pilot = profile.pilot()
-    key = f"{mapping}SamplesPerMm"
-    return float(pilot[key]) if key in pilot else float(mapping)
 
 
 def sessions(root):
