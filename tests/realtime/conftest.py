@@ -1,5 +1,6 @@
 """What every realtime test file shares: `jack`, a JACK server of its own on the dummy driver
-(unique name), started for the test and stopped after it by its process. Where this user may
+(unique name), started for the test and stopped after it by its process; `display`, a virtual X
+display of its own for the windows' tests. Where this user may
 use realtime scheduling it runs as a performer's would (`jackd -R`): its and scsynth's audio
 threads SCHED_FIFO, and the device's threads above them (ThreadScheduling), so that the tests'
 timing holds on a busy machine (scripts/realtime-under-load.sh)."""
@@ -7,6 +8,7 @@ import pytest
 
 from kfharness.jack import JackServer
 from kfharness.load import realtime_allowed
+from kfharness.xvfb import Xvfb
 
 REALTIME_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the device threads at 66
 
@@ -20,3 +22,11 @@ def performer_jack():
 def jack():
     with performer_jack() as server:
         yield server
+
+
+@pytest.fixture
+def display():
+    if not Xvfb.available():
+        pytest.fail("Xvfb is not installed (scripts/setup.sh installs the package xvfb)")
+    with Xvfb() as xvfb:
+        yield xvfb

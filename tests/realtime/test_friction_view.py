@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from kfharness import paths, sclang
-from kfharness.xvfb import Xvfb
 
 # --- screenshots as arrays ---------------------------------------------------------------------
 
@@ -160,14 +159,6 @@ def pilot_force(position_mm):
     sample = np.abs(np.sin(2 * np.pi * (position_mm - ORIGIN_MM) * 500 / 100))
     db = 20 * np.log10(np.maximum(sample, 1e-12))
     return 0.14 + (0.5 - 0.14) * np.clip((db + 30) / 30, 0, 1)
-
-
-@pytest.fixture
-def display():
-    if not Xvfb.available():
-        pytest.fail("Xvfb is not installed (scripts/setup.sh installs the package xvfb)")
-    with Xvfb() as xvfb:
-        yield xvfb
 
 
 def test_the_view_shows_the_puck_crossing_the_fragment_with_its_friction(display, jack):

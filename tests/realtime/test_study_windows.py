@@ -16,7 +16,6 @@ import pytest
 
 from kfharness import paths, sclang
 from kfstudy import readers
-from kfharness.xvfb import Xvfb
 
 ARTEFACTS = Path(os.environ.get("KF_TEST_ARTEFACTS_DIR") or paths.REPO_DIR / "build" / "test-artefacts") / "study_windows"
 
@@ -71,6 +70,7 @@ session.experimenterWindow.refresh;
 };
 session.experimenterWindow.coverageView.refresh;
 shot.(\experimenter, session.experimenterWindow.window);
+"KF-COVERAGE % %".format(session.coverage.count, session.coverage.fraction).postln;
 shot.(\exploring, session.participantWindow.window);
 session.participantWindow.pressKey($ );
 listen.stopRecording;
@@ -89,14 +89,6 @@ wait.({ session.isOver });
 shot.(\end, session.participantWindow.window);
 "KF-STATE %".format(session.state).postln;
 """
-
-
-@pytest.fixture
-def display():
-    if not Xvfb.available():
-        pytest.fail("Xvfb is not installed (scripts/setup.sh installs the package xvfb)")
-    with Xvfb() as xvfb:
-        yield xvfb
 
 
 def rgb(path):
@@ -145,11 +137,15 @@ def test_the_windows_driven_as_people_would(jack, display):
     (left, top, width, height), (wleft, wtop, _, _) = [[int(float(v)) for v in f] for f in run.lines("KF-BOUNDS")]
     coverage_map = experimenter[top - wtop:top - wtop + height, left - wleft:left - wleft + width]
     covered, empty = count(coverage_map, COVERED, 6), count(coverage_map, EMPTY, 3)
-    (cells, fraction), = [(int(f[0]), float(f[1])) for f in run.lines("KF-COVERAGE")]
+    (cells, before), (_, after) = [(int(f[0]), float(f[1])) for f in run.lines("KF-COVERAGE")]
     assert cells > 0
     # Every cell is drawn the same size: the filled share of the map is the fraction covered, up to
     # the cells' 1-pixel borders and the puck's outline (3 px over one cell) -- a few % of the map.
-    assert abs(covered / (covered + empty) - fraction) < 0.04, (covered, empty, fraction)
+    # The participant goes on exploring while the window is grabbed (0.4 s after the first line,
+    # longer on a loaded machine: 0.066 apart seen beside two CPU hogs), so the share drawn lies
+    # between the fractions posted before and after the shot.
+    share = covered / (covered + empty)
+    assert before - 0.04 < share < after + 0.04, (covered, empty, before, after)
 
     # What the session wrote: the answers as given, the events as they happened.
     folder = root / "W1"
