@@ -190,12 +190,7 @@ FrictionStudySession {
 		buttonsSynth = Synth.tail(server, \frictionStudyButtons, [\device, conditionDevice.index]);
 		buttonsResponder = OSCFunc({ this.done(\button) }, '/kfStudyButton', server.addr,
 			argTemplate: [buttonsSynth.nodeID]);
-		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
-		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
-		server.sync;
-		while { recorder.isRecording.not } { 0.01.wait };
-		this.log(\recordAudio);
-		coverage = study.coverageFor(condition);
+		this.prRecordAudio;
 		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: s[\friction], audio: s[\audio]);
 		// 50 frames a second; the cells between two frames are covered too (FrictionStudyCoverage).
 		lastPositionMm = nil;
@@ -276,12 +271,7 @@ FrictionStudySession {
 		if(experiment.respondsTo(\asEvent)) { this.log(\experiment, FrictionStudyFiles.json(experiment.asEvent)) };
 		if(how.respondsTo(\asEvent)) { this.log(\observer, FrictionStudyFiles.json(how.asEvent)) };
 		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
-		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
-		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
-		server.sync;
-		while { recorder.isRecording.not } { 0.01.wait };
-		this.log(\recordAudio);
-		coverage = study.coverageFor(condition);
+		this.prRecordAudio;
 		participantWindow !? {
 			participantWindow.showInstruction(condition.instruction);
 			participantWindow.doneButton.visible = false;  // the experiment ends it
@@ -312,6 +302,17 @@ FrictionStudySession {
 		if(simulated.notNil) { conditionDevice.close };
 		server.sync;
 		^this.prQuestions
+	}
+
+	// The participant's output pair into the condition's audio.wav; the report places its first
+	// sample at the recordAudio line.
+	prRecordAudio {
+		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
+		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
+		server.sync;
+		while { recorder.isRecording.not } { 0.01.wait };
+		this.log(\recordAudio);
+		coverage = study.coverageFor(condition);
 	}
 
 	prFrame { |m, resumed|
