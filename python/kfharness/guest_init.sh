@@ -11,7 +11,8 @@ mount -t proc proc /proc
 mount -t sysfs sysfs /sys
 mount -t devtmpfs devtmpfs /dev
 mount -t tmpfs tmpfs /run
-mount -t tmpfs tmpfs /tmp
+# /tmp stays the initramfs's own (writable) folder: a tmpfs over it would hide the programs of a
+# clone under /tmp, which the initramfs holds at their host paths.
 
 exec 3<>/dev/ttyS1
 stty -F /dev/ttyS1 raw -echo 115200
