@@ -69,6 +69,8 @@ class EmulatedPort : public usb::Port {
     return bus_->serial_;
   }
 
+  usb::InterfaceEndpoints openEndpoints() const override { return {kSetPointEndpoint, kStatusEndpoint}; }
+
   usb::Result claimInterface(int number) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
     if (!alive()) return usb::Result::kNoDevice;

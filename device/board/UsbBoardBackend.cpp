@@ -25,14 +25,10 @@ std::string idsText(const usb::DeviceIds& ids) {
 
 UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions options)
     : port_(std::move(port)), options_(options), ids_(options.ids) {
-  for (usb::Transfer& transfer : outTransfers_) {
-    transfer.endpoint = board::kSetPointEndpoint;
-    transfer.length = board::kSetPointSize;
-  }
-  zeroTransfer_.endpoint = board::kSetPointEndpoint;
+  for (usb::Transfer& transfer : outTransfers_) transfer.length = board::kSetPointSize;
   zeroTransfer_.length = board::kSetPointSize;
-  statusTransfer_.endpoint = board::kStatusEndpoint;
   statusTransfer_.length = board::kStatusSize;
+  useEndpoints({board::kSetPointEndpoint, board::kStatusEndpoint});
   for (usb::Transfer* transfer :
        {&outTransfers_[0], &outTransfers_[1], &outTransfers_[2], &outTransfers_[3], &statusTransfer_, &zeroTransfer_}) {
     transfer->timeoutMs = options_.transferTimeoutMs;
@@ -42,6 +38,13 @@ UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions o
 }
 
 UsbBoardBackend::~UsbBoardBackend() { close(); }
+
+void UsbBoardBackend::useEndpoints(const usb::InterfaceEndpoints& endpoints) {
+  endpoints_ = endpoints;
+  for (usb::Transfer& transfer : outTransfers_) transfer.endpoint = endpoints.out;
+  zeroTransfer_.endpoint = endpoints.out;
+  statusTransfer_.endpoint = endpoints.in;
+}
 
 void UsbBoardBackend::setError(const std::string& error) {
   std::lock_guard<PiMutex> lock(telemetryMutex_);
@@ -65,6 +68,9 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     error = "cannot open the friction board (" + idsText(ids_) + "): " + usb::describe(result);
     return false;
   }
+  // No transfer is in flight here (before the event thread, or after every callback of the
+  // handle before): the transfers take this board's endpoints.
+  useEndpoints(port_->openEndpoints());
   result = port_->claimInterface(board::kInterfaceNumber);
   if (result != usb::Result::kOk) {
     error = std::string("cannot claim the friction board's interface: ") + usb::describe(result);
@@ -287,7 +293,7 @@ BoardTelemetry UsbBoardBackend::telemetry() const {
 
 void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
   auto* self = static_cast<UsbBoardBackend*>(transfer.user);
-  if (transfer.endpoint == board::kStatusEndpoint)
+  if (&transfer == &self->statusTransfer_)
     self->onStatus(transfer);
   else
     self->onSetPoint(transfer);
@@ -468,11 +474,11 @@ void UsbBoardBackend::run() {
       }
       // A halt is cleared only on an endpoint with nothing in flight (libusb_clear_halt).
       if (haltOut_ && !anyOutInFlight()) {
-        if (port_->clearHalt(board::kSetPointEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        if (port_->clearHalt(endpoints_.out) == usb::Result::kNoDevice) markUnplugged();
         haltOut_ = false;
       }
       if (haltIn_ && !statusBusy_) {
-        if (port_->clearHalt(board::kStatusEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        if (port_->clearHalt(endpoints_.in) == usb::Result::kNoDevice) markUnplugged();
         haltIn_ = false;
       }
       submitIdle();

@@ -127,6 +127,7 @@ class UsbBoardBackend : public ForceBackend {
   bool connectLocked(std::string& error);  // portMutex_ held
   // CLEAR_ERRORS (through control()): what was set and what persists, counted in the telemetry.
   bool clearErrorsLocked(board::ClearReply& reply, std::string& error);
+  void useEndpoints(const usb::InterfaceEndpoints& endpoints);  // the transfers' endpoints
   void submitSetPoint(int slot);
   void submitStatus();
   void submitIdle();
@@ -149,7 +150,8 @@ class UsbBoardBackend : public ForceBackend {
   usb::DeviceIds ids_;
   std::mutex portMutex_;  // open/claim/release/close: by open() before the event thread, then by it
 
-  // Event thread only.
+  // Event thread only (and open() before it starts).
+  usb::InterfaceEndpoints endpoints_;  // of the open board's interface
   usb::Transfer outTransfers_[kMaxInFlight];
   bool outBusy_[kMaxInFlight] = {};
   usb::Transfer statusTransfer_;

@@ -50,6 +50,7 @@ SEAT0 = "ACTIVE=c1\nACTIVE_UID=1000\nSESSIONS=c1\nUIDS=1000\n"
 @dataclass
 class GuestSpec:
     programs: list  # [(name, [argv...])], run in order; argv[0] a host path, copied in with its libraries
+    executables: list = field(default_factory=list)  # host programs a test starts itself, copied in with their libraries
     modules: list = field(default_factory=list)  # module names as modprobe takes them (hid-generic, uhid)
     udev_rules: list = field(default_factory=list)  # rule files of ours, into /etc/udev/rules.d/
     files: list = field(default_factory=list)  # host files or folders, copied in at the same path
@@ -211,7 +212,7 @@ def build_initramfs(spec, release):
     archive = Cpio()
     archive.data("/init", INIT_SCRIPT.read_bytes(), 0o755)
     archive.host("/bin/busybox")
-    executables = UDEV_PROGRAMS + [argv[0] for _, argv in spec.programs]
+    executables = UDEV_PROGRAMS + list(spec.executables) + [argv[0] for _, argv in spec.programs]
     for executable in executables:
         if not Path(executable).exists():
             raise GuestError(f"{executable} is not there (scripts/setup.sh installs and builds it)")

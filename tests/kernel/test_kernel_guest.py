@@ -14,12 +14,14 @@ import pytest
 from kfharness import guest
 
 PROGRAM = os.environ.get("KF_KERNEL_TESTS", "")
+GADGET = os.environ.get("KF_BOARD_GADGET", "")  # the board's firmware as a USB gadget, started by the tests
 ARTEFACTS = Path(os.environ.get("KF_TEST_ARTEFACTS_DIR", "/tmp")) / "kernel"
 
 # What the guest needs: the USB host controller and HID stack for QEMU's mice, uhid for devices
 # made from report descriptors, evdev, and psmouse for the PC's built-in PS/2 mouse (a mouse
-# that is no USB one, for the order of the mice).
-MODULES = ["xhci-pci", "usbhid", "hid-generic", "uhid", "evdev", "psmouse"]
+# that is no USB one, for the order of the mice); dummy_hcd (a USB device controller wired to a
+# host controller of its own), libcomposite and FunctionFS for the friction board's gadget.
+MODULES = ["xhci-pci", "usbhid", "hid-generic", "uhid", "evdev", "psmouse", "dummy_hcd", "libcomposite", "usb_f_fs"]
 # QEMU's USB mouse on port 1 of an xHCI controller (the tests plug a twin in port 2 and unplug
 # and replug this one through QMP), and a USB keyboard on port 3 (a node that reports keys).
 QEMU_DEVICES = ["-device", "qemu-xhci,id=xhci", "-device", "usb-mouse,bus=xhci.0,port=1,id=mouse1",
@@ -42,7 +44,7 @@ def guest_run():
     spec = guest.GuestSpec(
         programs=[("kernel_tests", [PROGRAM, "--reporter", "junit", "--out", "/results/kernel_tests.xml",
                                     "--durations", "yes"])],
-        modules=MODULES, udev_rules=[os.environ["KF_UDEV_RULES"]],
+        executables=[GADGET], modules=MODULES, udev_rules=[os.environ["KF_UDEV_RULES"]],
         files=[Path(os.environ["KF_TEST_DATA_DIR"]) / "hid"], qemu_args=QEMU_DEVICES)
     run = guest.run(spec, ARTEFACTS)
     (ARTEFACTS / "console.log").write_text(run.console)
