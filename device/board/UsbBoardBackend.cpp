@@ -326,7 +326,7 @@ void UsbBoardBackend::submitStatus() {
 }
 
 void UsbBoardBackend::submitIdle() {
-  if (stopping_.load() || unplugged_ || !connected_.load()) return;
+  if (stopping_.load() || unplugged_ || !connected_.load() || steadyS() < retryAfterS_) return;
   const int inFlight = std::clamp(options_.transfersInFlight, 1, kMaxInFlight);
   for (int slot = 0; slot < inFlight && !haltOut_ && !unplugged_; ++slot)
     if (!outBusy_[slot]) submitSetPoint(slot);
@@ -383,6 +383,7 @@ void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
     markUnplugged();
     return;
   }
+  if (failedAtOnce(transfer.status)) return;  // the loop sends it again, a millisecond on
   if (!stopping_.load() && !unplugged_ && !haltOut_) submitSetPoint(slot);
 }
 
@@ -412,7 +413,19 @@ void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
       ++telemetry_.badStatus;
     }
   }
+  if (failedAtOnce(transfer.status)) return;
   if (!stopping_.load() && !unplugged_) submitStatus();
+}
+
+bool UsbBoardBackend::failedAtOnce(usb::TransferStatus status) {
+  // A transfer that failed (not a timeout, stall, cancel or unplug) may fail again as soon as it
+  // is sent: a device going away fails every transfer at once (EPROTO, before the kernel has
+  // seen it go). Sent again from its callback, it would keep this realtime thread busy, and on a
+  // machine with one CPU starve the kernel's own hub work, so that the unplug is never seen
+  // (tests/kernel: test_board_gadget.cpp). So it waits a set-point period, sent by the loop.
+  if (status != usb::TransferStatus::kError && status != usb::TransferStatus::kOverflow) return false;
+  retryAfterS_ = steadyS() + kRetryAfterErrorS;
+  return true;
 }
 
 bool UsbBoardBackend::anyOutInFlight() const {

@@ -131,6 +131,8 @@ class UsbBoardBackend : public ForceBackend {
   void submitSetPoint(int slot);
   void submitStatus();
   void submitIdle();
+  // After a transfer failed at once: no transfer is sent before retryAfterS_ (true: not now).
+  bool failedAtOnce(usb::TransferStatus status);
   void markUnplugged();
   void dropHandle();
   bool anyInFlight() const;
@@ -163,7 +165,9 @@ class UsbBoardBackend : public ForceBackend {
   bool haltOut_ = false;  // EP 0x01 stalled: cleared once no OUT transfer is in flight
   bool haltIn_ = false;   // EP 0x81 likewise
   bool unplugged_ = false;
-  bool leaked_ = false;  // a transfer was given up: the board is not opened again
+  bool leaked_ = false;                               // a transfer was given up: the board is not opened again
+  static constexpr double kRetryAfterErrorS = 0.001;  // a set-point period
+  double retryAfterS_ = 0.0;                          // after a transfer failed at once, nothing is sent before this
   double nextReopenS_ = 0.0;
 
   std::atomic<uint32_t> latestDrive_{0};  // drive bits, and kRestartPending

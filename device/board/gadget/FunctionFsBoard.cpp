@@ -5,7 +5,6 @@
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/timerfd.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -28,11 +27,7 @@ bool writeAll(int fd, const std::vector<uint8_t>& data) {
 
 }  // namespace
 
-int64_t FunctionFsBoard::nowNs() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
-}
+int64_t FunctionFsBoard::nowNs() { return monotonicNs(); }
 
 FunctionFsBoard::FunctionFsBoard(std::string functionFsDir, BoardFirmware& firmware, GadgetLog& log)
     : dir_(std::move(functionFsDir)), firmware_(firmware), log_(log) {}
@@ -243,6 +238,7 @@ void FunctionFsBoard::onStatus(long result) {
   if (result == static_cast<long>(kStatusSize)) {
     log_.statusTaken(nowNs(), status_.builtNs, status_.status.lastSequence, status_.status.framesReceived);
   } else if (replaced && enabled_) {
+    log_.statusReplaced(nowNs() - status_.cancelledNs);
     submitStatus();  // not taken within its tick: a fresh one in its place
   }
 }
@@ -260,6 +256,7 @@ void FunctionFsBoard::onTick() {
     submitStatus();  // the tick after the previous frame was taken
   } else if (!status_.cancelling && now - status_.builtNs >= kTickNs) {
     status_.cancelling = true;  // not taken by this tick: replaced once its cancel is back
+    status_.cancelledNs = now;
     cancel(status_.cb);
   }
 }
@@ -282,26 +279,32 @@ bool FunctionFsBoard::halt(bool out, std::string& error) {
     return false;
   }
   uint8_t none[1] = {};
-  if (!out && status_.queued) {
-    // A device controller halts an IN endpoint only with nothing queued on it: take the status
-    // frame back first (its completion is reaped here, and the tick queues the next one, which
-    // waits behind the halt until the host clears it).
-    cancel(status_.cb);
-    io_event event{};
-    timespec limit{1, 0};
-    while (status_.queued && io_getevents(aio_, 1, 1, &event, &limit) == 1) {
-      if (event.obj == &status_.cb) {
-        status_.queued = status_.cancelling = false;
-        continue;
+  // FunctionFS halts an endpoint on I/O in the wrong direction, and says so with EBADMSG. A
+  // device controller halts an IN endpoint only with nothing queued on it (EAGAIN otherwise):
+  // the status frame is taken back first (its completion reaped here; the tick queues the next
+  // one, which waits behind the halt until the host clears it).
+  for (int attempt = 0; attempt < 10; ++attempt) {
+    if (!out && status_.queued) {
+      if (!status_.cancelling) cancel(status_.cb);
+      status_.cancelling = true;
+      io_event event{};
+      timespec limit{0, 100000000};
+      while (status_.queued && io_getevents(aio_, 1, 1, &event, &limit) == 1) {
+        if (event.obj == &status_.cb) {
+          status_.queued = status_.cancelling = false;
+          continue;
+        }
+        for (Read& read : reads_)
+          if (event.obj == &read.cb) onRead(read, static_cast<long>(event.res));
       }
-      for (Read& read : reads_)
-        if (event.obj == &read.cb) onRead(read, static_cast<long>(event.res));
     }
+    const ssize_t result = out ? ::write(out_, none, 0) : ::read(in_, none, 0);
+    if (result < 0 && errno == EBADMSG) return true;
+    if (!(result < 0 && errno == EAGAIN)) break;
+    std::fprintf(stderr, "kf_board_gadget: halt %s: EAGAIN (status queued %d cancelling %d)\n", out ? "out" : "in",
+                 status_.queued, status_.cancelling);
   }
-  // FunctionFS halts an endpoint on I/O in the wrong direction, and says so with EBADMSG.
-  const ssize_t result = out ? ::write(out_, none, 0) : ::read(in_, none, 0);
-  if (result < 0 && errno == EBADMSG) return true;
-  error = std::string("the endpoint did not halt: ") + (result < 0 ? std::strerror(errno) : "no error");
+  error = std::string("the endpoint did not halt: ") + std::strerror(errno);
   return false;
 }
 

@@ -61,6 +61,7 @@ class FunctionFsBoard {
     bool queued = false;
     bool cancelling = false;
     int64_t builtNs = 0;
+    int64_t cancelledNs = 0;  // when its replacement began
     Status status;
   };
 

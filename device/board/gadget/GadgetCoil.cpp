@@ -59,7 +59,7 @@ bool GadgetCoil::open(std::string& error) {
   return true;
 }
 
-void GadgetCoil::setTarget(uint16_t drive, double timeS, const char* why) {
+void GadgetCoil::setTarget(uint16_t drive, double, const char* why) {
   target_ = drive;
   if (dutyFd_ >= 0) {
     // sysfs takes the whole value in one write at offset 0.
@@ -69,7 +69,9 @@ void GadgetCoil::setTarget(uint16_t drive, double timeS, const char* why) {
     if (::pwrite(dutyFd_, text, static_cast<size_t>(size), 0) != size)
       std::fprintf(stderr, "kf_board_gadget: cannot set the PWM duty: %s\n", std::strerror(errno));
   }
-  log_.target(std::llround(timeS * 1e9), drive, why);
+  // Logged when the pin changed, not at the firmware's moment for it (the watchdog's is its exact
+  // 20 ms): what the coil saw, late by however long the tick that noticed it was.
+  log_.target(monotonicNs(), drive, why);
 }
 
 double GadgetCoil::temperatureC(double nowS) {

@@ -41,6 +41,11 @@ void GadgetLog::tick(int64_t lateNs, uint64_t missed) {
   maxLateNs_ = std::max(maxLateNs_, lateNs);
 }
 
+void GadgetLog::statusReplaced(int64_t cancelNs) {
+  ++statusReplaced_;
+  maxCancelNs_ = std::max(maxCancelNs_, cancelNs);
+}
+
 long GadgetLog::report(const std::string& path) {
   std::FILE* out = std::fopen(path.c_str(), "w");
   if (out == nullptr) return -1;
@@ -67,12 +72,14 @@ long GadgetLog::report(const std::string& path) {
         break;
     }
   }
-  std::fprintf(out, "ticks %" PRIu64 " missed %" PRIu64 " late-max-ns %" PRId64 " dropped %" PRIu64 "\n", ticks_,
-               missedTicks_, maxLateNs_, dropped_);
+  std::fprintf(out,
+               "ticks %" PRIu64 " missed %" PRIu64 " late-max-ns %" PRId64 " dropped %" PRIu64 " replaced %" PRIu64
+               " cancel-max-ns %" PRId64 "\n",
+               ticks_, missedTicks_, maxLateNs_, dropped_, statusReplaced_, maxCancelNs_);
   const bool written = std::fclose(out) == 0;
   used_ = 0;
-  dropped_ = ticks_ = missedTicks_ = 0;
-  maxLateNs_ = 0;
+  dropped_ = ticks_ = missedTicks_ = statusReplaced_ = 0;
+  maxLateNs_ = maxCancelNs_ = 0;
   return written ? frames : -1;
 }
 

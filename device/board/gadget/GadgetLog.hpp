@@ -7,11 +7,20 @@
 // as text lines (one record a line, the kind first) and forgets them.
 #pragma once
 
+#include <time.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace kf::board::gadget {
+
+// CLOCK_MONOTONIC in ns: the gadget's one clock.
+inline int64_t monotonicNs() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return static_cast<int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
+}
 
 class GadgetLog {
  public:
@@ -25,6 +34,8 @@ class GadgetLog {
   void event(int64_t timeNs, const char* name);
   void statusTaken(int64_t timeNs, int64_t builtNs, uint16_t lastSequence, uint16_t framesReceived);
   void tick(int64_t lateNs, uint64_t missed);
+  // A status frame not taken within its tick, built anew once its cancel came back after `cancelNs`.
+  void statusReplaced(int64_t cancelNs);
 
   // Writes the records since the last report to `path` (then the tick figures); the number of
   // frames written, or -1 when the file could not be written.
@@ -48,8 +59,8 @@ class GadgetLog {
   std::vector<Record> records_;
   size_t used_ = 0;
   uint64_t dropped_ = 0;
-  uint64_t ticks_ = 0, missedTicks_ = 0;
-  int64_t maxLateNs_ = 0;
+  uint64_t ticks_ = 0, missedTicks_ = 0, statusReplaced_ = 0;
+  int64_t maxLateNs_ = 0, maxCancelNs_ = 0;
 };
 
 }  // namespace kf::board::gadget

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -107,8 +108,26 @@ GadgetBoard::~GadgetBoard() {
   (void)::write(toGadget_, quit.data(), quit.size());
   ::close(toGadget_);
   int status = 0;
-  ::waitpid(pid_, &status, 0);
+  const bool ended = waitUntil([&] { return ::waitpid(pid_, &status, WNOHANG) == pid_; }, kAnswerGuardMs / 1000.0);
+  if (!ended) {
+    std::fprintf(stderr, "kf_board_gadget did not quit: %s; killed\n", whereItWaits().c_str());
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status, 0);
+  }
   ::close(fromGadget_);
+}
+
+std::string GadgetBoard::whereItWaits() const {
+  // The kernel's view of a process that does not answer: where each of its threads sleeps.
+  std::string where;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid_) + "/task")) {
+    std::ifstream stack(task.path().string() + "/stack");
+    std::string line, frames;
+    for (int i = 0; i < 8 && std::getline(stack, line); ++i) frames += (frames.empty() ? "" : " < ") + line;
+    where += "[thread " + task.path().filename().string() + ": " + readFirstLine(task.path().string() + "/wchan") +
+             ": " + frames + "] ";
+  }
+  return where;
 }
 
 std::string GadgetBoard::command(const std::string& line) {
@@ -130,7 +149,7 @@ std::string GadgetBoard::command(const std::string& line) {
     pollfd fd{fromGadget_, POLLIN, 0};
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
     if (left.count() <= 0 || ::poll(&fd, 1, static_cast<int>(left.count())) <= 0)
-      throw std::runtime_error("kf_board_gadget did not answer '" + line + "'");
+      throw std::runtime_error("kf_board_gadget did not answer '" + line + "': " + whereItWaits());
     char chunk[256];
     const ssize_t got = ::read(fromGadget_, chunk, sizeof chunk);
     if (got <= 0) throw std::runtime_error("kf_board_gadget ended (before answering '" + line + "')");
@@ -171,7 +190,8 @@ GadgetReport GadgetBoard::report() {
       report.statuses.push_back(s);
     } else if (kind == "ticks") {
       std::string word;
-      words >> report.ticks >> word >> report.missedTicks >> word >> report.tickLateMaxNs >> word >> report.dropped;
+      words >> report.ticks >> word >> report.missedTicks >> word >> report.tickLateMaxNs >> word >> report.dropped >>
+          word >> report.statusReplaced >> word >> report.statusCancelMaxNs;
     }
   }
   ::unlink(path.c_str());

@@ -51,6 +51,8 @@ struct GadgetReport {
   std::vector<GadgetEvent> events;
   std::vector<GadgetStatusTaken> statuses;
   uint64_t ticks = 0, missedTicks = 0, dropped = 0;
+  uint64_t statusReplaced = 0;    // status frames not taken within their tick, built anew
+  int64_t statusCancelMaxNs = 0;  // the longest a replaced frame's cancel took to come back
   int64_t tickLateMaxNs = 0;
 
   std::vector<GadgetFrame> applied() const;  // the frames the firmware took
@@ -84,6 +86,7 @@ class GadgetBoard {
 
  private:
   std::string gadgetDir() const;
+  std::string whereItWaits() const;
 
   pid_t pid_ = -1;
   int toGadget_ = -1;
