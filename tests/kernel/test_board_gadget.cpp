@@ -93,6 +93,21 @@ SequenceCheck checkSequences(const std::vector<GadgetFrame>& frames) {
   return check;
 }
 
+// How the host's transfers of the set-points the gadget did not receive ended.
+std::string hostOutcomes(const CountingPort& port, const std::vector<GadgetFrame>& applied) {
+  std::string text;
+  const auto outcomes = port.setPoints();
+  for (size_t i = 1; i < applied.size(); ++i)
+    for (uint16_t seq = applied[i - 1].sequence + 1; seq != applied[i].sequence; ++seq) {
+      text += " [" + std::to_string(seq) + ":";
+      for (const auto& o : outcomes)
+        if (o.sequence == seq)
+          text += std::string(" ") + usb::describe(o.status) + " " + std::to_string(o.actualLength) + " bytes";
+      text += "]";
+    }
+  return text;
+}
+
 std::string describeCounts(const CountingPort::Counts& c) {
   return "submitted " + std::to_string(c.submitted) + ", called back " + std::to_string(c.calledBack) + " (cancelled " +
          std::to_string(c.cancelled) + ", no device " + std::to_string(c.noDevice) + "), in flight at close " +
@@ -325,6 +340,7 @@ TEST_CASE("board gadget: a halted endpoint is cleared by the host, and set-point
   CHECK(statusesAfterIn > 0);
   // The set-points lost are those whose transfers stalled, no others.
   INFO("halts at " << haltOutNs / 1000000 << " and " << haltInNs / 1000000 << " ms; jumps:" << sequences.where);
+  INFO("the host's side of the missing ones:" << hostOutcomes(*host.port, applied));
   CHECK(sequences.missing <= static_cast<long>(outStalls + after.lostTransfers - before.lostTransfers));
   CHECK(sequences.duplicates == 0);
   CHECK(after.connected);

@@ -24,6 +24,11 @@ CountingPort::Counts CountingPort::snapshot() const {
   return *shared_;
 }
 
+std::vector<CountingPort::SetPointOutcome> CountingPort::setPoints() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return setPoints_;
+}
+
 void CountingPort::close(double callbackWaitS) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -68,6 +73,9 @@ void CountingPort::onDone(usb::Transfer& transfer) {
     ++self->shared_->calledBack;
     if (transfer.status == usb::TransferStatus::kCancelled) ++self->shared_->cancelled;
     if (transfer.status == usb::TransferStatus::kNoDevice) ++self->shared_->noDevice;
+    if (!(transfer.endpoint & 0x80) && transfer.length >= 4)
+      self->setPoints_.push_back({static_cast<uint16_t>(transfer.buffer[2] | (transfer.buffer[3] << 8)),
+                                  transfer.status, transfer.actualLength});
     original = self->callbacks_[&transfer];
   }
   if (original != nullptr) original(transfer);

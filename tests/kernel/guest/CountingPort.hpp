@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "board/UsbPort.hpp"
 
@@ -24,11 +25,20 @@ class CountingPort : public usb::Port {
     int inFlightAtClose = 0;  // the most in flight at any close()
   };
 
+  // What became of each set-point the driver sent: its sequence (read from the transfer's
+  // bytes) and how its transfer ended.
+  struct SetPointOutcome {
+    uint16_t sequence;
+    usb::TransferStatus status;
+    int actualLength;
+  };
+
   explicit CountingPort(std::unique_ptr<usb::Port> inner);
   ~CountingPort() override;
   // The counts so far, readable after the driver is gone (they outlive the port).
   std::shared_ptr<const Counts> counts() const { return shared_; }
   Counts snapshot() const;
+  std::vector<SetPointOutcome> setPoints() const;
 
   usb::Result init() override { return inner_->init(); }
   void exit() override { inner_->exit(); }
@@ -56,6 +66,7 @@ class CountingPort : public usb::Port {
   std::shared_ptr<Counts> shared_ = std::make_shared<Counts>();
   int inFlight_ = 0;
   std::map<usb::Transfer*, void (*)(usb::Transfer&)> callbacks_;  // the driver's own, per transfer
+  std::vector<SetPointOutcome> setPoints_;
 };
 
 }  // namespace kf::guest
