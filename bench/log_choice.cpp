@@ -21,6 +21,9 @@
 
 namespace {
 
+// M_PI is POSIX's, not C++17's: MinGW has none (a user's default Windows build stopped here).
+constexpr double kPi = 3.14159265358979323846;
+
 // The paper's mapping: [-30, 0] dB -> [0.14, 0.5] N.
 constexpr double kLoDb = kf::paper::mapping::loDb, kHiDb = kf::paper::mapping::hiDb;
 constexpr double kLoForceN = kf::paper::mapping::loForceN, kHiForceN = kf::paper::mapping::hiForceN;
@@ -165,7 +168,7 @@ int main() {
   std::vector<float> input(samples);
   std::normal_distribution<float> g(0.f, 1.f);
   for (int i = 0; i < samples; ++i) {
-    const double db = -15.0 + 12.0 * std::sin(2.0 * M_PI * i / 48000.0 * 0.7);
+    const double db = -15.0 + 12.0 * std::sin(2.0 * kPi * i / 48000.0 * 0.7);
     input[i] = float(std::pow(10.0, db / 20.0) * 1.2533 * g(rng));  // E|N(0,1)| = 0.798
   }
   std::vector<float> coreOut(samples);

@@ -3,7 +3,7 @@
 // off, measured side by side (the two interleaved in every round, each round a fresh core on the
 // same path), and LoudnessToFriction's per sample on noise in the same rounds; and the alias that
 // anti-aliasing removes: the largest non-DC amplitude (N) of the 1 ms frames' spectrum at 300 mm/s,
-// on and off, measured as the tests measure it (tests/dsp/ForceFrameSpectrum.hpp).
+// on and off, measured as the tests measure it (tests/dsp/patterns/ForceFrameSpectrum.hpp).
 // Prints one JSON object (bench/kfbench/patterns.py reads it).
 #include <time.h>
 
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "ForceFrameSpectrum.hpp"
-#include "FrictionPatternCore.hpp"
 #include "LoudnessToFriction.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 namespace {
 

@@ -17,7 +17,13 @@ if(KF_EXTENSION_DIR STREQUAL "user")
   else()
     set(kf_user_extensions "$ENV{HOME}/.local/share/SuperCollider/Extensions")
   endif()
-  set(KF_EXTENSION_DIR "${kf_user_extensions}/KineticFriction" CACHE PATH
-      "Extension folder that install() fills with the plugin, classes and help" FORCE)
+  set(KF_EXTENSION_DIR "${kf_user_extensions}/KineticFriction" CACHE STRING
+      "Extension folder that install() fills with the plugin, classes and help (user: the user's Extensions)" FORCE)
   message(STATUS "Extension folder: ${KF_EXTENSION_DIR}")
+endif()
+if(NOT IS_ABSOLUTE "${KF_EXTENSION_DIR}")
+  # Relative to the build folder (install() would take it relative to the install prefix).
+  get_filename_component(kf_extension_dir "${KF_EXTENSION_DIR}" ABSOLUTE BASE_DIR "${CMAKE_BINARY_DIR}")
+  set(KF_EXTENSION_DIR "${kf_extension_dir}" CACHE STRING
+      "Extension folder that install() fills with the plugin, classes and help (user: the user's Extensions)" FORCE)
 endif()

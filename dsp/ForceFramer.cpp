@@ -36,6 +36,12 @@ void ForceFramer::reset() {
   lastCommandedN_ = static_cast<float>(minForceN_);
 }
 
+void ForceFramer::dropFrameInProgress() {
+  started_ = false;
+  weightedSum_ = 0.0;
+  weight_ = 0.0;
+}
+
 float ForceFramer::sanitize(float forceN) {
   if (std::isfinite(forceN)) return forceN;
   ++nonFiniteSamples_;

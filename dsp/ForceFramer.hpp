@@ -29,6 +29,9 @@ class ForceFramer {
   void setForceRange(double minForceN, double maxForceN);
   // Forgets the frame in progress and the last commanded value (back to minForceN).
   void reset();
+  // Forgets the frame in progress (its samples are never sent), keeping the last commanded
+  // value and the count of frames; the next block opens the frame of its own first sample.
+  void dropFrameInProgress();
 
   // One block: sample i starts at blockStartTimeS + i * sampleDurS. commandedN (may be null)
   // receives per sample the last completed frame's value as known after that sample. Returns

@@ -289,10 +289,10 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
     case CommandShape::kOpenSim: {
       double kind = 0.0, count = 0.0;
       if (!args.readNumber(kind)) return fail(error, errorSize, "hand script kind: %s", describe(args));
-      if (!isWholeIn(kind, -1.0, 6.0))
+      if (!isWholeIn(kind, -1.0, 7.0))
         return fail(error, errorSize,
                     "hand script kind %g is not -1 (none), 0 (path), 1 (speeds), 2 (force), 3 (path2D), 4 (line), "
-                    "5 (circle) or 6 (raster)",
+                    "5 (circle), 6 (raster) or 7 (explore)",
                     shown(kind));
       if (!args.readNumber(count)) return fail(error, errorSize, "hand script value count: %s", describe(args));
       if (!isWholeIn(count, 0.0, kMaxHandValues))
@@ -310,6 +310,8 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
         return fail(error, errorSize, "a line or circle hand script takes 5 values, not %d", wanted);
       if (out.kind == 6 && wanted != 6)
         return fail(error, errorSize, "a raster hand script takes 6 values, not %d", wanted);
+      if (out.kind == 7 && wanted != 9)
+        return fail(error, errorSize, "an explore hand script takes 9 values, not %d", wanted);
       if (wanted > 0) {
         out.values = storage(storageContext, wanted);
         if (out.values == nullptr) return fail(error, errorSize, "RT memory allocation failed for the hand script");

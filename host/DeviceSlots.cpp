@@ -73,11 +73,14 @@ SlotView viewSlot(int index, const BlockClock& clock) {
   if (view.device == nullptr) return view;
   Slot& slot = gSlots[index];
   if (!slot.trajectory.hasBlock(clock.block)) {
-    int numReports = view.device->popReports(slot.reports, kMaxReportsPerBlock);
+    // Reports that came while no reader read the slot (before its first reader, or while it had
+    // none) waited for no one: the status's reader delay counts from a reader on.
+    const bool readerWasReading = slot.trajectory.continuesAt(clock.block);
+    int numReports = view.device->popReports(slot.reports, kMaxReportsPerBlock, readerWasReading);
     // A backlog larger than the buffer (nobody read for seconds): the newest report stands for
     // the rest; its absolute counts include them.
     if (numReports == kMaxReportsPerBlock)
-      while (view.device->popReports(&slot.reports[kMaxReportsPerBlock - 1], 1) == 1) {
+      while (view.device->popReports(&slot.reports[kMaxReportsPerBlock - 1], 1, readerWasReading) == 1) {
       }
     slot.trajectory.takeBlock(clock, slot.reports, numReports, view.device->isLockstep(),
                               view.device->lockstepOriginS());

@@ -24,6 +24,7 @@ void SlotTrajectory::reset(const DeviceSpec& spec) {
   offsetXMm_ = offsetYMm_ = 0.0;
   positionRequested_ = false;
   reportsTaken_ = 0;
+  buttons_ = lastReportButtons_ = 0;
   clock_.reset();
   for (int m = 0; m < kNumModes; ++m) {
     references_[m].~TrajectoryReconstructor();
@@ -40,7 +41,7 @@ void SlotTrajectory::requestPosition(double xMm, double yMm) {
 
 void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* reports, int numReports, bool lockstep,
                                double lockstepOriginS) {
-  const bool continuous = valid_ && lastBlock_ == clock.block - 1;
+  const bool continuous = continuesAt(clock.block);
   reportsTaken_ += numReports;
   // The references catch up with the previous block, rendered as an audio-rate reader did.
   if (continuous)
@@ -69,8 +70,11 @@ void SlotTrajectory::takeBlock(const BlockClock& clock, const MouseReport* repor
   // A backlog (nobody read for a while) counts for its position only: it arrived late all at
   // once, and would teach the clock mapper a delay that is not there.
   if (!continuous) clock_.reset();
+  buttons_ = numReports > 0 ? 0 : lastReportButtons_;
   for (int i = 0; i < numReports; ++i) {
     const MouseReport& r = reports[i];
+    buttons_ |= r.buttons;
+    lastReportButtons_ = r.buttons;
     double timeS = clock.startS;
     if (lockstep)
       timeS = r.deviceTimeS + lockstepOriginS;

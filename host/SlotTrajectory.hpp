@@ -57,6 +57,8 @@ class SlotTrajectory {
 
   // Whether this block has been taken already.
   bool hasBlock(int64_t block) const { return valid_ && lastBlock_ == block; }
+  // Whether the block before this one was taken: a reader has been reading without a gap.
+  bool continuesAt(int64_t block) const { return valid_ && lastBlock_ == block - 1; }
 
   // The first reader of a block: `reports` are all the reports popped this block (oldest
   // first). lockstep: device time + lockstepOriginS is audio time; realtime: mapped.
@@ -78,6 +80,9 @@ class SlotTrajectory {
   double reportedXMm() const { return mm(xCounts_, yCounts_, true) + offsetXMm_; }
   double reportedYMm() const { return mm(xCounts_, yCounts_, false) + offsetYMm_; }
   int64_t lastBlock() const { return lastBlock_; }
+  // The buttons (bit i = button i + 1) of this block: those down in any of its reports, so a
+  // click shorter than a block still shows; with no report in the block, the last report's.
+  uint32_t buttons() const { return buttons_; }
   // Reports handed to takeBlock since reset (a backlog beyond the buffer counts as one).
   int64_t reportsTaken() const { return reportsTaken_; }
 
@@ -109,6 +114,8 @@ class SlotTrajectory {
   PositionEntry entries_[kMaxEntries];
   int numEntries_ = 0;
   int64_t reportsTaken_ = 0;
+  uint32_t buttons_ = 0;
+  uint32_t lastReportButtons_ = 0;
 };
 
 }  // namespace kf::sc

@@ -5,7 +5,9 @@
 //   kfOpenSim    index kind numValues values... [key value]...   kind: -1 none, 0 path
 //                (timeS, xMm pairs), 1 speeds (speedMmPerS, durationS pairs), 2 force (N), 3 path2D
 //                (timeS, xMm, yMm triples), 4 line (x0, y0, angleDeg, lengthMm, speed), 5 circle
-//                (cx, cy, radiusMm, speed, turns), 6 raster (x0, y0, widthMm, heightMm, rows, speed)
+//                (cx, cy, radiusMm, speed, turns), 6 raster (x0, y0, widthMm, heightMm, rows, speed),
+//                7 explore (fromMm, toMm, slowMmPerS, fastMmPerS, tiers, tierS, maxPushN,
+//                gainNSPerM, adaptS: a participant, sim/ExploringHand)
 //   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
 //   kfStatus     index             (posts telemetry and replies /kfStatus with its figures as
@@ -100,6 +102,10 @@ kf::HandScript handScriptOf(const CommandData* data) {
     case 6:
       return kf::HandScript::raster(args.values[0], args.values[1], args.values[2], args.values[3], args.values[4],
                                     args.values[5]);
+    case 7: {
+      const double* v = args.values;
+      return kf::HandScript::exploring({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]});
+    }
     default:
       return kf::HandScript::none();
   }

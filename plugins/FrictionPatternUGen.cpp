@@ -1,6 +1,6 @@
-// FrictionPattern: a spatial friction pattern (dsp/FrictionPatternCore), position (mm) in, force
+// FrictionPattern: a spatial friction pattern (dsp/patterns/FrictionPatternCore), position (mm) in, force
 // (N) out. Inputs: kind (fixed at init), position, loForce (N), hiForce (N), antialias (0/1),
-// p1, p2, p3 (by kind, dsp/FrictionPatternCore.hpp); for kind slope p1 is the height signal; the
+// p1, p2, p3 (by kind, dsp/patterns/FrictionPatternCore.hpp); for kind slope p1 is the height signal; the
 // 2D kinds (bumps2D, texture2D) have one more input, y (mm), read as position is (0 when absent).
 // Position and height are read at audio rate as they are; at control rate they are interpolated
 // linearly across the block from the last block's value (as SC UGens do), since a value held per
@@ -13,8 +13,8 @@
 #include <cmath>
 #include <optional>
 
-#include "FrictionPatternCore.hpp"
 #include "PluginShared.hpp"
+#include "patterns/FrictionPatternCore.hpp"
 
 namespace {
 

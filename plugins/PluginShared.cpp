@@ -70,6 +70,7 @@ PluginLoad(KineticFriction) {
   registerLoudnessToFriction();
   registerFrictionPattern();
   registerFrictionMouseIn();
+  registerFrictionButtons();
   registerFrictionOut();
   registerFrictionDrive();
   registerDeviceCommands();

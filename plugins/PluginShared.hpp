@@ -81,6 +81,7 @@ void registerSpeedGovernor();
 void registerLoudnessToFriction();
 void registerFrictionPattern();
 void registerFrictionMouseIn();
+void registerFrictionButtons();
 void registerFrictionOut();
 void registerFrictionDrive();
 void registerDeviceCommands();

@@ -57,21 +57,21 @@ FrictionCalibration {
 
 	// The file names the board (serial): the server refuses a table without one, or another
 	// board's, so write refuses to make such a file.
-	write { |argPath|
+	write { |path|
 		var file;
 		if(serial.isNil) {
 			Error("FrictionCalibration.write: give the serial of the board it was measured on " ++
 				"(FrictionCalibration(points, serial) or .serial_; the board's status shows it)").throw
 		};
-		argPath = argPath.standardizePath;
-		file = File(argPath, "w");
-		if(file.isOpen.not) { Error("FrictionCalibration.write: cannot write %".format(argPath)).throw };
+		path = path.standardizePath;
+		file = File(path, "w");
+		if(file.isOpen.not) { Error("FrictionCalibration.write: cannot write %".format(path)).throw };
 		file.write("kf-calibration 1\n");
 		serial !? { file.write("serial %\n".format(serial)) };
 		file.write("# drive (0..1 of full-scale current)  force (N)\n");
 		points.do { |p| file.write("% %\n".format(p[0].asStringPrec(17), p[1].asStringPrec(17))) };
 		file.close;
-		path = argPath;
+		this.prSetPath(path);  // the argument hides the variable of the same name
 	}
 
 	// The least drive that gives forceN; clamped to the table's ends.

@@ -1,8 +1,9 @@
 // One device slot of a server: a simulated friction device, a replay of a recorded session, or
 // hardware: a real mouse (hidapi or evdev, FrictionDeviceMouse.sc) as the puck's sensor, and the
 // friction board (libusb, FrictionDeviceBoard.sc) driving its magnet. Every command has a ...Msg
-// twin that returns the OSC message, so the same device can be used in a Score (pass server nil
-// to only describe it). The server's answers to the commands are FrictionAnswers' business.
+// twin that returns the OSC message, so the same device can be used in a Score: describeSim,
+// describeReplay and describeMouse make a device without opening it. A nil server is
+// Server.default, as everywhere in SC. The server's answers to the commands are FrictionAnswers'.
 FrictionDevice {
 	classvar <oldSpecNames;
 	// The devices sclang holds open, by server and slot.
@@ -57,26 +58,27 @@ FrictionDevice {
 		^if(device.isKindOf(FrictionDevice)) { device.server ? Server.default } { Server.default }
 	}
 
-	// hand: a FrictionHand (nil: the puck stays put). profile: an Event of spec or simulation
-	// settings by name (e.g. (maxForceN: 1.0, puckMassKg: 0.2)); nil: the paper's numbers.
-	// replace: true closes a device open in the slot; false (the default) refuses the slot.
+	// server: a running Server (nil: Server.default). hand: a FrictionHand (nil: the puck stays
+	// put). profile: an Event of spec or simulation settings by name (e.g. (maxForceN: 1.0,
+	// puckMassKg: 0.2)); nil: the paper's numbers. replace: true closes a device open in the slot;
+	// false (the default) refuses the slot.
 	*sim { |server, index = 0, hand, profile, replace = false|
-		if(hand.notNil and: { hand.isKindOf(FrictionHand).not }) {
-			Error("FrictionDevice.sim: hand must be a FrictionHand or nil, got %".format(hand)).throw
-		};
-		^this.new.prInit(server, index, \sim, hand, profile, replace).prOpen
+		^this.prSim(server ? Server.default, index, hand, profile, replace, "sim").prOpen
+	}
+	// The same device described only, on no server: its ...Msg methods for a Score.
+	*describeSim { |index = 0, hand, profile, replace = false|
+		^this.prSim(nil, index, hand, profile, replace, "describeSim")
 	}
 
 	// path: a kf-session recording (FrictionDevice.record) or a hid-recorder .hid file.
 	*replay { |server, path, index = 0, profile, replace = false|
-		if(path.isString.not) {
-			Error("FrictionDevice.replay: path must be a String, got %".format(path)).throw
-		};
-		path = path.standardizePath;
-		if(server.notNil and: { File.exists(path).not }) {
-			Error("FrictionDevice.replay: no such file: %".format(path)).throw
-		};
-		^this.new.prInit(server, index, \replay, path, profile, replace).prOpen
+		path = this.prReplayPath(path, "replay");
+		if(File.exists(path).not) { Error("FrictionDevice.replay: no such file: %".format(path)).throw };
+		^this.new.prInit(server ? Server.default, index, \replay, path, profile, replace).prOpen
+	}
+	// Described only (for a Score, which may write the file before it plays it).
+	*describeReplay { |path, index = 0, profile, replace = false|
+		^this.new.prInit(nil, index, \replay, this.prReplayPath(path, "describeReplay"), profile, replace)
 	}
 
 	// A real mouse and the friction board with its calibration, opened as one device: one answer
@@ -90,7 +92,7 @@ FrictionDevice {
 	// failed part is undone by one kfClose; a composite would repeat the mouse's and the board's
 	// arguments and stages in the plugin for the same outcome. See ARCHITECTURE.md.
 	*hardware { |server, mouse, board, profile, calibration, index = 0, backend, grab = false, replace = false|
-		^this.new.prInitMouse(server, index, mouse, backend, profile, grab, replace)
+		^this.new.prInitMouse(server ? Server.default, index, mouse, backend, profile, grab, replace)
 		.prInitBoard(board, calibration, "FrictionDevice.hardware").prOpen
 	}
 
@@ -207,6 +209,18 @@ FrictionDevice {
 
 	printOn { |stream| stream << this.class.name << "(" << kind << ", " << index << ")" }
 
+	*prSim { |server, index, hand, profile, replace, method|
+		if(hand.notNil and: { hand.isKindOf(FrictionHand).not }) {
+			Error("FrictionDevice.%: hand must be a FrictionHand or nil, got %".format(method, hand)).throw
+		};
+		^this.new.prInit(server, index, \sim, hand, profile, replace)
+	}
+
+	*prReplayPath { |path, method|
+		if(path.isString.not) { Error("FrictionDevice.%: path must be a String, got %".format(method, path)).throw };
+		^path.standardizePath
+	}
+
 	// kind: \sim, \replay or \mouse, the class method that opens it (and names its errors).
 	prInit { |argServer, argIndex, argKind, argSource, profile, argReplace = false|
 		var where = "FrictionDevice." ++ argKind;
@@ -284,20 +298,24 @@ FrictionDevice {
 	}
 
 	prForget { |newState|
-		var held = slots[server];
+		var held = slots[server], holdsBuses = state != \quit;
 		if(held.notNil and: { held[index] === this }) { held[index] = nil };
 		state = newState;
-		busSynths.do { |node| if(server.serverRunning) { node.free } };
+		// A node may be gone already (s.freeAll just before): freed without the server's complaint.
+		if(server.serverRunning and: { busSynths.notEmpty }) {
+			server.sendBundle(nil, ['/error', -1], *busSynths.values.collect { |node| ['/n_free', node.nodeID] })
+		};
 		busSynths = IdentityDictionary.new;
-		forceBus !? { forceBus.free };
+		[forceBus, positionBus].do { |bus| if(holdsBuses and: { bus.notNil }) { bus.free } };
 		forceBus = nil;
-		positionBus !? { positionBus.free };
 		positionBus = nil;
 	}
 
 	// The writer of forceBus (at the tail: it sends the sum played into the bus to the device)
 	// and the reader of positionBus (at the head: the puck for every synth after it), each started
-	// once its bus exists: one synth per role, claimed at once so that it is never started twice.
+	// once its bus exists: one synth per role, claimed at once so that it is never started twice,
+	// and let go when the server ends it (Cmd-., s.freeAll, a quit), so that ServerTree starts it
+	// again, and only then.
 	prStartBusSynths {
 		[
 			[\writer, forceBus, \addToTail, \kfForceWriter,
@@ -310,6 +328,7 @@ FrictionDevice {
 			if(bus.notNil and: { busSynths[role].isNil }) {
 				node = Synth.basicNew(defName, server);
 				busSynths[role] = node;
+				node.onFree { if(busSynths[role] === node) { busSynths.removeAt(role) } };
 				forkIfNeeded {
 					SynthDef(defName, graph).add;
 					server.sync;
@@ -328,20 +347,38 @@ FrictionDevice {
 		FrictionAnswers.failAll(srv, "the server quit");
 	}
 
+	// One device that cannot be opened again never stops the others, nor the rest of SC's boot
+	// sequence (ServerBoot functions run one after another: an error would leave the server
+	// without its default group).
 	*prServerBoot { |srv|
-		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prReopen } } };
+		slots[srv] !? { |held|
+			held.do { |dev|
+				dev !? {
+					try { dev.prReopen } { |error|
+						"FrictionDevice: % was not opened again after the boot: %".format(dev,
+							error.errorString.replace("ERROR: ", "")).error;
+						dev.prForget(\failed);
+					}
+				}
+			}
+		};
 	}
 
 	*prServerTree { |srv|
 		slots[srv] !? { |held| held.do { |dev| dev !? { dev.prRestoreWriter } } };
 	}
 
+	// The server freed the nodes; SC's quit made new bus allocators, so the buses are no longer
+	// held either (prForget must not free their numbers: they may be someone else's now).
 	prQuit { state = \quit; busSynths = IdentityDictionary.new }
 
 	prReopen {
 		if(state != \quit) { ^this };
-		forceBus !? { server.audioBusAllocator.reserve(forceBus.index, 1, false) };
-		positionBus !? { server.controlBusAllocator.reserve(positionBus.index, 4, false) };
+		// The same Bus objects get channels again from the new allocators, as JITLib's proxies do:
+		// whoever holds forceBus or positionBus follows (their numbers may change), and nothing
+		// allocated after the boot can share them. (Reserving the old numbers is not possible:
+		// SC 3.13's ContiguousBlockAllocator:reserve ignores the audio allocator's offset.)
+		[forceBus, positionBus].do { |bus| bus !? { bus.alloc } };
 		state = \opening;
 		FrictionAnswers.sendSequence(server, index, this.prOpenSteps, {
 			state = \open;
@@ -352,12 +389,10 @@ FrictionDevice {
 		}, false);
 	}
 
-	// After Cmd-. (all nodes freed): the force writer and the position reader again.
+	// After Cmd-. or s.freeAll (their nodes ended) and after a boot: the force writer and the
+	// position reader again, those not running (a re-open answered before ServerTree started them).
 	prRestoreWriter {
-		if(state == \open) {
-			busSynths = IdentityDictionary.new;
-			this.prStartBusSynths;
-		};
+		if(state == \open) { this.prStartBusSynths };
 	}
 
 	// In a ProxySpace (~dev = FrictionDevice.sim(s)), the proxy plays the puck's position and

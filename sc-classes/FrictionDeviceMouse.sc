@@ -6,9 +6,13 @@
 	// "/dev/input/event5") or "VVVV:PPPP" / "VVVV:PPPP:serial" (hex ids). backend: \evdev (nil on
 	// Linux: it opens wireless receivers' mice too) or \hidapi (nil elsewhere). profile: an Event
 	// of settings (e.g. (countMm: 0.0212)) or the path of a mouse profile file (writeMouseProfile).
-	// grab: evdev only, keeps the desktop cursor still. replace: as *sim's.
+	// grab: evdev only, keeps the desktop cursor still. server, replace: as *sim's.
 	*mouse { |server, index = 0, which, backend, profile, grab = false, replace = false|
-		^this.new.prInitMouse(server, index, which, backend, profile, grab, replace).prOpen
+		^this.new.prInitMouse(server ? Server.default, index, which, backend, profile, grab, replace).prOpen
+	}
+	// Described only, on no server: its ...Msg methods for a Score.
+	*describeMouse { |index = 0, which, backend, profile, grab = false, replace = false|
+		^this.new.prInitMouse(nil, index, which, backend, profile, grab, replace)
 	}
 
 	// The OSC message that opens the mouse (openMsg adds replace).

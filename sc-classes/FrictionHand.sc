@@ -1,8 +1,9 @@
 // A script for the simulated hand: target positions over time along x or on the surface (x, y),
-// speed segments along x, the 2D scripts (a line at an angle, a circle, a raster), or (for tests)
-// a constant push along x. The 2D scripts are made into (time, x, y) paths by the server
-// (device/sim/HandScript), at a constant speed from t = 0. The simulator pulls the puck towards the target through a
-// spring-damper with a force limit, so friction slows it as the paper's subjects reported.
+// speed segments along x, the 2D scripts (a line at an angle, a circle, a raster), a participant who
+// explores a strip with a push (explore), or (for tests) a constant push along x. The 2D scripts
+// are made into (time, x, y) paths by the server (device/sim/HandScript), at a constant speed from
+// t = 0. The simulator pulls the puck towards the target through a spring-damper with a force
+// limit, so friction slows it as the paper's subjects reported.
 FrictionHand {
 	var <kind, <points, <forceN;
 
@@ -40,6 +41,35 @@ FrictionHand {
 		^this.newCopyArgs(6, this.prCheckParams([x0, y0, widthMm, heightMm, rows, speedMmPerS], "raster", 5))
 	}
 
+	// A participant exploring the strip [fromMm, toMm] along x (device/sim/ExploringHand): it
+	// sweeps it back and forth at intended speeds that step from slowMmPerS to fastMmPerS in tiers
+	// geometric steps of tierS s each (then from slow again), pushing with a force (at most maxPushN)
+	// made of the resistance it has learnt (time constant adaptS s) and gainNSPerM (N per m/s) per
+	// speed shortfall. A push, not a path: it is slowed, and dwells, where friction is high.
+	*explore { |fromMm = 0, toMm = 50, slowMmPerS = 10, fastMmPerS = 200, tiers = 4, tierS = 5, maxPushN = 1.5,
+		gainNSPerM = 10, adaptS = 0.5|
+		var values = [fromMm, toMm, slowMmPerS, fastMmPerS, tiers, tierS, maxPushN, gainNSPerM, adaptS];
+		values.do { |v|
+			if(v.isNumber.not or: { v.isNaN } or: { v.abs == inf }) {
+				Error("FrictionHand.explore: arguments must be finite numbers, got %".format(values)).throw
+			}
+		};
+		if(fromMm >= toMm) {
+			Error("FrictionHand.explore: fromMm (%) must be below toMm (%)".format(fromMm, toMm)).throw
+		};
+		if(slowMmPerS <= 0 or: { fastMmPerS < slowMmPerS }) {
+			Error("FrictionHand.explore: speeds must be 0 < slowMmPerS <= fastMmPerS, got % and %".format(
+				slowMmPerS, fastMmPerS)).throw
+		};
+		if(tiers.isInteger.not or: { tiers < 1 } or: { tiers > 100 }) {
+			Error("FrictionHand.explore: tiers must be an Integer from 1 to 100, got %".format(tiers)).throw
+		};
+		[\tierS, tierS, \maxPushN, maxPushN, \gainNSPerM, gainNSPerM, \adaptS, adaptS].pairsDo { |name, v|
+			if(v <= 0) { Error("FrictionHand.explore: % must be > 0, got %".format(name, v)).throw }
+		};
+		^this.newCopyArgs(7, values.collect(_.asFloat))
+	}
+
 	// A constant push of forceN along x (tests of the puck's dynamics).
 	*force { |forceN|
 		^this.newCopyArgs(2, [], FrictionCheck.finite(forceN, "forceN", "FrictionHand.force"))
@@ -51,7 +81,7 @@ FrictionHand {
 		^[kind, values.size] ++ values
 	}
 
-	// How long the script runs, in s (0 for a constant force).
+	// How long the script runs, in s (0 for a constant force; an explorer's one round of its tiers).
 	duration {
 		var p = points;
 		^switch(kind,
@@ -59,11 +89,13 @@ FrictionHand {
 			4, { p[3] / p[4] },
 			5, { 2pi * p[2] * p[4] / p[3] },
 			6, { (p[2].abs * p[4] + if(p[4] > 1) { p[3].abs } { 0 }) / p[5] },
+			7, { p[4] * p[5] },
 			{ 0 })
 	}
 
 	printOn { |stream|
-		stream << this.class.name << "(" << [\path, \speeds, \force, \path2D, \line, \circle, \raster][kind] << ")"
+		var kinds = [\path, \speeds, \force, \path2D, \line, \circle, \raster, \explore];
+		stream << this.class.name << "(" << kinds[kind] << ")"
 	}
 
 	*prCheckTuples { |tuples, method, shape, size, ascending|

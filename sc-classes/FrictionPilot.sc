@@ -8,7 +8,7 @@ FrictionPilot {
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
-	var <buffer, <synth, <defName, monitorBus, quitAction;
+	var <buffer, <synth, <defName, monitorBus, monitorAllocator, quitAction;
 
 	*initClass {
 		var pilot = KineticFriction.paperPilot, mapping = KineticFriction.paperMapping;
@@ -160,8 +160,8 @@ FrictionPilot {
 
 	// ---- Scores (NRT) ----
 
-	// A Score that renders the pilot for device (a FrictionDevice, usually FrictionDevice.sim(nil,
-	// index, hand) or .replay(nil, path)): opens it, loads the signal, plays the pilot with
+	// A Score that renders the pilot for device (a FrictionDevice, usually FrictionDevice.describeSim(
+	// index, hand) or .describeReplay(path)): opens it, loads the signal, plays the pilot with
 	// mapping (a name of Table 1 or samples per mm) and friction (0 off, 1 on) for duration s,
 	// then closes the device. Output channels 0, 1: the delayed audio (times amp); with
 	// recordBus (e.g. 2), 6 more channels (recordChannelNames). recordPath: also write a
@@ -170,7 +170,7 @@ FrictionPilot {
 		recordBus, recordPath, bufnum = 0, signal, nodeID = 1000|
 		var spm = FrictionCheck.samplesPerMm(mapping, "FrictionPilot.score"), def, msgs;
 		if(device.isKindOf(FrictionDevice).not) {
-			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.sim(nil, 0, hand)), "
+			Error("FrictionPilot.score: device must be a FrictionDevice (e.g. FrictionDevice.describeSim(0, hand)), "
 				"got %".format(device)).throw
 		};
 		duration = duration ?? {
@@ -291,8 +291,17 @@ FrictionPilot {
 
 	// 5 control channels the playing synth writes (position mm, speed mm/s, requested force N,
 	// commanded force N, 1 while running), for FrictionView. Kept for the pilot's life, so a
-	// view keeps reading it across free and play.
-	monitorBus { ^monitorBus ?? { monitorBus = Bus.control(this.server, 5) } }
+	// view keeps reading it across free and play. SC's quit (and a boot's login) makes new bus
+	// allocators, which hold none of the old numbers: the same Bus gets channels again from the
+	// new one, so that nothing allocated after a reboot shares them.
+	monitorBus {
+		var allocator = this.server.controlBusAllocator;
+		if(monitorBus.isNil) { monitorBus = Bus.control(this.server, 5) } {
+			if(monitorAllocator !== allocator) { monitorBus.alloc }
+		};
+		monitorAllocator = allocator;
+		^monitorBus
+	}
 
 	isPlaying { ^synth.notNil }
 
@@ -302,7 +311,7 @@ FrictionPilot {
 	free {
 		synth !? { synth.free };
 		synth = nil;
-		monitorBus !? { monitorBus.setn(0 ! 5) };
+		monitorBus !? { this.monitorBus.setn(0 ! 5) };
 		CmdPeriod.remove(this);
 		quitAction !? { ServerQuit.remove(quitAction, this.server) };
 		quitAction = nil;

@@ -11,7 +11,7 @@ FrictionViewMonitor {
 	var <positionMm = 0, <speedMmPerS = 0, <forceN, <commandedForceN, <timeS = 0, <frameCount = 0;
 	var history, historyHead = 0, <historyCount = 0;
 	// forceChannels: how many force channels the frames carry, 0 (none), 1 (requested) or 2.
-	var <forceChannels = 0, replyID, def, oscFunc;
+	var <forceChannels = 0, replyID, def, defBuses, oscFunc;
 
 	// The frames of device (a FrictionDevice or a slot index): its position and speed from
 	// positionBus (a Bus: position mm, optionally speed mm/s), or nil: FrictionMouseIn on the
@@ -97,8 +97,10 @@ FrictionViewMonitor {
 		history = Array.fill((historyS * frameRate * 1.5).ceil.asInteger + 16, { FloatArray.newClear(5) });
 		replyID = nextReplyID;
 		nextReplyID = nextReplyID + 1;
-		// Built once, from the buses as they are now (they may be freed before the monitor).
+		// Built from the buses as they are now (they may be freed before the monitor), and again
+		// when their numbers changed (a device's or a pilot's buses after a reboot).
 		def = this.prDef(("frictionView" ++ replyID).asSymbol);
+		defBuses = this.prBusNumbers;
 		oscFunc = OSCFunc({ |msg| this.prFrame(msg) }, '/frictionView', server.addr, argTemplate: [nil, replyID]);
 		oscFunc.permanent = true;  // survives Cmd-.; the synth is started again by doOnServerTree
 		ServerTree.add(this, server);
@@ -139,8 +141,18 @@ FrictionViewMonitor {
 		})
 	}
 
+	// The bus numbers the synth reads: a device's buses and a pilot's monitorBus get new ones
+	// after a reboot (FrictionDevice.forceBus, FrictionPilot.monitorBus); nil: a bus freed.
+	prBusNumbers { ^[forceBus, positionBus, pilot !? { pilot.monitorBus }].collect { |bus| bus !? { bus.index } } }
+
 	prStart {
+		var buses;
 		if(isFree or: { server.serverRunning.not }) { ^this };
+		buses = this.prBusNumbers;
+		if(buses != defBuses and: { buses.every { |n, i| n.notNil or: { defBuses[i].isNil } } }) {
+			def = this.prDef(def.name);
+			defBuses = buses;
+		};
 		synth = Synth.basicNew(def.name, server);
 		// The def travels with its node, so a rebooted server (no defs) works as well.
 		server.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(server), [], \addToTail));

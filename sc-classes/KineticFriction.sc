@@ -6,21 +6,32 @@ KineticFriction {
 
 	*pluginDir { ^this.extensionDir +/+ "plugins" }
 
-	// Adds the plugin folder to options.ugenPluginsPath (keeping the standard plugins) unless
-	// scsynth already finds it in an extension folder; returns options.
+	// Adds the plugin folder to options.ugenPluginsPath unless scsynth already finds it in an
+	// extension folder; returns options. A ugenPluginsPath (scsynth's -U) replaces scsynth's own
+	// search, so where it was nil the folders that search covers come first: other extensions'
+	// plugins (sc3-plugins in an Extensions folder, say) keep loading.
 	*addPluginPath { |options|
 		var dirs;
 		options = options ?? { ServerOptions.new };
 		if(this.isInstalledExtension.not) {
 			dirs = options.ugenPluginsPath;
 			dirs = case
-				{ dirs.isNil } { this.systemPluginDirs }
+				{ dirs.isNil } { this.standardPluginDirs }
 				{ dirs.isString } { [dirs] }
 				{ dirs };
 			if(dirs.includesEqual(this.pluginDir).not) { dirs = dirs ++ [this.pluginDir] };
 			options.ugenPluginsPath = dirs;
 		};
 		^options
+	}
+
+	// What scsynth searches without -U, in its order, the folders that exist: its plugins, the
+	// system and the user extension folders, then SC_PLUGIN_PATH.
+	*standardPluginDirs {
+		var fromEnvironment = "SC_PLUGIN_PATH".getenv;
+		var dirs = this.systemPluginDirs ++ [Platform.systemExtensionDir, Platform.userExtensionDir]
+			++ (fromEnvironment !? { fromEnvironment.split(Platform.pathDelimiter) } ? []);
+		^dirs.select { |d| d.notEmpty and: { File.exists(d) } }
 	}
 
 	*isInstalledExtension {

@@ -6,6 +6,6 @@
 #   scripts/bench.sh --only timing --only spatial
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+scripts/setup.sh --all
 source scripts/env.sh
 exec "$KF_PYTHON" bench/run.py "$@"

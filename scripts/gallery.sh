@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The pattern gallery: sets up and builds (scripts/setup.sh), then renders every FrictionPattern on
-# the simulated device at a slow and a fast speed (NRT, no sound card needed) into out/gallery/:
-# force-against-position PNGs, a CSV per pattern and speed, and summary.md with the
-# anti-aliasing figures.
+# The pattern gallery: sets up as the main job does (scripts/setup.sh), then renders every
+# FrictionPattern on the simulated device at a slow and a fast speed (NRT, no sound card needed)
+# into out/gallery/: force-against-position PNGs, a CSV per pattern and speed, and summary.md with
+# the anti-aliasing figures.
 # Usage: scripts/gallery.sh [--rate 48000] [--out DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."

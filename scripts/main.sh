@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: sets up and builds (scripts/setup.sh), then renders the paper's pilot
-# interaction on the simulated device (no sound card needed) into out/pilot/:
-# audio and force WAVs, CSVs, Figure 2/3-style PNGs and summary.md.
+# The main job: sets up (scripts/setup.sh: the packages it runs with, the plugin and classes, no
+# test executables), then renders the paper's pilot interaction on the simulated device (no
+# sound card needed) into out/pilot/: audio and force WAVs, CSVs, Figure 2/3-style PNGs and
+# summary.md.
 # Usage: scripts/main.sh [--rate 48000] [--out DIR]   (the paper ran at --rate 192000)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,26 +1,60 @@
 #!/usr/bin/env bash
-# Installs the Debian packages the build, tests and main job need (only what is missing), then
-# configures and builds into build/ and installs the extension folder build/KineticFriction.
-# Usage: scripts/setup.sh [extra cmake args...]
+# Installs the Debian packages a job needs (only those missing), configures build/, builds into it
+# and installs the extension folder build/KineticFriction (plugin, classes, help).
+# Usage: scripts/setup.sh [--all] [extra cmake args...]
+#   (none)  for the main job and the gallery: the packages they run with, and the extension folder
+#           only (the plugin targets; a new build/ is configured without the tests and supernova)
+#   --all   for the test command and the bench: every package (the checks', the cross check's)
+#           and every target, the tests included
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+all=false
+if [ "${1:-}" = --all ]; then
+  all=true
+  shift
+fi
+
+# What the main job and the gallery run: the compiler and the plugin's libraries, SuperCollider,
+# jackd and Xvfb (the live view's screenshot), the Debian python with numpy, matplotlib and soundfile.
+MAIN_PACKAGES=(
+  g++ cmake make pkg-config
+  supercollider-dev supercollider-server supercollider-language
+  libhidapi-dev libusb-1.0-0-dev jackd2
+  python3 python3-numpy python3-matplotlib python3-soundfile xvfb
+)
+# Everything: the tests, the checks and the bench need these too.
 PACKAGES=(
-  g++ cmake make pkg-config clang-format
-  supercollider-dev supercollider-server supercollider-supernova supercollider-language
-  libhidapi-dev libusb-1.0-0-dev catch2 libsndfile1-dev jackd2
-  python3 python3-numpy python3-matplotlib python3-soundfile python3-pytest python3-pyflakes python3-pil xvfb
+  "${MAIN_PACKAGES[@]}"
+  clang-format supercollider-supernova catch2 libsndfile1-dev
+  python3-pytest python3-pyflakes python3-pil
+  python3-scipy python3-questplus psignifit  # the threshold fit and the study report's t test; their references
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
   qemu-system-x86 linux-image-amd64 busybox-static udev systemd  # tests/kernel: the QEMU guest (python/kfharness/guest.py)
   libaio-dev  # the board gadget (device/board/gadget): FunctionFS through kernel AIO
 )
 source scripts/packages.sh
-kf_install_missing "${PACKAGES[@]}"
+if $all; then
+  kf_install_missing "${PACKAGES[@]}"
+else
+  kf_install_missing "${MAIN_PACKAGES[@]}"
+fi
 
+# build/KineticFriction whatever an earlier configure cached (README's -DKF_EXTENSION_DIR=user).
+configure=(-DCMAKE_BUILD_TYPE=Release -DKF_EXTENSION_DIR="$PWD/build/KineticFriction")
+if $all; then
+  configure+=(-DKF_TESTS=ON -DKF_SUPERNOVA=ON)
+elif [ ! -e build/CMakeCache.txt ]; then
+  configure+=(-DKF_TESTS=OFF -DKF_SUPERNOVA=OFF)  # kept as they are in a build/ set up --all
+fi
 echo "== configuring and building (build/)"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" > build-configure.log 2>&1 || { cat build-configure.log; exit 1; }
+cmake -S . -B build "${configure[@]}" "$@" > build-configure.log 2>&1 || { cat build-configure.log; exit 1; }
 rm -f build-configure.log
-cmake --build build -j "$(nproc)"
+if $all; then
+  cmake --build build -j "$(nproc)"
+else
+  cmake --build build -j "$(nproc)" --target kf_extension
+fi
 cmake --install build > /dev/null
 echo "== extension folder: $(pwd)/build/KineticFriction"

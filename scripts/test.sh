@@ -8,7 +8,7 @@
 # Extra arguments go to ctest, e.g. scripts/test.sh -R scenes/
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+scripts/setup.sh --all
 source scripts/env.sh
 scripts/check.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"

@@ -5,7 +5,7 @@ import re
 import subprocess
 import time
 
-from kfharness import readers
+from kfstudy import readers
 
 from . import loudness, scores
 from .common import LTF_N, SR, log

@@ -59,7 +59,7 @@ def run(bench):
     force_path = work / "bench-drive-force.wav"
     soundfile.write(str(force_path), force, SR, subtype="FLOAT")
     data, _ = nrt.score_and_render("bench-drive", f"""
-        var dev = FrictionDevice.sim(nil, 0);
+        var dev = FrictionDevice.describeSim(0);
         // The pilot's sound delay with this drive (FrictionDevice.driveLatency, in NRT: no server).
         var delay = {BLOCK} / {SR} + FrictionDevice.driveCircuitLatencyOf("{drive_path}");
         var def = SynthDef(\\benchdrive, {{ var f = PlayBuf.ar(1, 10);

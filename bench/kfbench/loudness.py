@@ -2,7 +2,8 @@
 equation (2) in UGens), all compared with equations (1) and (2) in double."""
 import numpy as np
 
-from kfharness import readers, reference
+from kfharness import reference
+from kfstudy import readers
 
 from . import scores
 from .common import LOUDNESS_IN_SC, LTF_N, MAPPING, SR, amplitude_chain_sc, running_sum_chain_sc

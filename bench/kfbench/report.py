@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import drive_path, goals, patterns, realtime, report_rate, spatial, timing
+from . import drive_path, goals, patterns, realtime, report_rate, spatial, thresholds, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -176,6 +176,16 @@ def patterns_section(pt, build_dir):
                   cost=patterns.cost_table(pt, table), alias=patterns.alias_table(pt, table))
 
 
+def thresholds_section(th):
+    procedures, fits = thresholds.tables(th, table)
+    q = th["questplus_reference"]
+    return render("thresholds", cmd=CMD, runs=th["runs"], obs=th["observer"], targets=th["targets"],
+                  sclang_s=th["sclang_s"], procedures=procedures, fits=fits, same=q["same_choice"], trials=q["trials"],
+                  max_difference=q["max_relative_difference"], replay_s=q["replay_s"], own_s=q["own_s"],
+                  load_before=", ".join(f"{v:.2f}" for v in th["load_before"]),
+                  load_after=", ".join(f"{v:.2f}" for v in th["load_after"]))
+
+
 def e2e_section(e2e):
     runs = e2e["runs"]
     rows = [(i + 1, key, f"{r[key]['p50_ms']:.3f}", f"{r[key]['p99_ms']:.3f}", f"{r[key]['max_ms']:.3f}", r[key]["n"])
@@ -255,6 +265,7 @@ def write(results, path, build_dir="build"):
                       ("report_rate", lambda: report_rate_section(get("report_rate"), build_dir)),
                       ("drive", lambda: drive_section(get("drive"))),
                       ("patterns", lambda: patterns_section(get("patterns"), build_dir)),
+                      ("thresholds", lambda: thresholds_section(get("thresholds"))),
                       ("e2e", lambda: e2e_section(get("e2e"))),
                       ("rtload", lambda: rtload_section(get("rtload"))),
                       ("scale", lambda: scale_section(get("scale"))),

@@ -9,7 +9,7 @@ import time
 from kfharness import nrt
 
 from . import build, drift, drive_path, goals, loudness, native, patterns, plots, provenance, realtime, report, report_rate, \
-    rtload, scores, spatial, timing
+    rtload, scores, spatial, thresholds, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import summary_lines
 
@@ -111,6 +111,11 @@ def run_parts(bench, args, parts):
         log("patterns: FrictionPattern's kinds, ns/sample with anti-aliasing on and off, and the alias it removes")
         results["patterns"] = patterns.run(bench)
         _print({"patterns": results["patterns"]})
+    if "thresholds" in parts:
+        log(f"thresholds: the procedures against a model observer, {thresholds.RUNS} runs each, beside "
+            "python3-questplus and psignifit")
+        results["thresholds"] = thresholds.run(bench)
+        _print({"thresholds": results["thresholds"]})
     if "e2e" in parts:
         runs = []
         for i in range(args.e2e_runs):
@@ -131,6 +136,8 @@ def write_plots(results):
                             ("e2e", plots.plot_e2e, "e2e.png"), ("scale", plots.plot_scale, "scale.png")):
         if key in results:
             plot(results[key], BENCH_DIR / name)
+    if "thresholds" in results:
+        thresholds.plot(results["thresholds"], BENCH_DIR / "thresholds.png")
     if "timing" in results and "spatial" in results:
         plots.plot_spatial_tradeoff(results["timing"], results["spatial"], BENCH_DIR / "spatial_tradeoff.png")
 

@@ -5,7 +5,7 @@ indices about 1e7, read from a buffer holding k mod 16."""
 import numpy as np
 import soundfile
 
-from kfharness import readers
+from kfstudy import readers
 
 from . import scores
 from .common import BLOCK, GRID, MAPPINGS, ORIGIN, PILOT_FRAMES, PILOT_PERIOD, SPATIAL_S, SR

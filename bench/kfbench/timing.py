@@ -4,7 +4,7 @@ import random
 
 import numpy as np
 
-from kfharness import readers
+from kfstudy import readers
 
 from . import scores
 from .common import LOUDNESS_IN_SC, MAPPINGS, ORIGIN, PILOT_FRAMES, SPEEDS, SR, BLOCK, amplitude_chain_sc, \

@@ -91,7 +91,7 @@ void Device::failThread(const char* what) noexcept {
   safety_.resetToOff();
   telemetry_.setCommandedForce(safety_.commandedForceN());
   try {
-    recorder_.writeOff(std::max(lastPumpS_, 0.0));
+    recorder_.writeOff(std::max(lastPumpS_, 0.0), OffCause::kFailure);
     recorder_.close();
     postDeviceMessage((std::string("device thread stopped (") + what + "); magnet off, reopen the device").c_str());
   } catch (...) {
@@ -218,7 +218,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
   if (halted_.load()) return;
   if (!(nowS > lastPumpS_)) return;
 
-  if (offRequested_.exchange(false, std::memory_order_acq_rel)) applyOffRequestLocked(nowS);
+  if (offRequested_.exchange(false, std::memory_order_acq_rel)) applyOffRequestLocked(nowS, OffCause::kStop);
   if (lockstep_) {
     ForceFrame frame;  // only frames whose push found the state busy
     while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
@@ -236,7 +236,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
     if (board_) board_->driveOff();
     telemetry_.countWatchdogTrip();
     telemetry_.setCommandedForce(safety_.commandedForceN());
-    recorder_.writeOff(nowS);
+    recorder_.writeOff(nowS, OffCause::kWatchdog);
   }
 
   int polled = 0;
@@ -265,10 +265,10 @@ void Device::requestOff() {
   if (!lockstep_ || isClosed()) return;
   std::unique_lock<PiMutex> lock(stateMutex_, std::try_to_lock);
   if (lock.owns_lock() && lastPumpS_ >= 0.0 && offRequested_.exchange(false, std::memory_order_acq_rel))
-    applyOffRequestLocked(lastPumpS_);
+    applyOffRequestLocked(lastPumpS_, OffCause::kStop);
 }
 
-void Device::applyOffRequestLocked(double nowS) {
+void Device::applyOffRequestLocked(double nowS, OffCause cause) {
   ForceFrame dropped;
   while (frameQueue_.pop(dropped)) {
   }
@@ -278,7 +278,7 @@ void Device::applyOffRequestLocked(double nowS) {
   safety_.resetToOff();
   telemetry_.countOrderlyOff();
   telemetry_.setCommandedForce(safety_.commandedForceN());
-  recorder_.writeOff(nowS);
+  recorder_.writeOff(nowS, cause);
 }
 
 void Device::close() {
@@ -291,14 +291,14 @@ void Device::close() {
   safety_.resetToOff();
   pendingCount_ = 0;
   telemetry_.setCommandedForce(safety_.commandedForceN());
-  recorder_.writeOff(std::max(lastPumpS_, 0.0));
+  recorder_.writeOff(std::max(lastPumpS_, 0.0), OffCause::kClose);
   recorder_.close();
 }
 
-int Device::popReports(MouseReport* out, int capacity) {
+int Device::popReports(MouseReport* out, int capacity, bool measureDelay) {
   int popped = 0;
   while (popped < capacity && reportQueue_.pop(out[popped])) ++popped;
-  if (!lockstep_ && popped > 0) {
+  if (!lockstep_ && measureDelay && popped > 0) {
     const double now = nowS();
     for (int i = 0; i < popped; ++i) telemetry_.reportLatency.record(now - out[i].hostTimeS);
   }
@@ -406,7 +406,7 @@ void Device::flushRecordingLocked() {
 void Device::haltInOrder() {
   std::lock_guard<PiMutex> lock(stateMutex_);  // pumps hold it: none is under way, none after
   halted_.store(true);
-  applyOffRequestLocked(nowS());
+  applyOffRequestLocked(nowS(), OffCause::kQuit);
   flushRecordingLocked();
 }
 

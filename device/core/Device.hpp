@@ -75,8 +75,10 @@ class Device {
   void pump(double nowS, double scheduledS = -1.0);
 
   // Audio side (one consumer / one producer thread): never allocate, lock or wait.
-  // popReports also measures, in realtime, how long each report waited in the queue.
-  int popReports(MouseReport* out, int capacity);
+  // popReports also measures, in realtime, how long each report waited in the queue for its
+  // reader; measureDelay false: no reader was reading while they came (a slot's first read, or
+  // the first after its readers were all gone), so their wait is no reader's delay.
+  int popReports(MouseReport* out, int capacity, bool measureDelay = true);
   // Realtime: queued for the device thread. Lockstep: the audio thread is the pumper, so the
   // frame goes through the safety path at once (try_lock; queued when that fails), and
   // commandedForceN() tells at once what it became.
@@ -144,8 +146,9 @@ class Device {
   };
 
   void pumpLocked(double nowS, double scheduledS);
-  // requestOff() in the pump: the frames not sent dropped, the magnet off, the off recorded.
-  void applyOffRequestLocked(double nowS);
+  // requestOff() in the pump (and haltInOrder): the frames not sent dropped, the magnet off, the
+  // off recorded with its cause.
+  void applyOffRequestLocked(double nowS, OffCause cause);
   // Hands the recording's new lines to its writer; a recording that failed is posted, once.
   void flushRecordingLocked();
   void threadMain();

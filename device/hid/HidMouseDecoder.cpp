@@ -62,10 +62,22 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
   constexpr HidUsage kX = hidUsage(kHidPageGenericDesktop, 0x30);
   constexpr HidUsage kY = hidUsage(kHidPageGenericDesktop, 0x31);
 
+  // The top-level (application) collection a field is in: hid-input makes one input device of
+  // each (hid-generic), so a report's buttons belong to the mouse of their application.
+  auto applicationOf = [&descriptor](int collection) {
+    for (int guard = 0; collection >= 0 && guard < 4096; ++guard) {
+      const HidCollection& c = descriptor.collections[static_cast<size_t>(collection)];
+      if (c.parent < 0) return collection;
+      collection = c.parent;
+    }
+    return collection;
+  };
+
   for (const HidField& field : descriptor.fields) {
     if (field.kind != HidField::Kind::kInput || field.isConstant()) continue;
     if (field.bitSize == 0 || field.bitSize > 32) continue;
     Layout& layout = layoutFor(field.reportId);
+    if (layout.application < 0) layout.application = applicationOf(field.collection);
     if (field.isVariable()) {
       for (uint32_t i = 0; i < field.count; ++i) {
         const HidUsage usage = field.usageOfElement(i);
@@ -99,9 +111,21 @@ bool HidMouseDecoder::build(const HidReportDescriptor& descriptor, std::string& 
       }
     }
   }
-  // Only reports with motion are mouse reports.
-  layouts_.erase(std::remove_if(layouts_.begin(), layouts_.end(), [](const Layout& l) { return !l.haveX && !l.haveY; }),
-                 layouts_.end());
+  // Mouse reports: those with motion, and those with buttons in the application collection of a
+  // report with motion (not a gamepad's or a keyboard's buttons beside the mouse).
+  auto hasMotion = [](const Layout& l) { return l.haveX || l.haveY; };
+  auto isMouseReport = [&](const Layout& l) {
+    if (hasMotion(l)) return true;
+    if (l.buttonBits.empty() && l.buttonArrays.empty()) return false;
+    return std::any_of(layouts_.begin(), layouts_.end(),
+                       [&](const Layout& m) { return hasMotion(m) && m.application == l.application; });
+  };
+  std::vector<bool> keep;
+  for (const Layout& layout : layouts_) keep.push_back(isMouseReport(layout));
+  std::vector<Layout> mouseLayouts;
+  for (size_t i = 0; i < layouts_.size(); ++i)
+    if (keep[i]) mouseLayouts.push_back(std::move(layouts_[i]));
+  layouts_ = std::move(mouseLayouts);
   if (layouts_.empty()) {
     error = "the HID report descriptor has no relative Generic Desktop X or Y input";
     if (!descriptor.skipNotes.empty())
@@ -137,6 +161,7 @@ bool HidMouseDecoder::decode(const uint8_t* bytes, size_t size, HidMouseDelta& o
   out.reportId = reportId;
   out.dxCounts = readAxis(bytes, size, layout->haveX, layout->x, out.saturated);
   out.dyCounts = readAxis(bytes, size, layout->haveY, layout->y, out.saturated);
+  out.hasButtons = !layout->buttonBits.empty() || !layout->buttonArrays.empty();
   int64_t value = 0;
   for (const auto& [element, button] : layout->buttonBits)
     if (extractHidBits(bytes, size, element.bitOffset, element.bitSize, false, value) && value != 0)

@@ -1,7 +1,11 @@
 // HidMouseDecoder: finds, in a parsed report descriptor, the relative Generic Desktop X/Y
 // inputs and the buttons of each report ID, and decodes raw input reports to dx, dy, buttons,
 // flagging a delta at its field's limit (the descriptor's logical minimum or maximum, within
-// what the field's bits hold) as saturated.
+// what the field's bits hold) as saturated. A mouse report is one with X or Y, or one with
+// buttons in the application collection of such a report: some mice send their buttons in a
+// report of their own (the Xiaomi Mi Wireless Mouse's receiver, 2717:003B: buttons, wheel and
+// AC Pan in report 1, X and Y in report 2), which Linux's hid-input decodes into the same input
+// device as the motion.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +22,10 @@ struct HidMouseDelta {
   int32_t dxCounts = 0;
   int32_t dyCounts = 0;
   uint32_t buttons = 0;  // bit i = Button usage i + 1
+  // The report carries the buttons. When false (the X/Y report of a mouse that sends its buttons
+  // in another report) `buttons` is 0 and means nothing: the buttons stay as the last report
+  // that carried them left them, as the kernel keeps them.
+  bool hasButtons = false;
   // dx or dy at its field's limit: the sensor moved at least that far, maybe more (the excess
   // is lost). A value beyond the logical range is clamped to it first, as Linux's input layer
   // and Windows do, so hidraw and evdev give the same counts.
@@ -43,7 +51,7 @@ class HidMouseDecoder {
   // the widest range (no false flags; a narrower report's limit then goes unflagged). False
   // before build or without such a report.
   bool axisRange(int64_t& xLowest, int64_t& xHighest, int64_t& yLowest, int64_t& yHighest) const;
-  // Report IDs that carry X/Y (0 when the descriptor has no IDs).
+  // Report IDs of the mouse reports, X/Y or buttons (0 when the descriptor has no IDs).
   std::vector<uint8_t> mouseReportIds() const;
 
  private:
@@ -67,7 +75,8 @@ class HidMouseDecoder {
   };
   struct Layout {
     uint8_t reportId = 0;
-    size_t minBytes = 0;  // without the ID byte
+    int application = -1;  // the application collection of its first field (index), -1 none
+    size_t minBytes = 0;   // without the ID byte
     bool haveX = false, haveY = false;
     Axis x, y;
     std::vector<std::pair<Element, uint32_t>> buttonBits;  // element, button number (1-based)

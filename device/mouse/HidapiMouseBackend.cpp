@@ -29,6 +29,7 @@ bool HidapiMouseBackend::openInfo(const MouseInfo& info, std::string& error, Ope
   }
   handle_ = std::move(handle);
   decoder_ = std::move(decoder);
+  buttons_ = 0;  // unknown until a report carries them
   current_ = info;
   publishInfo(current_);
   return true;
@@ -54,7 +55,9 @@ void HidapiMouseBackend::take(const uint8_t* bytes, int size, double arrivalS) {
   report.deviceTimeS = arrivalS;
   report.dxCounts = delta.dxCounts;
   report.dyCounts = delta.dyCounts;
-  report.buttons = delta.buttons;
+  // A report without buttons (X/Y of a mouse that sends its buttons apart) leaves them as they were.
+  if (delta.hasButtons) buttons_ = delta.buttons;
+  report.buttons = buttons_;
   // The decoder knows each axis' logical limits (and clamps to them, as the kernel does).
   if (delta.saturated) report.flags |= kSaturated;
   if (afterLoss_) report.flags |= kAfterLoss;

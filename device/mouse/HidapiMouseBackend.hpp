@@ -42,6 +42,7 @@ class HidapiMouseBackend : public RealMouseBackend {
   std::shared_ptr<HidApi> api_;
   std::unique_ptr<HidHandle> handle_;
   HidMouseDecoder decoder_;
+  uint32_t buttons_ = 0;  // as the last report that carried them left them
   bool afterLoss_ = false;
   MouseInfo current_;  // the reader thread's (and open's) own
 };

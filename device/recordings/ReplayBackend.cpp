@@ -104,6 +104,7 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
   HidMouseDecoder decoder;
   if (!decoder.build(descriptor, error)) return false;
   size_t saturated = 0;
+  uint32_t buttons = 0;  // as the last report that carried them left them
   for (const HidRecordedEvent& event : recording.events) {
     HidMouseDelta delta;
     if (!decoder.decode(event.bytes.data(), event.bytes.size(), delta)) {
@@ -115,7 +116,8 @@ bool loadReplayReports(const std::string& path, DeviceSpec& spec, std::vector<Ti
     timed.report.deviceTimeS = event.timeS;
     timed.report.dxCounts = delta.dxCounts;
     timed.report.dyCounts = delta.dyCounts;
-    timed.report.buttons = delta.buttons;
+    if (delta.hasButtons) buttons = delta.buttons;
+    timed.report.buttons = buttons;
     if (delta.saturated) {
       timed.report.flags |= kSaturated;
       ++saturated;

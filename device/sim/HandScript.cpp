@@ -96,7 +96,15 @@ HandScript HandScript::constantForce(double forceN) {
   return script;
 }
 
+HandScript HandScript::exploring(const ExploreSettings& settings) {
+  HandScript script;
+  script.kind = Kind::kExplore;
+  script.explore = settings;
+  return script;
+}
+
 bool HandScript::isValid() const {
+  if (kind == Kind::kExplore) return explore.isValid();
   auto within = [](const char* name, double value) { return isWithinBounds(*findSettingBounds(name), value); };
   if (kind == Kind::kConstantForce) return within("handForceN", constantForceN);
   if (kind == Kind::kPath2D) {

@@ -1,7 +1,8 @@
 // HandScript: what the simulated hand wants to do — follow a path of (time, position) points
 // along x, a series of speed segments along x, a path of (time, x, y) points on the surface (and
 // the 2D scripts made of one: a line at an angle, a circle, a raster), or push with a constant
-// force along x (for tests).
+// force along x (for tests), or explore a strip as a participant would (ExploringHand: a push,
+// not a path, so friction slows it).
 #pragma once
 
 #include <array>
@@ -9,10 +10,12 @@
 #include <utility>
 #include <vector>
 
+#include "sim/ExploringHand.hpp"
+
 namespace kf {
 
 struct HandScript {
-  enum class Kind { kNone = -1, kPath = 0, kSpeeds = 1, kConstantForce = 2, kPath2D = 3 };
+  enum class Kind { kNone = -1, kPath = 0, kSpeeds = 1, kConstantForce = 2, kPath2D = 3, kExplore = 7 };
 
   Kind kind = Kind::kNone;
   // kPath: (timeS, xMm), time ascending; linear in between, held before the first and after
@@ -22,6 +25,7 @@ struct HandScript {
   double constantForceN = 0.0;  // kConstantForce
   // kPath2D: (timeS, xMm, yMm), time ascending; linear in between, held before and after.
   std::vector<std::array<double, 3>> points2D;
+  ExploreSettings explore;  // kExplore
 
   static HandScript path(std::vector<std::pair<double, double>> timeAndPositionMm);
   static HandScript speeds(std::vector<std::pair<double, double>> speedAndDurationS);
@@ -39,6 +43,9 @@ struct HandScript {
   // heightMm / (rows - 1) further along y (a boustrophedon, as a hand scans a page).
   static HandScript raster(double x0Mm, double y0Mm, double widthMm, double heightMm, double rows, double speedMmPerS);
   static constexpr int kCircleSegments = 64;
+  // A participant exploring the strip [fromMm, toMm] (ExploringHand); a script isValid()
+  // refuses when the settings are not ExploreSettings::isValid().
+  static HandScript exploring(const ExploreSettings& settings);
 
   // True when the points are usable: within their bounds (SettingBounds: handTimeS,
   // handPositionMm, handSpeedMmPerS, handDurationS, handForceN), times ascending, and a 2D

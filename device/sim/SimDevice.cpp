@@ -9,6 +9,8 @@ SimDevice::SimDevice(const DeviceSpec& spec, const SimParams& params, const Hand
     : spec_(spec),
       params_(params),
       hand_(hand),
+      exploring_(hand.kind == HandScript::Kind::kExplore),
+      explorer_(hand.explore),
       puck_(params.puckMassKg),
       magnet_(spec.magnetLagS, params.stepS, spec.minForceN),
       sensor_(spec, params, 0.0),
@@ -36,7 +38,8 @@ SimDevice::Push SimDevice::handPush(double timeS) const {
 void SimDevice::step() {
   const double startS = timeS();
   const double startMm = positionMm(), startYMm = positionYMm();
-  const Push push = handPush(startS);
+  const Push push =
+      exploring_ ? Push{explorer_.push(startS, params_.stepS, startMm, speedMmPerS()), 0.0} : handPush(startS);
   handForceN_ = push.xN;
   handForceYN_ = push.yN;
   puck_.step(params_.stepS, push.xN, push.yN, magnet_.forceN());

@@ -1,4 +1,5 @@
-// SimDevice: a whole simulated friction device — scripted hand (along x or on the surface), puck
+// SimDevice: a whole simulated friction device — scripted hand (along x or on the surface) or an
+// exploring participant's push, puck
 // with Coulomb friction,
 // lagging magnet and mouse sensor — stepped with a fixed step by advanceTo(). It is both the
 // mouse backend and the force backend. Deterministic: the same calls give the same reports
@@ -12,6 +13,7 @@
 #include "core/ForceBackend.hpp"
 #include "core/MouseBackend.hpp"
 #include "core/spec/DeviceSpec.hpp"
+#include "sim/ExploringHand.hpp"
 #include "sim/HandScript.hpp"
 #include "sim/MagnetModel.hpp"
 #include "sim/MouseSensorModel.hpp"
@@ -61,6 +63,8 @@ class SimDevice : public MouseBackend, public ForceBackend {
   DeviceSpec spec_;
   SimParams params_;
   HandTrajectory hand_;
+  bool exploring_;  // the hand is a participant (ExploringHand), not a script
+  ExploringHand explorer_;
   PuckModel puck_;
   MagnetModel magnet_;
   MouseSensorModel sensor_;

@@ -8,6 +8,8 @@ until a function asks).
     sclang     headless sclang: environment, class paths, scripts with or without a booted server
     nrt        scsynth -N renders of Scores
     jack       a JACK server on the dummy driver
-    readers    WAV and kf-session files
     reference  numeric references: equations (1) and (2), zero crossings
+
+The files the extension writes are read by python/kfstudy (readers, the study report, the
+psychometric fit), which is installed into the extension folder.
 """

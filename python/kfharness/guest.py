@@ -317,7 +317,8 @@ def run(spec, work_dir):
     finally:
         _stop(proc)
         result.console = console_path.read_text(errors="replace") if console_path.exists() else ""
-        qemu_text = (work_dir / "qemu.log").read_text(errors="replace")
+        qemu_text = "\n".join(line for line in (work_dir / "qemu.log").read_text(errors="replace").splitlines()
+                              if "info: QEMU waiting for connection" not in line)
         if result.failure and qemu_text.strip():
             result.failure += f"\nQEMU said: {qemu_text.strip()[-2000:]}"
     return result
@@ -354,7 +355,11 @@ def _converse(spec, proc, hook_path, qmp_path, result, start):
                 raise GuestError(_stage_failure(result, f"QEMU exited ({proc.returncode})"))
             return
         if not chunk:
-            raise GuestError(_stage_failure(result, "the guest closed its hook port (it powered off or crashed)"))
+            try:
+                what = f"QEMU exited ({proc.wait(5)})"
+            except subprocess.TimeoutExpired:
+                what = "the guest closed its hook port"
+            raise GuestError(_stage_failure(result, what))
         buffer.extend(chunk)
 
     def line():

@@ -4,7 +4,8 @@ import os
 import subprocess
 import time
 
-from . import paths, readers, sclang
+from . import paths, sclang
+from kfstudy import readers
 
 
 def server():

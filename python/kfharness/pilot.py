@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import nrt, profile, readers, reference
+from . import nrt, profile, reference
+from kfstudy import readers
 
 _PILOT = profile.pilot()
 _DEVICE = profile.device()
@@ -94,7 +95,7 @@ def score_code(scene, record_path=None):
     hand = f"FrictionHand.{'speeds' if scene.speeds_hand else 'path'}([{pts}])"
     rec = f'"{record_path}"' if record_path else "nil"
     return f"""
-        var dev = FrictionDevice.sim(nil, 0, {hand});
+        var dev = FrictionDevice.describeSim(0, {hand});
         score = FrictionPilot.score(dev, \\{scene.mapping}, {scene.friction}, {scene.duration_s},
             {scene.origin_mm}, 1, 2, {rec});
     """

@@ -58,8 +58,8 @@ def config(include_paths=None):
 # of leaving sclang waiting.
 SCRIPT_WRAPPER = """var fn = File.readAllString(%(code)s).compile;
 if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
-  %(program)s{ fn.value; "KF-SCRIPT-OK".postln; 0.exit }.try { |error|
-    error.reportError; "KF-SCRIPT-ERROR".postln; 1.exit } };
+  %(program)s%(start)s{ fn.value; "KF-SCRIPT-OK".postln; 0.exit }.try { |error|
+    error.reportError; "KF-SCRIPT-ERROR".postln; 1.exit }%(end)s };
 """
 
 
@@ -70,15 +70,25 @@ def _script_files(code, name):
     return key, code_path
 
 
-def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="script"):
+def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="script", env=None, routine=False):
     """Runs `code` (synchronous sclang, no server) headless; returns its output. The code succeeds
-    when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok)."""
+    when it runs to the end; any error makes sclang exit 1 (an AssertionError when expect_ok).
+    `env`: extra environment variables (a HOME of its own, say; None removes one). `routine`: the
+    code runs in a Routine on AppClock (it may wait)."""
     key, code_path = _script_files(code, name)
     script = paths.work_dir() / f"{key}.scd"
-    script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path), program=server_program_code()))
+    start, end = ("Routine { ", " }.play(AppClock)") if routine else ("", "")
+    script.write_text(SCRIPT_WRAPPER % dict(code=sc_string(code_path), program=server_program_code(), start=start,
+                                            end=end))
+    run_env = environment()
+    for name, value in (env or {}).items():
+        if value is None:
+            run_env.pop(name, None)
+        else:
+            run_env[name] = value
     proc = subprocess.run(["sclang", "-l", str(config(include_paths)), str(script)],
                           stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          env=environment(), timeout=timeout, text=True, errors="replace")
+                          env=run_env, timeout=timeout, text=True, errors="replace")
     out = proc.stdout
     if expect_ok:
         assert "KF-SCRIPT-OK" in out and proc.returncode == 0, f"sclang failed:\n{out[-4000:]}"

@@ -6,7 +6,11 @@ in the same window is ours.
 
     with Witness() as w:
         ...run...
-    w.result  # {"max_us": ..., "avg_us": ...} or None without cyclictest
+    w.result  # {"max_us": ..., "avg_us": ..., "stalls": ...} or None without cyclictest
+
+stalls: how many times the machine kept the witness from running for longer than `stall_us` (the
+most over its threads, one a core: a stall of the machine holds them all). After a late wake-up
+cyclictest sleeps to its next deadline still ahead, so one stall counts once however long it was.
 """
 import re
 import shutil
@@ -15,7 +19,8 @@ import subprocess
 
 
 class Witness:
-    def __init__(self):
+    def __init__(self, stall_us=100000):
+        self.stall_us = stall_us
         self.proc = None
         self.result = None
         self.output = ""
@@ -23,7 +28,7 @@ class Witness:
     def start(self):
         if shutil.which("cyclictest"):
             self.proc = subprocess.Popen(["cyclictest", "-m", "-p", "90", "-t", "-a", "-i", "1000", "-q",
-                                          "-h", "100000"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                                          "-h", str(self.stall_us)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         return self
 
     def stop(self):
@@ -38,7 +43,9 @@ class Witness:
             self.output = self.proc.communicate()[0]
         self.proc = None
         maxima, means = self._values("Max"), self._values("Avg")
-        self.result = {"max_us": max(maxima), "avg_us": sum(means) / len(means)} if maxima and means else None
+        overflows = self._values("Histogram Overflows")
+        self.result = ({"max_us": max(maxima), "avg_us": sum(means) / len(means), "stalls": max(overflows or [0])}
+                       if maxima and means else None)
         return self.result
 
     def _values(self, name):

@@ -57,7 +57,7 @@ def log(msg):
 
 
 def score_code(speed, seconds):
-    devices = "\n".join(f"        dev{i} = FrictionDevice.sim(nil, {i}, hand, {HAND});" for i in range(len(PATTERNS)))
+    devices = "\n".join(f"        dev{i} = FrictionDevice.describeSim({i}, hand, {HAND});" for i in range(len(PATTERNS)))
     names = ", ".join(f"dev{i}" for i in range(len(PATTERNS)))
     outs = ",\n".join(f"""                {{ var m = FrictionMouseIn.ar({i}), x = m[0];
                    var pilot = SpatialBufRd.ar(1, 0, x, {PILOT_SPM});
@@ -275,7 +275,7 @@ def write_summary(out_dir, rows, figures, folding, grid, rate, elapsed):
           "moved at more than half the target speed. Anti-aliased, each harmonic k is weighted on its own "
           "frequency k * speed / period, to 0 at 500 Hz: no harmonic folds at any speed (at 36 mm/s the "
           "540 Hz harmonic, folded to 460 Hz, was 0.0195 N when only the fundamental was faded; "
-          "`tests/dsp/test_friction_patterns.cpp` sweeps 20..300 mm/s: every folded line below 1e-5 N).\n",
+          "`tests/dsp/patterns/test_friction_patterns.cpp` sweeps 20..300 mm/s: every folded line below 1e-5 N).\n",
           "| grating | mean speed (mm/s) | temporal frequency (Hz) | largest alias in the frames (N) |",
           "|---|---|---|---|",
           f"| anti-aliased (`antialias: 1`) | {on['mean_speed']:.1f} | {on['mean_speed'] / 0.2:.0f} | {on['alias']:.2g} |",

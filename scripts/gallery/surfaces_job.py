@@ -29,9 +29,9 @@ def score(map_path):
     width = DATA.shape[1]
     spm = 1 / CELL_MM
     return f"""
-        var map = FrictionDevice.sim(nil, 0, FrictionHand.raster(48, 24, 4, 40, 0, 4), {FIRM_HAND});
-        var free = FrictionDevice.sim(nil, 1, FrictionHand.force({PUSH_N}));
-        var governed = FrictionDevice.sim(nil, 2, FrictionHand.force({PUSH_N}));
+        var map = FrictionDevice.describeSim(0, FrictionHand.raster(48, 24, 4, 40, 0, 4), {FIRM_HAND});
+        var free = FrictionDevice.describeSim(1, FrictionHand.force({PUSH_N}));
+        var governed = FrictionDevice.describeSim(2, FrictionHand.force({PUSH_N}));
         var def = SynthDef(\\surfaces, {{
             var m0 = FrictionMouseIn.ar(0, 0, 1), m1 = FrictionMouseIn.ar(1, 0, 1), m2 = FrictionMouseIn.ar(2, 0, 1);
             var value = SpatialBufRd2D.ar(1, m0[0], m0[1], {width}, {spm}, {spm}, 0, 0, 2);

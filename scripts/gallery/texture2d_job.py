@@ -22,7 +22,7 @@ FIRM_HAND = "(handStiffnessNPerM: 2000, handDampingNSPerM: 20)"
 
 def score():
     return f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.raster({SIDE_MM}, {SIDE_MM}, {ROWS}, {SPEED}), {FIRM_HAND});
+        var dev = FrictionDevice.describeSim(0, FrictionHand.raster({SIDE_MM}, {SIDE_MM}, {ROWS}, {SPEED}), {FIRM_HAND});
         var def = SynthDef(\\texture2d, {{
             var m = FrictionMouseIn.ar(0);
             var f = FrictionPattern.texture2D(m[0], m[1], {BAND[0]}, {BAND[1]}, {SEED});

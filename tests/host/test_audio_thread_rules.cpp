@@ -119,8 +119,8 @@ void Scenario::expectAnswer(const OscMessage& message) {
 }
 
 void Scenario::run() {
-  for (const char* name : {"FrictionMouseIn", "SpatialBufRd", "SpatialBufRd2D", "SpeedGovernor", "LoudnessToFriction",
-                           "FrictionOut", "FrictionDrive", "FrictionPattern"})
+  for (const char* name : {"FrictionMouseIn", "FrictionButtons", "SpatialBufRd", "SpatialBufRd2D", "SpeedGovernor",
+                           "LoudnessToFriction", "FrictionOut", "FrictionDrive", "FrictionPattern"})
     check(server_.unitDef(name).ctor != nullptr, std::string("the plugin defines ") + name);
   const std::string recording = options_.scratch + "/recording.txt";
   server_.start();

@@ -142,7 +142,7 @@ TEST_CASE("hand script counts must match the values sent", "[commands]") {
   CHECK(contains(short_.error, "hand script value 3 of 4: a string, not a number"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(1).i(3).f(1).f(2).f(3).bytes()).error, "pairs"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(1).i(9000).bytes()).error, "out of range 0..8192"));
-  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(7).i(0).bytes()).error, "kind 7"));
+  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(8).i(0).bytes()).error, "kind 8"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).f(NAN).i(0).bytes()).error, "kind nan"));
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(2).i(2).f(1).f(1).bytes()).error, "takes 1 value"));
   // The 2D scripts: path2D in triples, line and circle 5 values, raster 6.
@@ -153,6 +153,12 @@ TEST_CASE("hand script counts must match the values sent", "[commands]") {
   CHECK(parse(CommandShape::kOpenSim, Message().i(0).i(5).i(5).f(0).f(0).f(10).f(50).f(1).bytes()).ok);
   CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(6).i(5).f(0).f(0).f(10).f(5).f(2).bytes()).error,
                  "takes 6 values"));
+  // The exploring participant: 9 values.
+  CHECK(contains(parse(CommandShape::kOpenSim, Message().i(0).i(7).i(2).f(0).f(10).bytes()).error, "takes 9 values"));
+  Message explore;
+  explore.i(0).i(7).i(9);
+  for (float v : {0.f, 10.f, 5.f, 50.f, 3.f, 1.f, 1.5f, 10.f, 1.f}) explore.f(v);
+  CHECK(parse(CommandShape::kOpenSim, explore.bytes()).ok);
 }
 
 TEST_CASE("settings: at most 32, each a name with a number", "[commands]") {

@@ -175,6 +175,27 @@ TEST_CASE("a writer freed in the middle of a block frames the block if the other
   CHECK(slot->write(clockOf(11), f.data(), 64, sink));
 }
 
+TEST_CASE("the last writer gone mid-frame: its part of a frame is dropped, a writer later starts afresh") {
+  // 64 samples at 48 kHz: block 10 ends 14.67 ms in, two thirds of the way into frame 14.
+  auto slot = makeSlot(1);
+  Recorder sink;
+  std::vector<float> f(64, 1.0f), g(64, 0.5f);
+  for (int64_t blk = 0; blk <= 10; ++blk) CHECK(slot->write(clockOf(blk), f.data(), 64, sink));
+  CHECK(sink.frames.back().timeS == Approx(0.013));  // frame 14 is in progress
+  slot->unregisterWriter();
+  slot->writerGone(clockOf(11), sink);
+  const size_t before = sink.frames.size();
+  // 150 ms later a new writer starts: every frame it sends is its own, none from before.
+  slot->registerWriter();
+  for (int64_t blk = 123; blk < 130; ++blk) CHECK(slot->write(clockOf(blk), g.data(), 64, sink));
+  REQUIRE(sink.frames.size() > before);
+  for (size_t i = before; i < sink.frames.size(); ++i) {
+    INFO("frame " << i << " at " << sink.frames[i].timeS << " s");
+    CHECK(sink.frames[i].timeS >= clockOf(123).startS - 0.001);
+    CHECK(sink.frames[i].forceN == Approx(0.5));
+  }
+}
+
 TEST_CASE("control-rate writers and 44.1 to 192 kHz: still one frame per millisecond") {
   for (double rate : {44100.0, 96000.0, 192000.0}) {
     auto slot = makeSlot(2);

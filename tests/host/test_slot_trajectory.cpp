@@ -223,3 +223,31 @@ TEST_CASE("the slot turns the mouse's counts into the surface's mm with the spec
   CHECK(slot.entries()[1].dxMm == Approx(-10 * 0.02));  // the step of the second report
   CHECK(slot.entries()[1].dyMm == Approx(-10 * 0.03));
 }
+
+TEST_CASE("the buttons of a block: down in any of its reports, else the last report's") {
+  kf::DeviceSpec spec;
+  spec.countMm = kCountMm;
+  SlotTrajectory slot;
+  slot.reset(spec);
+  auto report = [](double timeS, uint32_t buttons) {
+    MouseReport r;
+    r.deviceTimeS = timeS;
+    r.buttons = buttons;
+    return r;
+  };
+  BlockClock clock;
+  auto take = [&](int64_t block, std::vector<MouseReport> reports) {
+    clock.block = block;
+    clock.startS = block * kBlock * kSampleDurS;
+    slot.takeBlock(clock, reports.data(), static_cast<int>(reports.size()), true, 0.0);
+    return slot.buttons();
+  };
+  CHECK(take(0, {}) == 0u);
+  CHECK(take(1, {report(0.0015, 1)}) == 1u);                     // left down
+  CHECK(take(2, {}) == 1u);                                      // held: no report, the last one's
+  CHECK(take(3, {report(0.004, 0)}) == 0u);                      // released
+  CHECK(take(4, {report(0.0055, 2), report(0.0056, 0)}) == 2u);  // a right click within one block
+  CHECK(take(5, {}) == 0u);                                      // ... released by the block's last report
+  slot.reset(spec);
+  CHECK(slot.buttons() == 0u);
+}

@@ -79,6 +79,8 @@ def guest_run():
         for hook in hooks.values():
             hook.close()
     (ARTEFACTS / "console.log").write_text(run.console)
+    (ARTEFACTS / "run.txt").write_text(f"kernel {run.kernel}\nboot_s {run.boot_s:.1f}\nwall_s {run.wall_s:.1f}\n"
+                                       f"failure {run.failure}\nlogs {run.logs}\nexits {run.exits}\n")
     for name, data in run.files.items():
         (ARTEFACTS / name).write_bytes(data)
     figures = run.files.get("figures.txt", b"").decode()
@@ -122,3 +124,15 @@ def test_case(guest_run, program, case):
         pytest.fail(f"'{case}' did not run in the guest\nconsole:\n{guest_run.console_tail()}")
     failures = cases[case]
     assert not failures, "\n\n".join(failures)
+
+
+# The rig's own failures, without the test program: each must fail the run with its reason.
+def test_a_guest_that_cannot_boot_fails_with_the_reason(tmp_path):
+    # 24 MiB do not hold the kernel and the initramfs: the guest never reaches its /init.
+    run = guest.run(guest.GuestSpec(programs=[("true", ["/usr/bin/true"])], memory_mb=24, timeout_s=60), tmp_path)
+    assert run.failure and "the guest did not boot" in run.failure, run.failure
+
+
+def test_a_module_the_kernel_does_not_have_fails_before_booting(tmp_path):
+    run = guest.run(guest.GuestSpec(programs=[("true", ["/usr/bin/true"])], modules=["kf-no-such-module"]), tmp_path)
+    assert run.failure and "module kf-no-such-module is not in /lib/modules/" in run.failure, run.failure

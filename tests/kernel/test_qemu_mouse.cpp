@@ -151,9 +151,10 @@ TEST_CASE("a stalled reader: the kernel drops reports, the loss is reported, rea
   both.drain();
   both.restart(0);
 
-  // Both readers held at their next read while 150 reports come (evdev keeps 2 events of each and
-  // one SYN_REPORT: 450 events; its buffer holds at most a few hundred for a mouse, hidraw's ring
-  // 63 reports). The left press comes early and is followed by far more than either holds.
+  // Both readers held at their next read while 150 reports come: 450 events for evdev (REL_X,
+  // REL_Y, SYN_REPORT each), far more than its buffer for a mouse holds (a power of two of a few
+  // hundred at most), and more than hidraw's ring of 63 reports. The left press comes early, so
+  // the events after it overflow evdev's buffer and drop it.
   stall->on = true;
   REQUIRE(waitUntil([&] { return stall->held.load() == 2; }, 5.0));
   int64_t dx = 0, dy = 0;

@@ -6,7 +6,8 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from kfharness import paths, readers
+from kfharness import paths
+from kfstudy import readers
 
 OUT = Path(os.environ["KF_MAIN_JOB_OUT"])
 

@@ -6,7 +6,8 @@ the commanded force within 1e-6 of full scale after the loop's delay, and the dr
 one block after the writer is freed, after Cmd-. and after /quit."""
 import numpy as np
 
-from kfharness import drive, paths, readers, sclang
+from kfharness import drive, paths, sclang
+from kfstudy import readers
 
 BLOCK = 64
 SR = 48000

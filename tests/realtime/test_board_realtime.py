@@ -47,7 +47,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         dev.removeBoard;
         s.sync;
         phase.(\\removed);
-        FrictionDevice.sim(nil, 5).arm;  // described only: nothing sent
+        FrictionDevice.describeSim(5).arm;  // described only: nothing sent
         s.sendMsg('/cmd', 'kfBoardArm', 6, 1);  // no device in slot 6
         s.sync;
         dev.close;

@@ -10,7 +10,8 @@ import struct
 import numpy as np
 import pytest
 
-from kfharness import paths, procs, readers, sclang
+from kfharness import paths, procs, sclang
+from kfstudy import readers
 
 HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
 COUNT_MM = 0.021

@@ -12,7 +12,8 @@ import signal
 import pytest
 
 from conftest import performer_jack
-from kfharness import paths, procs, readers, sclang
+from kfharness import paths, procs, sclang
+from kfstudy import readers
 
 FORCE_N = 1.4
 

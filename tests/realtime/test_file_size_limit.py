@@ -5,16 +5,26 @@ with one message and a kfStatus entry, the file is kept whole (whole lines, with
 and the server and the force frames go on at the commanded force."""
 import pytest
 
-from kfharness import paths, procs, readers, sclang, status
+from kfharness import paths, procs, sclang, status
+from kfharness.witness import Witness
+from kfstudy import readers
 
 LIMIT_BYTES = 64 * 1024
 FORCE_N = 1.0
+# A watchdog trip (10 ms without a frame) that the recording's end did not cause: the machine
+# itself stalling (its vCPUs paused by the host: up to 24 ms beside a disk writer, measured by the
+# witness, cyclictest at SCHED_FIFO 90) holds the audio thread and the device thread alike, and
+# the device thread can run first when it ends. Frames come every block (1.33 ms at 48 kHz / 64)
+# and the device pumps every 1 ms, so a stall from 10 - 1.33 - 1 ms on can trip it: each stall
+# of the witness longer than that may have made one trip, and no more.
+TRIP_STALL_US = 7600
 
 
 def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     record = paths.work_dir() / "fsize-session.txt"
     record.unlink(missing_ok=True)
-    run = sclang.require_ok(sclang.run_with_server("var dev, syn, before;\n" + status.SC_POST + f"""
+    with Witness(stall_us=TRIP_STALL_US) as witness:
+        run = sclang.require_ok(sclang.run_with_server("var dev, syn, before;\n" + status.SC_POST + f"""
         dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 10]]));
         s.sync;
         syn = {{ FrictionOut.ar(0, DC.ar({FORCE_N})) * 0 }}.play;
@@ -44,7 +54,9 @@ def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     a = status.parse(run.output, "KF-STATUS-A")[0]
     b = status.parse(run.output, "KF-STATUS-B")[0]
     assert b["frames"] - a["frames"] >= 800, "the force frames stopped"
-    assert b["lastForceN"] == pytest.approx(FORCE_N) and b["watchdogTrips"] == 0
+    stalls = witness.result["stalls"] if witness.result else 0
+    assert b["lastForceN"] == pytest.approx(FORCE_N)
+    assert b["watchdogTrips"] <= stalls, f"{b['watchdogTrips']} watchdog trips, the machine stalled {stalls} times"
     # The file: within the limit, whole lines only, readable to its end.
     size = record.stat().st_size
     assert 0 < size <= LIMIT_BYTES

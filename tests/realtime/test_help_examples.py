@@ -1,14 +1,25 @@
-"""Every code:: example of every help file runs on a booted realtime server (JACK dummy), fails
-when it fails, and posts what its text says it posts.
+"""Every code:: example of every help file runs on a booted realtime server (JACK dummy), at the
+pace a person evaluates it, fails when it fails, and posts what its text says it posts.
 
 Each block is split as a user evaluates it in the IDE: a region between a line holding only "("
 and a line starting with ")" is one piece, every other non-blank line is one piece. (If a piece
-alone does not compile, the whole block runs as one piece.) Pieces run in order on AppClock, a
-short pause after each, and each piece's value is posted as "-> value", as the IDE does; a block
-gets ~1.5 s. Blocks of a file run in order, so later ones see the ~variables and synths of
-earlier ones; after the last block of a file, s.freeAll and every device slot is closed
-(FREE_EACH_BLOCK = True frees nodes after every block instead). The files are shared out over
-SHARDS servers running side by side (shards_of), files naming one temp file in the same one.
+alone does not compile, the whole block runs as one piece.) Pieces run in order on AppClock and
+each piece's value is posted as "-> value", as the IDE does. After each piece the runner waits as a
+person would before the next: a short pause; for a boot (or reboot) to finish, ServerTree
+included; and for the routines the piece started (fork, Routine.play) to end, at most
+FORK_WAIT_MAX_S (a routine still running then is one a person leaves running). A block gets
+BLOCK_TIME_S. Blocks of a file run in order, so later ones see the ~variables and synths of earlier
+ones; after the last block of a file, s.freeAll and every device slot is closed (FREE_EACH_BLOCK =
+True frees nodes after every block instead).
+
+The guides (every file outside HelpSource/Classes: Guides/ and Overviews/) are followed as one
+user follows them: all in one sclang on one server, the overview first, then the guides in the
+order it links them (guide_order). In a guide, a line about a closed device ("no device is open
+at index 3": a synth reading a slot its example closed, or started before its device) fails the
+block, and its last block is its clean-up: a node still on the server CLEANUP_WATCH_S after it,
+but the default group, fails the guide. The class help files are shared out over the other servers (shards_of), files
+naming one temp file in the same one. After every block of every file the server must still have
+its default group (node 1).
 
 A block whose first line is a comment beginning "// needs " ("// needs a mouse") needs hardware
 this machine may not have: it is skipped (it still has to compile: tests/scenes/test_help.py).
@@ -17,24 +28,27 @@ An example fails (FAILURES) on a line of the server or sclang saying something w
 "FAILURE IN SERVER", "Node <n> not found", a line starting "ERROR" (sclang errors, and the
 refusals FrictionAnswers posts), "*** ERROR", an sclang exception (a piece that threw,
 DoesNotUnderstand, a call stack), a piece that does not compile, a command the server refused
-("kfZero: no device is open at index 7"), scsynth exiting or crashing; the whole run fails on a
-non-zero exit or a time-out, naming the piece that was running. Each failure names the file, the
-block (SCDoc's code block number, from 0, and its first line) and the offending line.
+("kfZero: no device is open at index 7"), scsynth exiting or crashing, a server without its
+default group; the whole run fails on a non-zero exit or a time-out, naming the piece that was
+running. Each failure names the file, the block (SCDoc's code block number, from 0, and its first
+line) and the offending line.
 
-An example that shows an error on purpose says so, and only that error is then allowed; what it
-posts is checked against what its text says, by comments the runner reads (ANNOTATIONS):
+What an example posts, writes or fails with is checked against what its comments say, in words a
+user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
 
-  // expect error: <text>  this block must post a failure line containing <text>; any other
-                           failure line still fails it
-  // -> <value>            a piece's value: the line "-> <value>" is posted, as in the IDE
-  // posts: <text>         a line containing <text> is posted
-  // writes: <file> (<n> channels, <d> s)
-                           the file (in Platform.defaultTempDir unless absolute) is written
-                           during the run; a WAV file has n channels and lasts d s (both optional)
+  // -> <value>                a piece's value: the line "-> <value>" is posted, as in the IDE
+  // posts "<text>"            a line containing <text> is posted (also "this posts "<text>"")
+  // fails with "<text>"       this block must post a failure line containing <text>; any other
+                               failure line still fails it
+  // writes <file> (<n> channels, <d> s)
+                               the file (in Platform.defaultTempDir unless absolute) is written
+                               during the run; a WAV file has n channels and lasts d s (both
+                               optional)
 
 Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
 A block's output is what is posted from its start to the end of its file: an NRT render or a
-server reply may come after the block's 1.5 s on a loaded machine.
+server reply may come after the block's time on a loaded machine. The test markers of earlier
+versions ("// posts:", "// expect error:", "// writes:") are refused, so that none is left unread.
 test_broken_examples_are_reported shows that each rule fails a broken example.
 """
 import os
@@ -45,27 +59,35 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack
 from pathlib import Path
 
-from kfharness import paths, readers, sclang
+from kfharness import paths, sclang
+from kfstudy import readers
 from conftest import performer_jack
 from kfharness.jack import JackServer
 
 HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or paths.REPO_DIR / "HelpSource")
 PIECE_PAUSE_S = 0.3
-BLOCK_TIME_S = 1.5
+BLOCK_TIME_S = 1.2
+# A person waits for a fork's waits; one still running after this is left running.
+FORK_WAIT_MAX_S = 10.0
+# A boot takes ~1 s here; a server not back after this is a failure.
+BOOT_WAIT_MAX_S = 30.0
+# After a guide's clean-up: how long the runner listens for synths still running.
+CLEANUP_WATCH_S = 1.0
 # Nodes are freed after each file, not after each block: the guides are sessions (a pilot started
 # in one block is steered by the next ones), which s.freeAll after every block would break into
 # "/n_set Node not found". Devices are closed after each file too.
 FREE_EACH_BLOCK = False
-# The files run in this many servers side by side (each its own jackd, scsynth and sclang): a
-# run is mostly the examples' pauses, not work, so two halve its time on two cores.
+# The class help files run in this many servers beside the guides' (each its own jackd, scsynth
+# and sclang): a run is mostly the examples' pauses, not work, so they share two cores well.
 SHARDS = 3
 TEMP_NAME = re.compile(r'defaultTempDir\s*\+/\+\s*"([^"]+)"')
-CODE_BLOCK = re.compile(r"^code::\s*$", re.M)
+CODE_BLOCK = re.compile(r"^code::[ \t]*$(.*?)^::", re.M | re.S)
+LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 
 RUNNER = r"""
-var files = [%(files)s];
-var markers = ["// -> ", "// posts: ", "// writes: ", "// expect error: "];
-var codeBlocks, piecesOf, serverAlive, restart;
+var files = [%(files)s], guides = [%(guides)s];
+var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
+var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
 		(node.children ? []).collect(codeBlocks).flatten(1)
@@ -105,27 +127,81 @@ restart = {
 	s.bootSync;
 	"KF-SCSYNTH-PID %%".format(s.pid).postln;
 };
+// A boot is finished once ServerTree has run after it.
+ServerBoot.add({ treePending = true }, s);
+ServerTree.add({ treePending = false }, s);
+// The routines waiting on the clocks fork and Routine.play use (TempoClock.default, SystemClock).
+routinesQueued = {
+	var found = IdentitySet.new;
+	[TempoClock.default.queue, thisProcess.prSchedulerQueue].do { |queue|
+		if(queue.size > 1) { forBy(1, queue.size - 1, 3) { |i| if(queue[i + 1].isKindOf(Routine)) { found.add(queue[i + 1]) } } }
+	};
+	found
+};
+// After a piece, as a person waits before the next one: a pause (noting the routines the piece
+// started), the boot if one is under way, then those routines' ends (a routine waiting on a
+// Condition is off the clocks but not done: its state is kept, 6 when done).
+waitLikeAPerson = { |known, path, b|
+	var started = IdentitySet.new, until = Main.elapsedTime + %(piece_pause)f, note, waited = 0;
+	note = { routinesQueued.().do { |r| if(known.includes(r).not) { started.add(r) } } };
+	while { Main.elapsedTime < until } { note.(); 0.05.wait };
+	while { (s.serverRunning.not or: { treePending }) and: { waited < %(boot_wait)f } } {
+		0.1.wait; waited = waited + 0.1
+	};
+	// (Reported once: a boot that stopped before ServerTree is not waited for again.)
+	if(waited >= %(boot_wait)f) { "KF-HELP-BOOT-TIMEOUT %% %%".format(path, b).postln; treePending = false };
+	if(waited > 0 and: { s.serverRunning }) { s.sync };
+	waited = 0;
+	while { note.(); started.any { |r| r.state != 6 } and: { waited < %(fork_wait)f } } {
+		0.05.wait; waited = waited + 0.05
+	};
+	started.do { |r| if(r.state != 6) { known.add(r) } };
+};
+hasDefaultGroup = {
+	var seen = false, reply = OSCFunc({ seen = true }, '/n_info', s.addr, argTemplate: [1]);
+	s.sendMsg('/n_query', 1);
+	s.sync;
+	reply.free;
+	seen
+};
+// The nodes on the server but the root and the default groups (one per client), as [id, defName or \group].
+nodesBesidesDefault = {
+	var nodes = List.new, reply;
+	// The reply comes before /synced: once synced it is in (or lost: then no node is reported).
+	reply = OSCFunc({ |msg|
+		var i = 2, walk;
+		walk = {
+			var id = msg[i], children = msg[i + 1];
+			i = i + 2;
+			if(children < 0) { nodes.add([id, msg[i]]); i = i + 1 } {
+				nodes.add([id, \group]);
+				children.do { walk.() };
+			}
+		};
+		walk.();
+	}, '/g_queryTree.reply', s.addr).oneShot;
+	s.sendMsg('/g_queryTree', 0, 0);
+	s.sync;
+	reply.free;
+	nodes.reject { |n| n[0] == 0 or: { s.defaultGroups.any { |g| g.nodeID == n[0] } } }
+};
 
 "KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
-files.do { |path|
-	var doc = SCDoc.parseFileFull(path), blocks;
+files.do { |path, f|
+	var doc = SCDoc.parseFileFull(path), blocks, known = routinesQueued.(), fileStart = Main.elapsedTime;
 	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%".format(path).postln } {
 		blocks = codeBlocks.(doc);
 		"KF-HELP-FILE %% (%% blocks)".format(path, blocks.size).postln;
 		blocks.do { |code, b|
 			var pieces = piecesOf.(code), start = Main.elapsedTime;
 			var lines = code.split($\n), first = lines.detect { |l| l.stripWhiteSpace.notEmpty and: { l.stripWhiteSpace != "(" } };
-			// The block and what its comments say it does, for the test to check.
+			// The block and its comments, for the test to read what they say it does.
 			"KF-HELP-BLOCK %% %% %%".format(path, b, (first ? "").stripWhiteSpace.keep(70)).postln;
-			lines.do { |line|
-				markers.do { |marker|
-					line.find(marker) !? { |at| ("KF-HELP-EXPECT " ++ marker.drop(3) ++ line.drop(at + marker.size)).postln }
-				}
-			};
 			if(code.stripWhiteSpace.beginsWith("// needs ")) {
 				"KF-HELP-SKIPPED %% %% (needs hardware)".format(path, b).postln;
 				pieces = [];
-				start = start - %(block_time)f;  // no time to wait for
+			} {
+				lines.do { |line| line.find("//") !? { |at| ("KF-HELP-COMMENT " ++ line.drop(at + 2)).postln } };
 			};
 			pieces.do { |piece, p|
 				var fn = piece.compile, value, threw = false;
@@ -140,13 +216,20 @@ files.do { |path|
 					};
 					if(threw.not) { ("-> " ++ value.asString).postln };
 				};
-				%(piece_pause)f.wait;
+				waitLikeAPerson.(known, path, b);
 			};
 			if(pieces.notEmpty) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 			"KF-HELP-BLOCK-END %% %%".format(path, b).postln;
 			if(serverAlive.().not) { restart.() } {
+				if(hasDefaultGroup.().not) { "KF-HELP-NO-DEFAULT-GROUP %% %%".format(path, b).postln };
 				if(%(free_each_block)s) { s.freeAll; s.sync };
 			};
+		};
+		// A guide's last block is its clean-up: nothing of it may still run or post.
+		if(guides[f] and: { serverAlive.() }) {
+			"KF-HELP-CLEANED-UP %%".format(path).postln;
+			%(cleanup_watch)f.wait;
+			nodesBesidesDefault.().do { |n| "KF-HELP-LEFT-RUNNING %% %%".format(path, n).postln };
 		};
 		s.freeAll;
 		16.do { |i| s.sendMsg('/cmd', 'kfClose', i) };
@@ -154,7 +237,7 @@ files.do { |path|
 		Window.allWindows.do(_.close);
 		0.2.wait;
 		if(serverAlive.().not) { restart.() };
-		"KF-HELP-FILE-DONE %%".format(path).postln;
+		"KF-HELP-FILE-DONE %% in %% s".format(path, (Main.elapsedTime - fileStart).round(0.1)).postln;
 	};
 };
 "KF-HELP-ALL-DONE".postln;
@@ -170,16 +253,48 @@ FAILURES = [
     (re.compile(r"^KF-HELP-COMPILE-FAILED"), "a piece does not compile"),
     (re.compile(r"^KF-HELP-PARSE-FAILED"), "the help file does not parse"),
     (re.compile(r"^KF-HELP-SERVER-DIED"), "scsynth exited"),
-    (re.compile(r"^Server '\w+' exited"), "scsynth exited"),
+    (re.compile(r"^KF-HELP-BOOT-TIMEOUT"), "the server did not finish booting"),
+    (re.compile(r"^KF-HELP-NO-DEFAULT-GROUP"), "the server has no default group (node 1)"),
+    (re.compile(r"^KF-HELP-LEFT-RUNNING"), "a node left running after the guide's clean-up"),
+    # A reboot's quit ends scsynth with 0; a server that died unasked is KF-HELP-SERVER-DIED.
+    (re.compile(r"^Server '\w+' exited with exit code (?!0\.)"), "scsynth exited"),
     (re.compile(r"^(Segmentation fault|Aborted|terminate called)"), "a crash"),
     (re.compile(r"RT memory allocation failed"), "RT memory allocation failed"),
     # The plugin's commands post only their refusals as "<command>: <reason>"; kfListMice also
     # posts its count so, and kfOpenReplay a warning about the file it still plays.
     (re.compile(r"^kf\w+: (?!warning: |\w+: \d+ mice$)"), "a command refused by the server"),
 ]
+# In a guide: a synth reading or writing a slot with no device, one its example did not free.
+CLOSED_DEVICE = re.compile(r"no device is open")
 NOTES = [re.compile(p) for p in (r"^WARNING", r"^KF-HELP-NOTE", r"no device is open", r"^kf\w+: ")]
-EXPECT = re.compile(r"^KF-HELP-EXPECT (->|posts:|writes:|expect error:) (.*)$")
+COMMENT = re.compile(r"^KF-HELP-COMMENT (.*)$")
+# What a comment says the example does (the text after "//").
+ANNOTATIONS = [
+    ("->", re.compile(r"^\s*-> (.*?)\s*$")),
+    ("posts", re.compile(r'\bposts "(.*)"')),
+    ("fails with", re.compile(r'\bfails with "(.*)"')),
+    ("writes", re.compile(r"\bwrites (\S+\.\w+(?: \([^)]*\))?)")),
+]
+OLD_MARKER = re.compile(r"^\s*(posts|expect error|writes):")
 NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+
+
+def is_guide(path):
+    """A guide (or overview): a file a user follows from top to bottom, not a class's reference."""
+    return Path(path).parent.name != "Classes"
+
+
+def guide_order(files):
+    """The guides and overviews of `files` in the order a user meets them: each overview, then the
+    guides in the order it links them, then the guides it does not link, sorted."""
+    guides = sorted(f for f in files if is_guide(f))
+    overviews = [f for f in guides if f.parent.name == "Overviews"]
+    ordered = list(overviews)
+    for overview in overviews:
+        for name in LINK.findall(overview.read_text()):
+            linked = [f for f in guides if f.relative_to(f.parent.parent).with_suffix("").as_posix() == name]
+            ordered += [f for f in linked if f not in ordered]
+    return ordered + [f for f in guides if f not in ordered]
 
 
 class Example:
@@ -240,16 +355,20 @@ def check_written(text, temp_dir, since):
 
 
 def run_examples(files, jack, timeout=240, after=None, booted=None):
-    """Runs every example of `files` on one server booted against `jack`, once the Event `after`
-    (if any) is set; sets `booted` when its server is up. Returns (run, examples, problems, notes):
-    problems are the failures and unmet expectations, each naming its example."""
+    """Runs every example of `files`, in this order, on one server booted against `jack`, once the
+    Event `after` (if any) is set; sets `booted` when its server is up. Returns (run, examples,
+    problems, notes): problems are the failures and unmet expectations, each naming its example."""
     if after is not None:
         after.wait()
     since = time.time()
-    run = sclang.run_with_server(RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
-                                               piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S,
-                                               free_each_block=str(FREE_EACH_BLOCK).lower()),
-                                 jack, name="help", timeout=timeout, booted=booted)
+    code = RUNNER % dict(files=", ".join(sclang.sc_string(f) for f in files),
+                         guides=", ".join(str(is_guide(f)).lower() for f in files),
+                         piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
+                         boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
+                         free_each_block=str(FREE_EACH_BLOCK).lower())
+    run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
+                                 # The study's examples: the participant's pair and the experimenter's.
+                                 server_options={"numOutputBusChannels": 4})
     examples, in_file, current, notes, problems = [], [], None, [], []
     where, temp_dir, finished, in_stack = "(before the first example)", "/tmp", False, False
     for line in run.output.splitlines():
@@ -274,16 +393,26 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
             in_file.append(current)
             where = "piece -"
             continue
-        if m := EXPECT.match(line):
-            current.expects.append((m[1].rstrip(":"), m[2]))
+        if m := COMMENT.match(line):
+            if OLD_MARKER.match(m[1]):
+                problems.append(f"{current}: a test marker of an earlier version, not read: //{m[1]} "
+                                "(write // posts \"...\", // fails with \"...\", // writes <file>)")
+            for kind, annotation in ANNOTATIONS:
+                if found := annotation.search(m[1]):
+                    current.expects.append((kind, found[1]))
             continue
         if line.startswith("KF-HELP-PIECE "):
             where = "piece " + line.split()[-1]
+        if line.startswith("KF-HELP-CLEANED-UP "):
+            where = "after the clean-up"
         if line.startswith("KF-HELP-FILE-DONE "):
             in_file = []
         if not line.startswith("KF-HELP-"):
             for example in in_file:
                 example.output.append(line)
+        if current is not None and is_guide(current.path) and CLOSED_DEVICE.search(line):
+            current.failures.append((where, "a synth reads or writes a slot with no device (not freed with it?)", line))
+            continue
         for pattern, what in FAILURES:
             if pattern.search(line):
                 if current is None:
@@ -300,7 +429,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
         problems.append(f"the run {why} while running {current} {where}; log {run.log_path}")
 
     for example in examples:
-        expected_errors = [text for kind, text in example.expects if kind == "expect error"]
+        expected_errors = [text for kind, text in example.expects if kind == "fails with"]
         seen, reported = set(), set()
         for piece, what, line in example.failures:
             shown = [text for text in expected_errors if text in line]
@@ -309,7 +438,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
                 reported.add((piece, what))
                 problems.append(f"{example} {piece}: {what}: {line}")
         for kind, text in example.expects:
-            if kind == "expect error":
+            if kind == "fails with":
                 ok = text in seen
             elif kind == "->":
                 ok = any(map(matcher("-> " + text, whole_line=True), example.output))
@@ -318,35 +447,51 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
             else:
                 why = check_written(text, temp_dir, since)
                 if why:
-                    problems.append(f"{example}: // writes: {text}: {why}")
+                    problems.append(f"{example}: // writes {text}: {why}")
                 continue
             if not ok:
                 # What came instead: lines holding the text before its first number, or its values.
                 head = re.split(NUMBER, text)[0].strip() if kind == "posts" else ""
                 came = [line for line in example.output if (line.startswith("-> ") if not head else head in line)]
-                label = kind if kind == "->" else kind + ":"
-                problems.append(f"{example}: // {label} {text}: not posted (posted: {came[:4]})")
+                said = f"-> {text}" if kind == "->" else f'{kind} "{text}"'
+                problems.append(f"{example}: // {said}: not posted (posted: {came[:4]})")
     return run, examples, problems, notes
 
 
+def temp_names(path):
+    """The files in Platform.defaultTempDir the examples of `path` that run name (not those that
+    need hardware)."""
+    blocks = [b for b in CODE_BLOCK.findall(path.read_text()) if not b.strip().startswith("// needs ")]
+    return set(name for b in blocks for name in TEMP_NAME.findall(b))
+
+
+def blocks_in(path):
+    return len(CODE_BLOCK.findall(path.read_text()))
+
+
 def shards_of(files, count):
-    """`files` in `count` lists to run side by side, each in the sorted order. Files naming the
-    same file in Platform.defaultTempDir (one writes what another reads, or both write it) stay in
-    one list, in order; the lists are balanced by their number of code blocks."""
+    """`files` in lists to run side by side: the guides in one, in guide_order; the class help
+    files in count - 1 more, each in the sorted order. Files naming the same file in
+    Platform.defaultTempDir (one writes what another reads, or both write it) stay in one list, in
+    order; the lists are balanced by their number of code blocks."""
+    guides = guide_order(files)
     groups = []  # [(temp names, files)]
-    for f in files:
-        text = f.read_text()
-        names = set(TEMP_NAME.findall(text))
+    for f in [f for f in files if not is_guide(f)]:
+        names = temp_names(f)
         joined = [g for g in groups if g[0] & names]
         merged = (names.union(*(g[0] for g in joined)), [x for g in joined for x in g[1]] + [f])
         groups = [g for g in groups if g not in joined] + [merged]
-    shards = [[] for _ in range(count)]
-    weight = [0] * count
-    for names, group in sorted(groups, key=lambda g: -sum(CODE_BLOCK.subn("", x.read_text())[1] for x in g[1])):
+    guide_names = set().union(*map(temp_names, guides))
+    shards = [[] for _ in range(count - 1)]
+    weight = [0] * (count - 1)
+    for names, group in sorted(groups, key=lambda g: -sum(map(blocks_in, g[1]))):
+        if names & guide_names:
+            guides += group  # it shares a temp file with a guide: after them, on their server
+            continue
         i = weight.index(min(weight))
         shards[i] += group
-        weight[i] += sum(CODE_BLOCK.subn("", x.read_text())[1] for x in group)
-    return [sorted(shard) for shard in shards if shard]
+        weight[i] += sum(map(blocks_in, group))
+    return [shard for shard in [guides] + [sorted(shard) for shard in shards] if shard]
 
 
 def test_help_shards_keep_files_sharing_a_temp_file_together():
@@ -356,8 +501,11 @@ def test_help_shards_keep_files_sharing_a_temp_file_together():
     owner = {}
     for i, shard in enumerate(shards):
         for f in shard:
-            for name in TEMP_NAME.findall(f.read_text()):
+            for name in temp_names(f):
                 assert owner.setdefault(name, i) == i, f"{name} is used by files in two shards"
+    guides = [f for f in files if is_guide(f)]
+    assert guides and shards[0][:len(guides)] == guide_order(files), "the guides run first, in one session"
+    assert shards[0][0].parent.name == "Overviews", "a user starts at the overview"
 
 
 def test_every_help_example_runs_on_a_realtime_server():
@@ -390,8 +538,11 @@ def test_every_help_example_runs_on_a_realtime_server():
     assert sum(len(e.expects) for e in examples) >= 10, "the help's output annotations were not read"
 
 
-# Broken examples, one way each, and a good block: every broken one must be reported, the good
-# one not. One server run for all. (Node numbers far above those sclang allocates.)
+# Broken examples, one way each, and good blocks: every broken one must be reported, the good
+# ones not. One server run for all: a class's help and a guide (its stricter rules, a reboot and a
+# fork longer than the pause between pieces, which a person waits for: with FORK_WAIT_MAX_S or
+# BOOT_WAIT_MAX_S at 0 the good blocks 0 and 1 of the guide are reported). (Node numbers far above
+# those sclang allocates.)
 BROKEN_HELP = """title:: BrokenExamples
 summary:: Examples the help-example test must report
 categories:: KineticFriction
@@ -408,41 +559,91 @@ nil.kfNoSuchMethod;
 ::
 
 code::
-(1 + 1).postln;  // posts: 3
+(1 + 1).postln;  // posts "3"
 0.5 + 0.25;  // -> 0.9
-1 + 1;  // writes: kf-help-never-written.wav
+1 + 1;  // writes kf-help-never-written.wav
 ::
 
 code::
-// expect error: Node 99997 not found
+// fails with "Node 99997 not found"
 s.sendMsg("/n_free", 99996);
 ::
 
 code::
-// expect error: Node 99998 not found
+// this fails with "Node 99998 not found"
 s.sendMsg("/n_free", 99998);
-(1 + 1).postln;  // posts: 2
+(1 + 1).postln;  // this posts "2"
 0.5 + 0.25;  // -> 0.75
 ::
+
+code::
+(1 + 1).postln;  // posts: 2
+::
+
+code::
+s.sendMsg("/n_free", 1);
+::
 """
-# (block, what its report says)
-BROKEN = [(0, "FAILURE IN SERVER /n_set Node 99999 not found"), (1, "ERROR: a broken example"),
-          (1, "Message 'kfNoSuchMethod' not understood"), (2, "// posts: 3: not posted"),
-          (2, "// -> 0.9: not posted"), (2, "kf-help-never-written.wav was not written"),
-          (3, "FAILURE IN SERVER /n_free Node 99996 not found"),
-          (3, "// expect error: Node 99997 not found: not posted")]
-GOOD = 4
+BROKEN_GUIDE = """title:: BrokenGuide
+summary:: A guide the help-example test must report
+categories:: KineticFriction
+
+description::
+
+code::
+(
+~kfDone = false;
+fork { 1.0.wait; ~kfDone = true };
+)
+"waited: %".format(~kfDone).postln;  // posts "waited: true"
+::
+
+code::
+s.reboot;
+"running: %".format(s.serverRunning).postln;  // posts "running: true"
+::
+
+code::
+(
+fork {
+	~kfDev = FrictionDevice.sim(s, 9, replace: true);
+	~kfReader = { FrictionMouseIn.kr(9)[0]; Silent.ar }.play;
+};
+)
+::
+
+code::
+~kfDev.close;
+::
+"""
+# (file, block, what its report says)
+BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found"),
+          ("BrokenExamples", 1, "ERROR: a broken example"),
+          ("BrokenExamples", 1, "Message 'kfNoSuchMethod' not understood"),
+          ("BrokenExamples", 2, '// posts "3": not posted'), ("BrokenExamples", 2, "// -> 0.9: not posted"),
+          ("BrokenExamples", 2, "kf-help-never-written.wav was not written"),
+          ("BrokenExamples", 3, "FAILURE IN SERVER /n_free Node 99996 not found"),
+          ("BrokenExamples", 3, '// fails with "Node 99997 not found": not posted'),
+          ("BrokenExamples", 5, "a test marker of an earlier version, not read: // posts: 2"),
+          ("BrokenExamples", 6, "the server has no default group"),
+          ("BrokenGuide", 3, "a slot with no device"), ("BrokenGuide", 3, "a node left running")]
+GOOD = [("BrokenExamples", 4), ("BrokenGuide", 0), ("BrokenGuide", 1), ("BrokenGuide", 2)]
 
 
 def test_broken_examples_are_reported(tmp_path):
-    help_file = tmp_path / "HelpSource" / "Classes" / "BrokenExamples.schelp"
-    help_file.parent.mkdir(parents=True)
-    help_file.write_text(BROKEN_HELP)
+    help_files = [tmp_path / "HelpSource" / "Classes" / "BrokenExamples.schelp",
+                  tmp_path / "HelpSource" / "Guides" / "BrokenGuide.schelp"]
+    for path, text in zip(help_files, [BROKEN_HELP, BROKEN_GUIDE]):
+        path.parent.mkdir(parents=True)
+        path.write_text(text)
     with JackServer() as jack:
-        run, examples, problems, notes = run_examples([help_file], jack, timeout=120)
+        run, examples, problems, notes = run_examples(help_files, jack, timeout=120)
     print("\n".join(problems))
-    assert run.ok and [e.block for e in examples] == list(range(GOOD + 1)), run.output[-3000:]
-    for block, what in BROKEN:
-        assert any(p.startswith(f"{help_file} block {block} ") and what in p for p in problems), \
-            f"broken block {block} not reported as '{what}':\n" + "\n".join(problems)
-    assert not [p for p in problems if p.startswith(f"{help_file} block {GOOD} ")], problems
+    assert run.ok and [(Path(e.path).stem, e.block) for e in examples] == \
+        [("BrokenExamples", b) for b in range(7)] + [("BrokenGuide", b) for b in range(4)], run.output[-3000:]
+    named = {path.stem: path for path in help_files}
+    for name, block, what in BROKEN:
+        assert any(p.startswith(f"{named[name]} block {block} ") and what in p for p in problems), \
+            f"broken block {block} of {name} not reported as '{what}':\n" + "\n".join(problems)
+    for name, block in GOOD:
+        assert not [p for p in problems if p.startswith(f"{named[name]} block {block} ")], problems

@@ -8,7 +8,8 @@ Each test prints its measured figures on a line starting with KF-FIGURE.
 import numpy as np
 import pytest
 
-from kfharness import paths, readers, sclang, status
+from kfharness import paths, sclang, status
+from kfstudy import readers
 
 COUNT_MM = 0.021
 

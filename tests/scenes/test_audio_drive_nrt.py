@@ -36,7 +36,7 @@ def test_the_drive_follows_the_combined_force_through_the_calibration_sample_by_
     b_dur_s = 0.0395  # writer B lasts 1896 samples from 4992: it ends at 6888, inside block 107
     head_free_s = 0.3  # after the hard cases at fixed forces, before writer A is freed
     data, log = nrt.score_and_render("nrtdrive", f"""
-        var dev = FrictionDevice.sim(nil, 0);
+        var dev = FrictionDevice.describeSim(0);
         var root = RootNode(Server.default);
         // Each drive on its own channel and on channel 4, which sums them.
         var drive = SynthDef(\\nrtdrive, {{ |out| var d = FrictionDrive.ar(0); Out.ar(out, d); Out.ar(4, d) }});

@@ -63,7 +63,7 @@ def test_a_buffer_reallocated_300_times_in_a_second_posts_a_line_not_hundreds():
 
 def test_nan_device_index_and_origin():
     data, log = nrt.score_and_render("nanindex", """
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.speeds([[50, 1]]));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.speeds([[50, 1]]));
         var def = SynthDef(\\nanindex, {
             var big = DC.kr(1e30) * 1e30, nan = big - big, everyOtherBlock = LFPulse.kr(ControlRate.ir / 2);
             Out.ar(0, [FrictionMouseIn.ar(nan)[0], FrictionOut.ar(nan, DC.ar(1.0)),

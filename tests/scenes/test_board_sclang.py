@@ -44,7 +44,7 @@ def test_calibration_tables_validate_round_trip_and_invert():
 
 def test_board_messages_for_scores():
     out = sclang.run_script("""
-        var dev = FrictionDevice.sim(nil, 3);
+        var dev = FrictionDevice.describeSim(3);
         var table = FrictionCalibration.linear(0.14, 1.4);
         var errors = List.new;
         [dev.addBoardMsg, dev.addBoardMsg("KF-0001", true, 3), dev.armMsg, dev.disarmMsg,
@@ -66,7 +66,7 @@ def test_board_messages_for_scores():
 
 def test_a_score_cannot_carry_a_board():
     _, log = nrt.score_and_render("board_nrt", """
-        var dev = FrictionDevice.sim(nil, 0);
+        var dev = FrictionDevice.describeSim(0);
         score = Score([[0.0, dev.openMsg], [0.0, dev.addBoardMsg(emulate: true)], [0.01, dev.armMsg],
             [0.02, ['/c_set', 0, 0]]]);
     """)

@@ -2,7 +2,8 @@
 record and replay, and closed slots."""
 import numpy as np
 
-from kfharness import nrt, paths, readers, sclang
+from kfharness import nrt, paths, sclang
+from kfstudy import readers
 
 SR = 48000
 HID_FILE = paths.test_data_dir() / "hid" / "genius-gila-gaming-mouse-0458-0138.hid"
@@ -26,7 +27,7 @@ def render_device(name, open_code, seconds, force="DC.ar(0.3)", extra_events="",
 
 
 def test_steady_100_mm_per_s_hand_reads_100_mm_per_s_within_one_speed_level():
-    data, _ = render_device("steady", "FrictionDevice.sim(nil, 0, FrictionHand.speeds([[100, 3]]))", 2.0)
+    data, _ = render_device("steady", "FrictionDevice.describeSim(0, FrictionHand.speeds([[100, 3]]))", 2.0)
     t = np.arange(len(data)) / SR
     steady = (t > 1.0) & (t < 1.9)  # after the hand has taken up its lag
     speed = data[steady, 2]
@@ -40,7 +41,7 @@ def test_steady_100_mm_per_s_hand_reads_100_mm_per_s_within_one_speed_level():
 
 def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_path=paths.work_dir()):
     rec = tmp_path / "frames.kfs"
-    data, _ = render_device("frames", "FrictionDevice.sim(nil, 0, FrictionHand.speeds([[60, 2]]))", 1.0,
+    data, _ = render_device("frames", "FrictionDevice.describeSim(0, FrictionHand.speeds([[60, 2]]))", 1.0,
                             force="LFPulse.ar(50).range(0.2, 0.8)",
                             extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
     session = readers.Session(rec)
@@ -58,16 +59,16 @@ def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_p
 
 
 def test_friction_slows_the_puck_as_the_simulation_says():
-    slow, _ = render_device("heavy", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
+    slow, _ = render_device("heavy", "FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
                             force="DC.ar(1.4)")
-    fast, _ = render_device("light", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
+    fast, _ = render_device("light", "FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
                             force="DC.ar(0.14)")
     i = int(0.6 * SR)
     assert slow[i, 0] < fast[i, 0] - 5, f"{slow[i, 0]} mm with 1.4 N vs {fast[i, 0]} mm with 0.14 N"
 
 
 def test_out_of_range_force_is_clamped_and_nan_is_the_minimum():
-    data, _ = render_device("clamp", "FrictionDevice.sim(nil, 0)", 0.3,
+    data, _ = render_device("clamp", "FrictionDevice.describeSim(0)", 0.3,
                             force="Select.ar(LFPulse.ar(10, 0, 0.5), [DC.ar(5), DC.ar(1e30) * 1e30 - (DC.ar(1e30) * 1e30)])")
     force = data[: int(0.29 * SR), 4]
     assert np.all(np.isfinite(force))
@@ -81,10 +82,10 @@ def test_out_of_range_force_is_clamped_and_nan_is_the_minimum():
 def test_record_then_replay_gives_identical_output():
     rec = paths.work_dir() / "session.kfs"
     recorded, _ = render_device(
-        "rec", "FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.5, 30], [1.0, 10], [1.5, 45]]), "
+        "rec", "FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [0.5, 30], [1.0, 10], [1.5, 45]]), "
         "(reportJitterS: 0.0005, dropProbability: 0.05, seed: 7))", 1.6,
         extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
-    replayed, _ = render_device("replay", f"FrictionDevice.replay(nil, \"{rec}\")", 1.6)
+    replayed, _ = render_device("replay", f"FrictionDevice.describeReplay(\"{rec}\")", 1.6)
     reports = readers.Session(rec).reports
     assert len(reports) > 150
     assert np.max(np.abs(recorded[:, 0])) > 25
@@ -92,7 +93,7 @@ def test_record_then_replay_gives_identical_output():
 
 
 def test_hid_recorder_file_replays_through_the_ugens():
-    data, log = render_device("hid", f"FrictionDevice.replay(nil, \"{HID_FILE}\")", 9.0)
+    data, log = render_device("hid", f"FrictionDevice.describeReplay(\"{HID_FILE}\")", 9.0)
     x, y = data[:, 0].astype(np.float64), data[:, 1].astype(np.float64)
     # The recording's relative X and Y sum to -67 and -40 counts (decoded independently in the
     # device tests); at 0.021 mm a count the puck ends there.
@@ -116,7 +117,7 @@ def test_closed_slot_gives_zero_position_minimum_force_and_one_warning_each():
 
 
 def test_same_score_renders_the_same_file_sample_for_sample():
-    open_code = ("FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.4, 20], [0.8, 5]]), "
+    open_code = ("FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [0.4, 20], [0.8, 5]]), "
                  "(reportJitterS: 0.001, dropProbability: 0.1))")
     a, _ = render_device("det_a", open_code, 0.9, force="LoudnessToFriction.ar(SinOsc.ar(FrictionMouseIn.ar(0)[2].abs * 10))")
     b, _ = render_device("det_b", open_code, 0.9, force="LoudnessToFriction.ar(SinOsc.ar(FrictionMouseIn.ar(0)[2].abs * 10))")
@@ -130,23 +131,27 @@ def test_bad_device_arguments_give_clear_errors():
             { FrictionHand.path([[0, 0], [-1, 3]]) },
             { FrictionHand.speeds([[10, -1]]) },
             { FrictionHand.path([]) },
-            { FrictionDevice.sim(nil, 16) },
-            { FrictionDevice.sim(nil, 0, 3) },
-            { FrictionDevice.sim(nil, 0, nil, (maxForceN: "x")) },
+            { FrictionDevice.describeSim(16) },
+            { FrictionDevice.describeSim(0, 3) },
+            { FrictionDevice.describeSim(0, nil, (maxForceN: "x")) },
             { SynthDef(\\x, { FrictionMouseIn.ar(0, 0, 5) }).add },
-            { SynthDef(\\y, { FrictionOut.ar(-1, 0.2) }).add }
+            { SynthDef(\\y, { FrictionOut.ar(-1, 0.2) }).add },
+            // A nil server is Server.default (not booted here), as everywhere in SC: no silent
+            // description of a device that is not open.
+            { FrictionDevice.sim(nil, 0) }
         ].do { |f| try { f.value } { |e| errors.add(e.errorString) } };
         errors.do(_.postln);
-        if(errors.size != 8) { Error("expected 8 errors, got %".format(errors.size)).throw };
+        if(errors.size != 9) { Error("expected 9 errors, got %".format(errors.size)).throw };
     """)
     for text in ["times must ascend", "durations must be >= 0", "non-empty array", "index must be an Integer from 0 to 15",
-                 "hand must be a FrictionHand", "must be a number", "interpolation must be 0", "device must be a slot index"]:
+                 "hand must be a FrictionHand", "must be a number", "interpolation must be 0", "device must be a slot index",
+                 "FrictionDevice.sim: server localhost is not running"]:
         assert text in out, text
 
 
 def test_specs_names_carry_units_old_names_still_work_and_audio_delay_is_one_ms():
     out = sclang.run_script("""
-        var d = FrictionDevice.sim(nil, 0), e = FrictionDevice.sim(nil, 1, nil, (maxForce: 1.0, tactileLatencyS: 0.003));
+        var d = FrictionDevice.describeSim(0), e = FrictionDevice.describeSim(1, nil, (maxForce: 1.0, tactileLatencyS: 0.003));
         [\\countMm, \\updateRateHz, \\maxSpeedMmPerS, \\minForceN, \\maxForceN, \\audioLatencyS, \\tactileLatencyS].do { |k|
             "UNIT % %".format(k, d.specs[k]).postln };
         [\\countMm, \\updateRate, \\maxSpeed, \\minForce, \\maxForce, \\audioLatency, \\tactileLatency].do { |k|
@@ -170,9 +175,9 @@ def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
     """Device time starts at the open, as in realtime: a hand script opened at 0.5 s runs from
     the block the open ran at (scsynth: 0.5 s, 375 blocks of 64 at 48 kHz)."""
     hand = "FrictionHand.path([[0, 0], [0.3, 20], [0.6, 5]])"
-    early, _ = render_device("open_early", f"FrictionDevice.sim(nil, 0, {hand})", 1.2)
+    early, _ = render_device("open_early", f"FrictionDevice.describeSim(0, {hand})", 1.2)
     late, _ = nrt.score_and_render("open_late", f"""
-        var dev = FrictionDevice.sim(nil, 0, {hand});
+        var dev = FrictionDevice.describeSim(0, {hand});
         var def = SynthDef(\\open_late, {{
             Out.ar(0, FrictionMouseIn.ar(0, 0, 1) ++ [FrictionOut.ar(0, DC.ar(0.3))])
         }});

@@ -24,7 +24,7 @@ def render():
     soundfile.write(str(path), m.ravel().astype(np.float32), SR, subtype="FLOAT")
     opens, outs = [], []
     for slot, (hand, seconds) in enumerate(SCRIPTS.values()):
-        opens.append(f"[0.0, FrictionDevice.sim(nil, {slot}, {hand}).openMsg]")
+        opens.append(f"[0.0, FrictionDevice.describeSim({slot}, {hand}).openMsg]")
         outs.append(f"{{ var m = FrictionMouseIn.ar({slot}, 0, 1); "
                     f"[m[0], m[1], SpatialBufRd2D.ar(1, m[0], m[1], {SIZE}, 1, 1, -30, -30, 4)] }}.value")
     longest = max(seconds for _, seconds in SCRIPTS.values())

@@ -25,7 +25,7 @@ def hid_reports():
 
 def test_replayed_500_hz_mouse_is_reconstructed_at_500_hz():
     data, _ = nrt.score_and_render("rate500", """
-        var dev = FrictionDevice.replay(nil, "%s");
+        var dev = FrictionDevice.describeReplay("%s");
         var def = SynthDef(\\rate500, { Out.ar(0, FrictionMouseIn.ar(0, 0, 1)) });
         score = Score([
             [0.0, dev.openMsg],

@@ -10,13 +10,13 @@ from kfharness import nrt, paths, sclang
 
 def test_mouse_messages_and_specs():
     out = sclang.run_script(r"""
-        var d = FrictionDevice.mouse(nil, 2, "0458:0138", \evdev, (countMm: 0.02), true);
+        var d = FrictionDevice.describeMouse(2, "0458:0138", \evdev, (countMm: 0.02), true);
         "KF-MSG %".format(d.openMsg).postln;
         "KF-MOUSEMSG %".format(d.mouseMsg == d.openMsg).postln;
-        "KF-REPLACE %".format(FrictionDevice.mouse(nil, 1, replace: true).openMsg).postln;
+        "KF-REPLACE %".format(FrictionDevice.describeMouse(1, replace: true).openMsg).postln;
         "KF-SPEC % %".format(d.specs[\countMm], d.specs[\maxSpeed]).postln;
-        "KF-FIRST %".format(FrictionDevice.mouse(nil, 0).openMsg).postln;
-        "KF-INDEX %".format(FrictionDevice.mouse(nil, 1, 3).openMsg).postln;
+        "KF-FIRST %".format(FrictionDevice.describeMouse(0).openMsg).postln;
+        "KF-INDEX %".format(FrictionDevice.describeMouse(1, 3).openMsg).postln;
         "KF-REOPEN %".format(d.reopenMsg).postln;
         "KF-LIST %".format(FrictionDevice.listMiceMsg(\hidapi, "/tmp/x")).postln;
         "KF-RECORD %".format(d.recordMsg("/tmp/m.txt")).postln;
@@ -41,7 +41,7 @@ def test_stroke_and_profile_round_trip():
             cpi: 1200, countMmX: x, countMmY: y, updateRateHz: 500));
         p = FrictionDevice.readMouseProfile("{path}");
         "KF-P % % % %".format(p[\\name], p[\\vendorId], (p[\\countMmX] - x).abs < 1e-9, p[\\cpi]).postln;
-        d = FrictionDevice.mouse(nil, 0, nil, \\hidapi, "{path}");
+        d = FrictionDevice.describeMouse(0, nil, \\hidapi, "{path}");
         "KF-D % % %".format(d.specs[\\countMm].round(1e-7), d.specs[\\updateRate], d.openMsg).postln;
         "KF-CPI %".format(FrictionDevice.mouseProfileSettings((cpi: 1000))[\\countMm]).postln;
     """)
@@ -57,9 +57,9 @@ def test_stroke_and_profile_round_trip():
 def test_bad_mouse_arguments_give_clear_errors():
     out = sclang.run_script(r"""
         [
-            { FrictionDevice.mouse(nil, 0, nil, \usb) },
-            { FrictionDevice.mouse(nil, 0, 3.5) },
-            { FrictionDevice.mouse(nil, 0, nil, \hidapi, "/no/such/profile.txt") },
+            { FrictionDevice.describeMouse(0, nil, \usb) },
+            { FrictionDevice.describeMouse(0, 3.5) },
+            { FrictionDevice.describeMouse(0, nil, \hidapi, "/no/such/profile.txt") },
             { FrictionDevice.countMmFromStroke(0, 100) },
             { FrictionDevice.countMmFromStroke(100, -1) },
         ].do { |f, i| f.try { |e| "KF-ERR % %".format(i, e.errorString).postln } };
@@ -77,7 +77,7 @@ def test_a_score_cannot_open_a_real_mouse_and_nothing_moves():
         var def = SynthDef(\\mouseNrt, { Out.ar(0, FrictionMouseIn.ar(0)) });
         score = Score([
             [0.0, ['/d_recv', def.asBytes]],
-            [0.0, FrictionDevice.mouse(nil, 0).openMsg],
+            [0.0, FrictionDevice.describeMouse(0).openMsg],
             [0.0, Synth.basicNew(\\mouseNrt, nil, 1000).newMsg],
             [0.2, ['/c_set', 0, 0]]]);
     """, channels=4)

@@ -15,7 +15,7 @@ def read_frames(path):
 
 def test_readers_agree_to_the_sample_late_readers_start_where_the_puck_is_and_zero_rebases_all():
     data, _ = nrt.score_and_render("onepos", """
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.speeds([[20, 1], [-30, 1], [40, 2]]));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.speeds([[20, 1], [-30, 1], [40, 2]]));
         var def = SynthDef(\\onepos, { |out| Out.ar(out, FrictionMouseIn.ar(0)[0]) });
         score = Score([
             [0.0, dev.openMsg],
@@ -47,7 +47,7 @@ def test_readers_agree_to_the_sample_late_readers_start_where_the_puck_is_and_ze
 def test_several_writers_in_a_score_one_frame_per_millisecond_by_the_rule():
     rec = paths.work_dir() / "nrt-writers.kfs"
     nrt.score_and_render("nrtwriters", f"""
-        var dev = FrictionDevice.sim(nil, 0);
+        var dev = FrictionDevice.describeSim(0);
         var def = SynthDef(\\nrtwriter, {{ |force = 0.14| FrictionOut.ar(0, DC.ar(force)) }});
         score = Score([
             [0.0, dev.openMsg],

@@ -47,7 +47,7 @@ def render(rate, seconds):
     outs = ", ".join(code for _, code, _ in KINDS)
     extra = ", ".join(code for _, code in EXTRA)
     data, log = nrt.score_and_render(f"patterns{rate}", f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [0.25, 40], [0.35, 40], [{seconds}, 20]]));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [0.25, 40], [0.35, 40], [{seconds}, 20]]));
         var def = SynthDef(\\patterns, {{
             var x = FrictionMouseIn.ar(0)[0], h = sin(x * 0.5);
             Out.ar(0, [x, h, {outs}, {extra}])
@@ -161,7 +161,7 @@ def test_bumps2d_under_the_hands_circle_is_its_definition():
     # FrictionMouseIn gave; same float tolerance as the 1D kinds (measured here: 1.5e-8 N at worst).
     rate, seconds = 48000, 1.2
     data, log = nrt.score_and_render("patterns2d", f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.circle(15, 60, 1, 1, 1));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.circle(15, 60, 1, 1, 1));
         var def = SynthDef(\\patterns2d, {{
             var m = FrictionMouseIn.ar(0);
             Out.ar(0, [m[0], m[1], FrictionPattern.bumps2D(m[0], m[1], 4, 3, 2)])
@@ -191,7 +191,7 @@ def test_texture2d_along_a_line_at_an_angle_is_its_definition():
     # gave; the same float tolerance as the 1D kinds (1e-6 N).
     rate, seconds = 48000, 0.4
     data, log = nrt.score_and_render("patterns-texture2d", f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.line(30, 50, 250, 1, -2));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.line(30, 50, 250, 1, -2));
         var def = SynthDef(\\texture2d, {{
             var m = FrictionMouseIn.ar(0);
             Out.ar(0, [m[0], m[1], FrictionPattern.texture2D(m[0], m[1], 0.5, 3, 11),

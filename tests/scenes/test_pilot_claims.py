@@ -174,8 +174,8 @@ def test_pilot_class_signal_mappings_and_clear_errors():
         "PILOT-TABLE3 %".format(FrictionPilot.table(\mapping3, 2.6, 334).atAll([\cycleWidthMm, \fragmentWidthMm, \loHz, \hiHz])).postln;
         "PILOT-MSGS %".format(FrictionPilot.loadSignalMsgs(3).size).postln;
         "PILOT-FRICTIONMSG %".format(FrictionPilot.setFrictionMsg(1000, false)).postln;
-        "PILOT-DELAY %".format(FrictionDevice.sim(nil, 2).audioDelay).postln;
-        FrictionPilot.synthDef(\p, FrictionDevice.sim(nil, 2), true);
+        "PILOT-DELAY %".format(FrictionDevice.describeSim(2).audioDelay).postln;
+        FrictionPilot.synthDef(\p, FrictionDevice.describeSim(2), true);
         FrictionPilot.synthDef(\p, 3);
         expectError.(\mapping, { FrictionPilot.samplesPerMmOf(\mapping4) });
         expectError.(\negative, { FrictionPilot.samplesPerMmOf(-1) });
@@ -183,8 +183,8 @@ def test_pilot_class_signal_mappings_and_clear_errors():
         expectError.(\device, { FrictionPilot.synthDef(\p, "zero") });
         expectError.(\friction, { FrictionPilot(0, \mapping1, 2) });
         expectError.(\scoreDevice, { FrictionPilot.score(0) });
-        expectError.(\duration, { FrictionPilot.score(FrictionDevice.replay(nil, "/nonexistent.txt")) });
-        expectError.(\recordBus, { FrictionPilot.score(FrictionDevice.sim(nil, 0, FrictionHand.speeds([[1, 1]])), recordBus: 1) });
+        expectError.(\duration, { FrictionPilot.score(FrictionDevice.describeReplay("/nonexistent.txt")) });
+        expectError.(\recordBus, { FrictionPilot.score(FrictionDevice.describeSim(0, FrictionHand.speeds([[1, 1]])), recordBus: 1) });
         expectError.(\forces, { FrictionPilot.synthDef(\p, 0, false, 0.5, 0.2) });
     """)
     assert "PILOT-SIGNAL 24000 1.0 -1.0" in out
@@ -202,7 +202,7 @@ def test_pilot_class_signal_mappings_and_clear_errors():
 def test_the_same_pilot_on_a_replay_of_the_session_gives_the_same_sound_and_force(renders):
     r, scene = renders["m1_fast_on"], SCENES["m1_fast_on"]
     data, _ = nrt.score_and_render("pilot-claims-replay", f"""
-        var dev = FrictionDevice.replay(nil, "{r['session']}");
+        var dev = FrictionDevice.describeReplay("{r['session']}");
         score = FrictionPilot.score(dev, \\mapping1, 1, {scene.duration_s}, {scene.origin_mm}, 1, 2);
     """, sample_rate=SR, channels=len(P.CHANNELS))
     replay = {name: data[:, i].astype(np.float64) for i, name in enumerate(P.CHANNELS)}

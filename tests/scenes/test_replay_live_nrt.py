@@ -12,7 +12,7 @@ def record_session():
     if SESSION.exists():
         return
     nrt.score_and_render("recordidle", f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.path([[0, 0], [2, 0], [3, 30], [3.5, 30]]));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [2, 0], [3, 30], [3.5, 30]]));
         var def = SynthDef(\\recordidle, {{ Out.ar(0, FrictionMouseIn.ar(0)[0]) }});
         score = Score([
             [0.0, dev.openMsg],
@@ -27,7 +27,7 @@ def record_session():
 def replay_x(name, profile, seconds):
     record_session()
     data, _ = nrt.score_and_render(name, f"""
-        var dev = FrictionDevice.replay(nil, "{SESSION}", 0, {profile});
+        var dev = FrictionDevice.describeReplay("{SESSION}", 0, {profile});
         var def = SynthDef(\\{name}, {{ Out.ar(0, FrictionMouseIn.ar(0)[0]) }});
         score = Score([
             [0.0, dev.openMsg],

@@ -20,7 +20,7 @@ def render():
     """Per case: FrictionMouseIn's speed along x and the commanded force (N), from 0.5 s on."""
     opens, outs = [], []
     for slot, (hand, target, gain) in enumerate(CASES):
-        opens.append(f"[0.0, FrictionDevice.sim(nil, {slot}, {hand}).openMsg]")
+        opens.append(f"[0.0, FrictionDevice.describeSim({slot}, {hand}).openMsg]")
         force = f"SpeedGovernor.ar(m[2], m[3], {target}, {gain}, {LO_N}, {HI_N})" if gain else f"DC.ar({LO_N})"
         outs.append(f"{{ var m = FrictionMouseIn.ar({slot}, 0, 1); [m[2], FrictionOut.ar({slot}, {force})] }}.value")
     data, _ = nrt.score_and_render("governor", f"""

@@ -33,8 +33,8 @@ def truth():
 def test_synthetic_recordings_through_the_ugens_saturation_posted():
     seconds = 1.4
     data, log = nrt.score_and_render("synthhid", f"""
-        var slow = FrictionDevice.replay(nil, "{SLOW}", 0, (countMm: {SLOW_COUNT_MM}));
-        var fast = FrictionDevice.replay(nil, "{FAST}", 1, (countMm: {FAST_COUNT_MM}));
+        var slow = FrictionDevice.describeReplay("{SLOW}", 0, (countMm: {SLOW_COUNT_MM}));
+        var fast = FrictionDevice.describeReplay("{FAST}", 1, (countMm: {FAST_COUNT_MM}));
         var def = SynthDef(\\synthhid, {{
             Out.ar(0, FrictionMouseIn.ar(0, 0, 1)[0..1] ++ FrictionMouseIn.ar(1, 0, 1)[0..1])
         }});

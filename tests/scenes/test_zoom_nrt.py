@@ -14,7 +14,7 @@ FRAMES = 60000
 
 def render_zoom(name, keep, change="['/n_set', 1000, \\spm, 1000]"):
     data, _ = nrt.score_and_render(name, f"""
-        var dev = FrictionDevice.sim(nil, 0, FrictionHand.speeds([[20, 3]]));
+        var dev = FrictionDevice.describeSim(0, FrictionHand.speeds([[20, 3]]));
         var def = SynthDef(\\{name}, {{ |spm = 500, origin = 0|
             var x = FrictionMouseIn.ar(0)[0];
             Out.ar(0, [SpatialBufRd.ar(1, 0, x, spm, origin, 2, {keep}), x]);

@@ -14,7 +14,8 @@ import argparse
 import re
 import time
 
-from kfharness import load, paths, readers, sclang, status
+from kfharness import load, paths, sclang, status
+from kfstudy import readers
 from kfharness.witness import Witness
 from kfharness.jack import JackServer
 

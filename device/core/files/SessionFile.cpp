@@ -119,10 +119,28 @@ void Recorder::writeFrame(double hostTimeS, const ForceFrame& frame, float comma
   append(line, std::min<int>(length, sizeof line - 1));
 }
 
-void Recorder::writeOff(double hostTimeS) {
+const char* offCauseName(OffCause cause) {
+  switch (cause) {
+    case OffCause::kStop:
+      return "stop";
+    case OffCause::kQuit:
+      return "quit";
+    case OffCause::kClose:
+      return "close";
+    case OffCause::kWatchdog:
+      return "watchdog";
+    case OffCause::kFailure:
+      return "failure";
+    case OffCause::kSignal:
+      return "signal";
+  }
+  return "unknown";
+}
+
+void Recorder::writeOff(double hostTimeS, OffCause cause) {
   if (!isOpen()) return;
   char line[64];
-  const int length = std::snprintf(line, sizeof line, "O %.17g\n", hostTimeS);
+  const int length = std::snprintf(line, sizeof line, "O %.17g %s\n", hostTimeS, offCauseName(cause));
   append(line, std::min<int>(length, sizeof line - 1));
 }
 
@@ -167,8 +185,8 @@ void Recorder::appendOffFromSignal(double hostTimeS) const {
   RecordingWriter* writer = signalWriter_.load(std::memory_order_acquire);
   const int fd = writer ? writer->sealFromSignal() : -1;
   if (fd < 0) return;
-  // "\nO <seconds>.<nanoseconds>\n" by hand: snprintf is not async-signal-safe.
-  char text[48];
+  // "\nO <seconds>.<nanoseconds> signal\n" by hand: snprintf is not async-signal-safe.
+  char text[56];
   int n = 0;
   text[n++] = '\n';
   text[n++] = 'O';
@@ -186,6 +204,8 @@ void Recorder::appendOffFromSignal(double hostTimeS) const {
   while (d > 0) text[n++] = digits[--d];
   text[n++] = '.';
   for (uint64_t scale = 100000000; scale > 0; scale /= 10) text[n++] = static_cast<char>('0' + (nanos / scale) % 10);
+  text[n++] = ' ';
+  for (const char* c = offCauseName(OffCause::kSignal); *c != '\0'; ++c) text[n++] = *c;
   text[n++] = '\n';
   (void)writeFile(fd, text, static_cast<size_t>(n));
 }
@@ -275,9 +295,12 @@ bool readSessionFile(const std::string& path, const DeviceSpec& spec, SessionDat
            parseFloat(tokens[3], recorded.commandedForceN);
       if (ok) out.frames.push_back(recorded);
     } else if (tag == "O") {
-      double timeS = 0.0;
-      ok = tokens.size() == 1 && parseDouble(tokens[0], timeS) && std::isfinite(timeS);
-      if (ok) out.offTimesS.push_back(timeS);
+      // The cause is optional: files written before it was recorded have none.
+      RecordedOff off;
+      ok = (tokens.size() == 1 || tokens.size() == 2) && parseDouble(tokens[0], off.hostTimeS) &&
+           std::isfinite(off.hostTimeS);
+      if (ok && tokens.size() == 2) off.cause = tokens[1].substr(0, 32);
+      if (ok) out.offs.push_back(off);
     } else {
       error = reader.lineError("unknown record '" + tag.substr(0, 32) + "'");
       return false;

@@ -31,11 +31,27 @@ struct RecordedFrame {
   float commandedForceN = 0.0f;  // after ForceSafety
 };
 
+// Why the magnet was driven off: the word an off record carries (docs/record-format.md).
+enum class OffCause {
+  kStop,      // an orderly stop: the last FrictionOut of the slot went away (free, Cmd-., freeAll)
+  kQuit,      // the server quit (/quit): halted in order before its audio stopped
+  kClose,     // the device closed
+  kWatchdog,  // frames stopped without a stop
+  kFailure,   // the device thread failed (a backend threw)
+  kSignal,    // the server ended on a signal (the signal handler's record)
+};
+const char* offCauseName(OffCause cause);
+
+struct RecordedOff {
+  double hostTimeS = 0.0;
+  std::string cause;  // offCauseName's word; empty in files written before the cause was recorded
+};
+
 struct SessionData {
   DeviceSpec spec;
   std::vector<TimedReport> reports;
   std::vector<RecordedFrame> frames;
-  std::vector<double> offTimesS;  // host times the magnet was driven off
+  std::vector<RecordedOff> offs;  // when the magnet was driven off, and why
   std::string warning;            // e.g. a last line cut mid-way (dropped); empty if none
 };
 
@@ -59,7 +75,7 @@ class Recorder {
   bool open(const std::string& path, const DeviceSpec& spec, std::string& error);
   void writeReport(double hostTimeS, const MouseReport& report);
   void writeFrame(double hostTimeS, const ForceFrame& frame, float commandedForceN);
-  void writeOff(double hostTimeS);
+  void writeOff(double hostTimeS, OffCause cause);
   // Hands the lines written since to the writer (the file, or a threaded writer's queue).
   // False once the recording failed.
   bool flush();
@@ -79,8 +95,8 @@ class Recorder {
     return failed;
   }
 
-  // Async-signal-safe (no allocation, no stdio, no lock): appends an off record at hostTimeS
-  // with write(2), for the signal handlers that drive the magnet off on the way out. A blank
+  // Async-signal-safe (no allocation, no stdio, no lock): appends an off record at hostTimeS,
+  // cause signal, with write(2), for the signal handlers that drive the magnet off on the way out. A blank
   // line first, so the record stands on its own line whatever a write cut short left. The file
   // is sealed first (RecordingWriter::sealFromSignal): lines a threaded writer had not written
   // yet (at most its 10 ms period's) are lost with the process, never written after the record.

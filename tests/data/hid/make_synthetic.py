@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Writes the synthetic hid-recorder recordings of tests/data/hid/ from one known physical
-trajectory, as three mice would report it: a 125 Hz boot-like mouse with 8-bit axes, a 1 kHz
-gaming mouse with 12-bit axes and a 8 kHz gaming mouse with 16-bit axes (tests/data/hid/README.md
-says what each file is). Also writes the trajectory itself (synthetic-trajectory.csv), which the
+trajectory, as four mice would report it: a 125 Hz boot-like mouse with 8-bit axes, a 1 kHz
+gaming mouse with 12-bit axes, a 8 kHz gaming mouse with 16-bit axes and a 250 Hz wireless mouse
+that sends its buttons in a report of their own (tests/data/hid/README.md says what each file is). Also writes the trajectory itself (synthetic-trajectory.csv), which the
 tests and the report-rate bench compare the replayed position with.
 
     /usr/bin/python3 tests/data/hid/make_synthetic.py            # rewrites the files beside it
@@ -70,8 +70,8 @@ BOOT_DESCRIPTOR = [
 ]
 
 
-def boot_report(buttons, dx, dy):
-    return [buttons & 7] + le(dx, 1) + le(dy, 1) + [0]
+def boot_report(buttons, dx, dy, buttons_changed):
+    return [[buttons & 7] + le(dx, 1) + le(dy, 1) + [0]]
 
 
 # 1 kHz gaming mouse, report ID 2: 16 buttons, X and Y as 12-bit fields packed in 3 bytes
@@ -96,9 +96,9 @@ GAMING_12_DESCRIPTOR = [
 ]
 
 
-def gaming_12_report(buttons, dx, dy):
+def gaming_12_report(buttons, dx, dy, buttons_changed):
     packed = (dx & 0xFFF) | (dy & 0xFFF) << 12
-    return [0x02] + le(buttons, 2) + le(packed, 3) + [0, 0]
+    return [[0x02] + le(buttons, 2) + le(packed, 3) + [0, 0]]
 
 
 # 8 kHz gaming mouse, report ID 1: 5 buttons and 3 bits of padding, X and Y 16 bits (logical
@@ -124,8 +124,40 @@ GAMING_16_DESCRIPTOR = [
 ]
 
 
-def gaming_16_report(buttons, dx, dy):
-    return [0x01, buttons & 0x1F] + le(dx, 2) + le(dy, 2) + [0, 0]
+def gaming_16_report(buttons, dx, dy, buttons_changed):
+    return [[0x01, buttons & 0x1F] + le(dx, 2) + le(dy, 2) + [0, 0]]
+
+
+# 250 Hz wireless mouse that sends its buttons apart from its motion, in the layout of the Xiaomi
+# Mi Wireless Mouse's receiver (2717:003B; hid-tools' mouse tests describe it): report 1 holds 5
+# buttons, 3 bits of padding, a wheel and AC pan (8 bits each, logical -127..127), report 2 X and Y
+# (12 bits each, logical -2047..2047), and a consumer-control application holds media keys
+# (report 3, one bit each, and 4 bits of padding). Written for this project from the HID Usage
+# Tables (Generic Desktop 0x01, Button 0x09, Consumer 0x0C pages), not copied from any file.
+SPLIT_DESCRIPTOR = [
+    0x05, 0x01, 0x09, 0x02, 0xA1, 0x01,  # Generic Desktop, Mouse, Application
+    0x85, 0x01, 0x09, 0x01, 0xA1, 0x00,  # report ID 1: Pointer, Physical
+    0x05, 0x09, 0x19, 0x01, 0x29, 0x05, 0x15, 0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x05, 0x81, 0x02,  # 5 buttons
+    0x75, 0x03, 0x95, 0x01, 0x81, 0x01,  # 3 bits constant
+    0x05, 0x01, 0x09, 0x38, 0x15, 0x81, 0x25, 0x7F, 0x75, 0x08, 0x95, 0x01, 0x81, 0x06,  # wheel
+    0x05, 0x0C, 0x0A, 0x38, 0x02, 0x81, 0x06,  # AC pan
+    0xC0,
+    0x85, 0x02, 0x05, 0x01, 0x09, 0x01, 0xA1, 0x00,  # report ID 2: Pointer, Physical
+    0x09, 0x30, 0x09, 0x31, 0x16, 0x01, 0xF8, 0x26, 0xFF, 0x07, 0x75, 0x0C, 0x95, 0x02, 0x81, 0x06,  # X, Y
+    0xC0, 0xC0,
+    0x05, 0x0C, 0x09, 0x01, 0xA1, 0x01, 0x85, 0x03,  # Consumer Control, Application, report ID 3
+    0x15, 0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x04,  # 4 keys, one bit each:
+    0x09, 0xE9, 0x09, 0xEA, 0x09, 0xCD, 0x09, 0xB5, 0x81, 0x02,  # volume up, down, play/pause, next
+    0x95, 0x04, 0x81, 0x01,  # 4 bits constant
+    0xC0,
+]
+
+
+def split_reports(buttons, dx, dy, buttons_changed):
+    reports = [[0x01, buttons & 0x1F, 0, 0]] if buttons_changed else []
+    if (dx, dy) != (0, 0):
+        reports.append([0x02] + le((dx & 0xFFF) | (dy & 0xFFF) << 12, 3))
+    return reports
 
 
 # (file, name, rate Hz, count size mm, logical limit of a delta, descriptor, packer, extra
@@ -139,11 +171,16 @@ MICE = [
     ("synthetic-8khz-16bit-gaming.hid", "KF synthetic 8 kHz gaming mouse (16-bit X/Y)", 8000, 25.4 / 3200, 32767,
      GAMING_16_DESCRIPTOR, gaming_16_report,
      [(0.0205, [0x03, 0xE9, 0x00])]),  # a volume-up key of the consumer-control report
+    ("synthetic-250hz-split-buttons.hid", "KF synthetic 250 Hz mouse with buttons apart (Xiaomi layout)", 250,
+     25.4 / 1000, 2047, SPLIT_DESCRIPTOR, split_reports,
+     [(0.8502, [0x01, 0x00, 0x01, 0x00]),  # a wheel step: report 1 again, the buttons unchanged
+      (1.1002, [0x03, 0x01]), (1.1202, [0x03, 0x00])]),  # volume up pressed and released
 ]
 
 
 def events(rate_hz, count_mm, limit, pack):
-    """(time s, report bytes, saturated) of every report the mouse sends."""
+    """(time s, report bytes, saturated) of every report the mouse sends (pack gives the reports of
+    one poll: one for most mice, the buttons' and the motion's for one that sends them apart)."""
     out = []
     last_counts = (0, 0)
     last_buttons = 0
@@ -156,10 +193,13 @@ def events(rate_hz, count_mm, limit, pack):
         last_counts = counts  # a clipped excess is lost, not carried
         if (dx, dy) == (0, 0) and buttons == last_buttons:
             continue
+        buttons_changed = buttons != last_buttons
         last_buttons = buttons
         saturated = max(abs(dx), abs(dy)) >= limit
         dx, dy = (max(-limit, min(limit, d)) for d in (dx, dy))
-        out.append((t, pack(buttons, dx, dy), saturated))
+        reports = pack(buttons, dx, dy, buttons_changed)
+        for report in reports:  # the motion is in the last
+            out.append((t, report, saturated and report is reports[-1]))
     return out
 
 

@@ -69,7 +69,7 @@ TEST_CASE("board emulator: disarmed boards never drive, ARM needs its key", "[bo
   CHECK(reply[0] == kProtocolMajor);
 }
 
-TEST_CASE("board driver: set-points reach the board at 1 kHz once armed", "[board]") {
+TEST_CASE("board driver: set-points reach the board at 1 kHz once armed", "[board][wallclock]") {
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);
   backend->commandDrive(0.0, 0.8f, 0.5f);
@@ -103,7 +103,7 @@ TEST_CASE("board driver: set-points reach the board at 1 kHz once armed", "[boar
   CHECK(waitFor([&] { return bus->drive() == 0; }));
 }
 
-TEST_CASE("board driver: close sends drive 0, disarms, releases and closes", "[board]") {
+TEST_CASE("board driver: close sends drive 0, disarms, releases and closes", "[board][wallclock]") {
   auto bus = EmulatedUsb::create();
   auto backend = openBoard(bus);
   std::string error;
@@ -279,7 +279,7 @@ TEST_CASE("the real libusb opens, finds no board and says so", "[board][libusb]"
   CHECK_FALSE(backend.telemetry().connected);
 }
 
-TEST_CASE("a device with the board: frames drive it, the watchdog and close turn it off", "[board]") {
+TEST_CASE("a device with the board: frames drive it, the watchdog and close turn it off", "[board][wallclock]") {
   auto bus = EmulatedUsb::create();
   std::shared_ptr<UsbBoardBackend> board = openBoard(bus);
   std::string error;

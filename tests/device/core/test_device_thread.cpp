@@ -12,7 +12,7 @@
 using namespace kf;
 using namespace std::chrono_literals;
 
-TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, telemetry", "[thread]") {
+TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, telemetry", "[thread][wallclock]") {
   const DeviceSpec spec;
   auto sim = std::make_shared<SimDevice>(spec, SimParams{}, HandScript::speeds({{100.0, 5.0}}));
   auto sink = std::make_shared<CountingForceSink>();

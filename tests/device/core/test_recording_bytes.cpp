@@ -22,7 +22,7 @@ TEST_CASE("a recording's lines end in a bare newline, and only the same file is 
   MouseReport report;
   report.dxCounts = 3;
   recorder.writeReport(0.001, report);
-  recorder.writeOff(0.002);
+  recorder.writeOff(0.002, OffCause::kClose);
   REQUIRE(recorder.flush());
 
   Recorder second;

@@ -128,14 +128,14 @@ TEST_CASE("one writer per file, under any path", "[recording]") {
   Recorder first, second;
   std::string error;
   REQUIRE(first.open(path, DeviceSpec{}, error));
-  first.writeOff(0.5);
+  first.writeOff(0.5, OffCause::kClose);
   REQUIRE(first.flush());
   CHECK_FALSE(second.open(path, DeviceSpec{}, error));
   CHECK(contains(error, "another device is recording to this file"));
   REQUIRE(::symlink(path.c_str(), link.c_str()) == 0);
   CHECK_FALSE(second.open(link, DeviceSpec{}, error));
   // The refused open did not truncate the file being written.
-  CHECK(contains(readAll(path), "O 0.5\n"));
+  CHECK(contains(readAll(path), "O 0.5 close\n"));
 
   // Two device slots recording to one file: the second is refused.
   auto a = openSimDevice(DeviceSpec{}, SimParams{}, HandScript::none(), true);
@@ -185,16 +185,26 @@ TEST_CASE("an exception on the device thread drives the magnet off and is posted
   auto mouse = std::make_shared<ThrowingMouse>();
   auto force = std::make_shared<CountingForce>();
   Device device(DeviceSpec{}, mouse, force, false);
+  const std::string path = outputPath("failure.txt");
+  std::string error;
+  REQUIRE(device.startRecording(path, error));
   device.start();
+  // The thread drives the magnet off, then posts: its message says it has done both.
+  std::vector<std::string> messages;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (force->offs.load() == 0 && std::chrono::steady_clock::now() < deadline)
+  while (messages.empty() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    messages = takeMessages();
+  }
   CHECK(force->offs.load() == 1);
   CHECK(device.telemetry().lastCommandedForceN == Approx(DeviceSpec{}.minForceN));
-  const std::vector<std::string> messages = takeMessages();
   REQUIRE(messages.size() == 1);
   CHECK(contains(messages[0], "driver lost the device"));
   device.close();  // joins the ended thread
+  SessionData session;
+  REQUIRE(readSessionFile(path, DeviceSpec{}, session, error));
+  REQUIRE(session.offs.size() == 1);  // the recording ended with the failure
+  CHECK(session.offs[0].cause == "failure");
   setDeviceMessageSink(nullptr);
 }
 
@@ -212,11 +222,12 @@ TEST_CASE("emergencyOff: magnet off and an off record, without a lock", "[record
   device.emergencyOff();
   CHECK(force->signalOffs.load() == 1);
   const std::string text = readAll(path);
-  CHECK(contains(text, "\nO 1.500000000\n"));
+  CHECK(contains(text, "\nO 1.500000000 signal\n"));
   SessionData session;
   REQUIRE(readSessionFile(path, DeviceSpec{}, session, error));
-  REQUIRE(session.offTimesS.size() == 1);
-  CHECK(session.offTimesS[0] == Approx(1.5));
+  REQUIRE(session.offs.size() == 1);
+  CHECK(session.offs[0].hostTimeS == Approx(1.5));
+  CHECK(session.offs[0].cause == "signal");
   CHECK(session.frames.back().commandedForceN == Approx(1.4f));
 }
 
@@ -290,7 +301,7 @@ TEST_CASE("a signal handler's off record is the last line: the writer thread wri
   recorder.close();
   std::string text = readAll(path);
   while (!text.empty() && text.back() == '\n') text.pop_back();
-  CHECK(text.substr(text.rfind('\n') + 1) == "O 0.005500000");
+  CHECK(text.substr(text.rfind('\n') + 1) == "O 0.005500000 signal");
 }
 
 TEST_CASE("a realtime device's write error is posted once and the file keeps whole lines", "[recording]") {
@@ -330,8 +341,10 @@ TEST_CASE("a disk that falls behind stops the recording instead of the device th
   std::string lines = "R 1\n";
   REQUIRE(writer->hand(lines));
   CHECK(lines.empty());
-  // More than the queue holds in one hand-over: as a disk that stalled for half a minute.
-  std::string flood(RecordingWriter::kQueueBytes, 'x');
+  // More than the queue holds in one hand-over, even empty: as a disk that stalled for half a
+  // minute. (A flood of exactly the queue's size fitted whenever the writer had taken "R 1"
+  // meanwhile: it writes every 10 ms, and a loaded machine let it in between.)
+  std::string flood(RecordingWriter::kQueueBytes + 1, 'x');
   flood.back() = '\n';
   CHECK_FALSE(writer->hand(flood));
   CHECK(contains(writer->error(), "MiB behind"));

@@ -4,6 +4,7 @@
 
 #include "hid/HidMouseDecoder.hpp"
 #include "hid/HidReportDescriptor.hpp"
+#include "recordings/HidRecorderFile.hpp"
 #include "sim/DeterministicRandom.hpp"
 
 using namespace kf;
@@ -267,6 +268,40 @@ TEST_CASE("a receiver's descriptor with many report IDs: only the mouse report i
   HidMouseDelta other;
   for (const Bytes& report : {Bytes{0x03, 0xe9, 0x00, 0x00, 0x00}, Bytes{0x04, 0x01}, Bytes(20, 0x11)})
     CHECK_FALSE(decoder.decode(report.data(), report.size(), other));
+}
+
+TEST_CASE("a mouse that sends its buttons in a report of their own: decoded, not taken for another device's", "[hid]") {
+  // The Xiaomi Mi Wireless Mouse receiver's layout (tests/data/hid/README.md): buttons, wheel and
+  // AC pan in report 1, 12-bit X and Y in report 2, media keys in report 3 (another application).
+  HidRecording split;
+  std::string error;
+  REQUIRE(readHidRecorderFile(std::string(KF_HID_DATA_DIR) + "/synthetic-250hz-split-buttons.hid", split, error));
+  const HidMouseDecoder decoder = decoderFor(split.descriptor);
+  CHECK(decoder.mouseReportIds() == std::vector<uint8_t>{1, 2});
+  const HidMouseDelta buttons = decodeOk(decoder, {0x01, 0x05, 0x01, 0x00});  // left and middle, a wheel step
+  CHECK(buttons.hasButtons);
+  CHECK(buttons.buttons == 5);
+  CHECK(buttons.dxCounts == 0);
+  CHECK(buttons.dyCounts == 0);
+  const HidMouseDelta motion = decodeOk(decoder, {0x02, 0xfd, 0x2f, 0x00});  // dx -3, dy 2
+  CHECK_FALSE(motion.hasButtons);                                            // the buttons stay as report 1 left them
+  CHECK(motion.dxCounts == -3);
+  CHECK(motion.dyCounts == 2);
+  HidMouseDelta keys;
+  const Bytes report3 = {0x03, 0x01};
+  CHECK_FALSE(decoder.decode(report3.data(), report3.size(), keys));
+
+  // A gamepad's buttons beside a mouse (another application collection) are not the mouse's.
+  const Bytes mouseAndGamepad = {
+      0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x85, 0x01, 0x09, 0x01, 0xa1, 0x00, 0x05, 0x01, 0x09,
+      0x30, 0x09, 0x31, 0x15, 0x81, 0x25, 0x7f, 0x75, 0x08, 0x95, 0x02, 0x81, 0x06, 0xc0, 0xc0,  // mouse: X, Y, ID 1
+      0x05, 0x01, 0x09, 0x05, 0xa1, 0x01, 0x85, 0x02, 0x05, 0x09, 0x19, 0x01, 0x29, 0x08, 0x15,
+      0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x08, 0x81, 0x02, 0xc0};  // gamepad: 8 buttons, ID 2
+  const HidMouseDecoder withGamepad = decoderFor(mouseAndGamepad);
+  CHECK(withGamepad.mouseReportIds() == std::vector<uint8_t>{1});
+  const Bytes gamepadReport = {0x02, 0xff};
+  CHECK_FALSE(withGamepad.decode(gamepadReport.data(), gamepadReport.size(), keys));
+  CHECK_FALSE(decodeOk(withGamepad, {0x01, 0x01, 0x02}).hasButtons);
 }
 
 TEST_CASE("what a mouse does not use is skipped, not refused", "[hid]") {

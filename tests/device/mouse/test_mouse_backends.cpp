@@ -122,7 +122,7 @@ TEST_CASE("hidapi backend: a real mouse's whole recording, in real time, sums to
   CHECK(c.measuredRateHz < 1000);
 }
 
-TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid]") {
+TEST_CASE("hidapi backend: arrival stamps carry the injected jitter and no more", "[mouse][hid][wallclock]") {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.endS = 7.0;
@@ -280,8 +280,8 @@ TEST_CASE("evdev backend: SYN_DROPPED is counted, the broken packet dropped, the
   CHECK(flagged <= api->lastHandle->syncDropped());
 }
 
-TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on request resumes", "[mouse]", FakeHidApi,
-                   FakeEvdevApi) {
+TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on request resumes", "[mouse][wallclock]",
+                   FakeHidApi, FakeEvdevApi) {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.unplugAtS = 0.3;
@@ -469,4 +469,34 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   CHECK(sumOf(reports).reports == expected.reports);
   CHECK(sumOf(reports).x == expected.x);
   CHECK(sumOf(reports).y == expected.y);
+}
+
+TEST_CASE(
+    "hidapi backend: a mouse that sends its buttons apart (Xiaomi layout) has its presses read, held across "
+    "its X/Y reports",
+    "[mouse][hid]") {
+  FakeMouseScript script;
+  std::string error;
+  REQUIRE(readHidRecorderFile(std::string(KF_HID_DATA_DIR) + "/synthetic-250hz-split-buttons.hid", script.recording,
+                              error));
+  script.kernelQueue = 4096;
+  auto api = std::make_shared<FakeHidApi>(script);
+  auto backend = HidapiMouseBackend::open(api, "", error);
+  INFO(error);
+  REQUIRE(backend);
+  const auto reports = collectAll(*backend, *api->timeline);
+  // Report 1 (buttons, wheel, AC pan) and report 2 (X, Y) are both mouse reports; report 3 (the
+  // receiver's media keys) is not.
+  std::vector<uint32_t> steps;
+  uint32_t buttons = 0;
+  size_t movingWithLeft = 0;
+  for (const MouseReport& r : reports) {
+    if (r.buttons != buttons) steps.push_back(r.buttons);
+    buttons = r.buttons;
+    movingWithLeft += (r.dxCounts != 0 || r.dyCounts != 0) && r.buttons == 1;
+  }
+  CHECK(steps == std::vector<uint32_t>{1, 0, 1, 0, 2, 0});  // the file's presses (tests/data/hid/README.md)
+  CHECK(movingWithLeft > 0);  // the X/Y reports while the left button is held keep it held
+  CHECK(backend->counters().malformed == 2);
+  CHECK(reports.size() == api->timeline->played().size() - 2);
 }

@@ -56,7 +56,8 @@ TEST_CASE("record then replay gives identical reports", "[record]") {
   CHECK(session.reports.size() == original.size());
   CHECK(session.frames.size() == 1000);
   CHECK(session.frames[150].commandedForceN == Approx(0.44f));
-  CHECK(session.offTimesS.size() == 1);  // the close
+  REQUIRE(session.offs.size() == 1);
+  CHECK(session.offs[0].cause == "close");
 
   auto replayed = openReplayDevice(path, DeviceSpec{}, true, error);
   REQUIRE(replayed);
@@ -98,8 +99,51 @@ TEST_CASE("session files with damage give clear errors", "[record]") {
   CHECK(session.reports[0].report.dyCounts == -4);
   REQUIRE(session.frames.size() == 1);
   CHECK(std::isnan(session.frames[0].frame.forceN));
+  REQUIRE(session.offs.size() == 1);
+  CHECK(session.offs[0].cause.empty());  // written before off records said why: still read
+
+  write("kf-session 1 countMm=0.02\nO 0.2 stop now\n");
+  CHECK_FALSE(readSessionFile(path, spec, session, error));
+  CHECK(error.find(":2:") != std::string::npos);
 
   std::string replayError;
   CHECK_FALSE(openReplayDevice(outputPath("no-such-file"), spec, true, replayError));
   CHECK_FALSE(replayError.empty());
+}
+
+TEST_CASE("an off record says why the magnet went off: stop, watchdog, quit, close", "[record]") {
+  // The realtime test of the orderly stops (tests/realtime/test_orderly_off.py) tells the stop's
+  // off from a watchdog trip earlier in the scene by this word.
+  const std::string path = outputPath("off-causes.kfsession");
+  std::string error;
+  auto device = openSimDevice(DeviceSpec{}, SimParams{}, HandScript::none(), true, &error);
+  REQUIRE(device);
+  REQUIRE(device->startRecording(path, error));
+  int ms = 0;
+  auto frames = [&](int count) {
+    for (int i = 0; i < count; ++i, ++ms) {
+      device->pushForceFrame({ms * 0.001, 1.0f});
+      device->pump((ms + 1) * 0.001);
+    }
+  };
+  auto silence = [&](double seconds) {
+    for (const int end = ms + static_cast<int>(seconds * 1000.0); ms < end; ++ms) device->pump((ms + 1) * 0.001);
+  };
+  frames(100);
+  device->requestOff();  // the last FrictionOut of the slot went away
+  silence(0.05);
+  frames(100);
+  silence(2.0 * DeviceSpec{}.watchdogS + 0.01);  // frames stop without a stop
+  frames(100);
+  device->haltInOrder();  // the server's /quit
+  device->close();
+
+  SessionData session;
+  REQUIRE(readSessionFile(path, DeviceSpec{}, session, error));
+  std::vector<std::string> causes;
+  for (const RecordedOff& off : session.offs) causes.push_back(off.cause);
+  CHECK(causes == std::vector<std::string>{"stop", "watchdog", "quit", "close"});
+  REQUIRE(session.offs.size() == 4);
+  CHECK(session.offs[0].hostTimeS == Approx(0.1));
+  CHECK(session.offs[1].hostTimeS > 0.25);
 }

@@ -64,7 +64,8 @@ std::unique_ptr<Synth> chainSynth(FakeServer& server, ChainWatch& watch) {
   return synth;
 }
 
-// Every interpolation at audio and control rate, a moving origin, and the bad inputs.
+// Every interpolation at audio and control rate, a moving origin, and the bad inputs; and
+// FrictionButtons of slot 0 at both rates and of bad slots.
 std::unique_ptr<Synth> mouseModesSynth(FakeServer& server) {
   auto synth = server.newSynth("mouse modes");
   const auto& mouse = server.unitDef("FrictionMouseIn");
@@ -78,6 +79,11 @@ std::unique_ptr<Synth> mouseModesSynth(FakeServer& server) {
   synth->add(mouse, ar, {c(-1), c(0), c(1)}, 4, "device -1");
   synth->add(mouse, ar, {c(kNaN), c(0), c(1)}, 4, "device NaN");
   synth->add(mouse, kr, {c(16), c(0), c(1)}, 4, "device 16");
+  const auto& buttons = server.unitDef("FrictionButtons");
+  synth->add(buttons, kr, {c(0)}, 3, "buttons of device 0, control rate");
+  synth->add(buttons, ar, {c(0)}, 3, "buttons of device 0, audio rate");
+  synth->add(buttons, kr, {c(kNaN)}, 3, "buttons of device NaN");
+  synth->add(buttons, kr, {c(5)}, 3, "buttons of device 5 (none open)");
   return synth;
 }
 
@@ -286,6 +292,7 @@ std::unique_ptr<Synth> slot1Synth(FakeServer& server) {
   auto synth = server.newSynth("slot 1");
   synth->add(server.unitDef("FrictionMouseIn"), ar, {c(1), c(0), c(2)}, 4, "device 1, predictive");
   synth->add(server.unitDef("FrictionMouseIn"), kr, {c(1), c(0), c(1)}, 4, "device 1, linear");
+  synth->add(server.unitDef("FrictionButtons"), kr, {c(1)}, 3, "buttons of device 1");
   synth->add(server.unitDef("FrictionOut"), ar, {c(1), c(0.8f)}, 1, "device 1, constant force");
   return synth;
 }

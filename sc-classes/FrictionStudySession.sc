@@ -1,0 +1,466 @@
+// One participant's session of a FrictionStudy, run on a server: the session folder and the run.
+//
+// The folder (folder/participant): manifest.json (study, participant, order, seed, date, the
+// project's version, the device with its settings, board and calibration, sample rate and the
+// latencies in use), session.csv (start, resume, finish, abort), answers.csv (one line per answer,
+// written and flushed as it is given), and per condition a folder NN-name (NN its place in the
+// order) with device.kfsession (the device recording), audio.wav (the participant's audio as
+// heard) and events.csv (prepare, start, pause, resume, done, end... with times in s from its
+// prepare line). A condition cut short (a crash, a kill, repeat) keeps its folder as it was and
+// runs again into NN-name-attemptK (K = 2, 3, ...): the last attempt is the condition's.
+//
+// Everything is checked before the first participant sees anything (the study, the code, the
+// folder, the server, the channels, the device): a refusal is an Error with the reason.
+FrictionStudySession {
+	classvar <answersHeader, <eventsHeader, <trialsHeader;
+	var <study, <participant, <folder, <server, <participantIndex, <seed, <device, <simulated, <windows;
+	var <participantOut, <experimenterOut, <deviceIndex;
+	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
+	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
+	var <participantWindow, <experimenterWindow, <>onEnd;
+	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
+	var buttonsSynth, buttonsResponder;
+	var routine;
+
+	*initClass {
+		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
+		eventsHeader = #[timeS, event, detail, wallTime];
+		trialsHeader = #[participant, position, condition, attempt, trial, level, target, answer, correct, startS,
+			interval1S, interval2S, answerS, wallTime];
+	}
+
+	// study: a FrictionStudy. participant: a code (letters, digits, _ and -), never used before in
+	// root (the folder the sessions go into). server: booted, with outputs for both pairs.
+	// participantIndex: the participant's number (the Latin square's row). seed: of a random order
+	// (nil: drawn, and kept in the manifest). device: an open FrictionDevice, or simulated: a
+	// FrictionStudySimParticipant (a simulated device opened per condition in deviceIndex).
+	// windows: show the participant's and the experimenter's windows. participantOut and
+	// experimenterOut: the first channels of the two output pairs.
+	*new { |study, participant, root, server, participantIndex = 0, seed, device, simulated, windows = true,
+		participantOut = 0, experimenterOut = 2, deviceIndex = 0|
+		^super.new.prInit(study, participant, root, server, participantIndex, seed, device, simulated, windows,
+			participantOut, experimenterOut, deviceIndex, false)
+	}
+
+	// The session in sessionFolder (made by FrictionStudy.run) again, from the condition it was in;
+	// study must be the one it was started with (its name and conditions are compared).
+	*resume { |study, sessionFolder, server, device, simulated, windows = true, participantOut = 0,
+		experimenterOut = 2, deviceIndex = 0|
+		var manifest, path = sessionFolder.asString.standardizePath +/+ "manifest.json";
+		if(File.exists(path).not) {
+			Error("FrictionStudySession.resume: no session in % (no manifest.json)".format(sessionFolder)).throw
+		};
+		manifest = File.readAllString(path).parseJSON;
+		if(study.isKindOf(FrictionStudy).not or: { manifest["study"]["name"] != study.name }) {
+			Error("FrictionStudySession.resume: the session in % is of the study %, not %".format(
+				sessionFolder, manifest["study"]["name"].cs, study !? { study.name.cs })).throw
+		};
+		^super.new.prInit(study, manifest["participant"], sessionFolder.asString.standardizePath.dirname, server,
+			manifest["participantIndex"].asInteger, manifest["seed"].asInteger, device, simulated, windows,
+			participantOut, experimenterOut, deviceIndex, true).prResume(manifest)
+	}
+
+	// ---- control: from the windows, keys, or code ----
+
+	// The participant (or by: \window, \key, \button (a puck button), \code) is done exploring.
+	// During the introduction, it ends the introduction.
+	done { |by = \participant|
+		if((state == \running and: { paused.not }) or: { state == \introduction }) { endedBy = by; ending = \done }
+	}
+	// The experimenter ends the condition (its questions follow).
+	next { this.done(\experimenter) }
+	// The condition runs again from its start (what it wrote is kept as an attempt).
+	repeat { if(state == \running) { ending = \repeat } }
+	abort { if(state == \running or: { state == \questions } or: { state == \introduction }) { ending = \abort } }
+	// Pauses (the pilot stops: the magnet at rest, nothing heard) or goes on.
+	pause { |on = true|
+		if(state != \running or: { on == paused }) { ^this };
+		paused = on;
+		if(on) { pauseT0 = Main.elapsedTime; pilot.free; this.log(\pause) } {
+			pausedS = pausedS + (Main.elapsedTime - pauseT0);
+			pilot.play;
+			this.log(\resume)
+		};
+	}
+	// The answer to the question asked now (checked by it; an Error if it does not fit).
+	answer { |value, source = \participant|
+		if(state != \questions or: { question.isNil }) {
+			Error("FrictionStudySession: no question is asked now").throw
+		};
+		answerValue = [question.check(value), source];
+	}
+
+	// ---- what it is at ----
+
+	isOver { ^[\finished, \aborted, \failed].includes(state) }
+	conditionCount { ^order.size }
+	// Time in the condition (s), pauses left out.
+	elapsedS {
+		if(conditionT0.isNil) { ^0 };
+		^Main.elapsedTime - conditionT0 - pausedS - if(paused) { Main.elapsedTime - pauseT0 } { 0 }
+	}
+
+	// Starts the session (a new one; resume starts itself).
+	start {
+		if(state != \ready) { ^this };
+		this.prWriteManifest;
+		this.prSessionLog(\start, "");
+		this.prPlay;
+	}
+
+	// A line in the condition's events.csv, with the time since its prepare line.
+	log { |event, detail = ""|
+		conditionDir !? {
+			FrictionStudyFiles.appendCsv(conditionDir +/+ "events.csv",
+				[this.prLogTime, event, detail, FrictionStudyFiles.now], eventsHeader)
+		}
+	}
+
+	prLogTime { ^(Main.elapsedTime - (preparedT0 ? Main.elapsedTime)).round(0.001) }
+
+	printOn { |stream| stream << this.class.name << "(" << participant.cs << ", " << state << ")" }
+
+	// ---- the run ----
+
+	prPlay {
+		routine = Routine {
+			var result;
+			try {
+				SynthDef(\frictionStudyListen, { Out.ar(\out.kr(2), In.ar(\in.kr(0), 2)) }).add;
+				// A press of any of the puck's buttons (FrictionButtons) is the participant's "done".
+				SynthDef(\frictionStudyButtons, {
+					SendReply.kr(FrictionButtons.kr(\device.kr(0)).sum > 0, '/kfStudyButton', 1)
+				}).add;
+				server.sync;
+				if(windows) {
+					participantWindow = FrictionStudyParticipantWindow(this);
+					experimenterWindow = FrictionStudyExperimenterWindow(this);
+				};
+				if(position == 0 and: { simulated.isNil } and: { windows }) { this.prIntroduction };
+				while { position < order.size and: { this.isOver.not } } {
+					condition = order[position];
+					result = this.prRunCondition;
+					switch(result,
+						\end, { position = position + 1 },
+						\abort, { state = \aborted; this.prSessionLog(\abort, condition.name) }
+					);
+				};
+				if(this.isOver.not) { state = \finished; this.prSessionLog(\finish, "") };
+			} { |error|
+				state = \failed;
+				this.prSessionLog(\error, error.errorString);
+				error.reportError;
+			};
+			participantWindow !? { participantWindow.showEnd };
+			experimenterWindow !? { experimenterWindow.refresh };
+			onEnd.value(this);
+		}.play(AppClock);
+	}
+
+	prIntroduction {
+		state = \introduction;
+		ending = nil;
+		participantWindow.showInstruction(study.introduction, "I am ready to begin");
+		while { ending.isNil } { 0.05.wait };
+		if(ending == \abort) { state = \aborted; this.prSessionLog(\abort, "introduction") };
+	}
+
+	prRunCondition {
+		var s = condition.settings;
+		preparedT0 = Main.elapsedTime;
+		conditionT0 = nil;
+		pausedS = 0;
+		paused = false;
+		attempt = this.prLastAttempt(position) + 1;
+		conditionDir = this.prConditionDir(position, attempt);
+		File.mkdir(conditionDir);
+		this.log(\prepare, condition.name);
+		state = \preparing;
+		conditionDevice = if(simulated.notNil) {
+			FrictionDevice.sim(server, deviceIndex, simulated.handFor(condition), replace: true)
+		} { device };
+		conditionDevice.record(conditionDir +/+ "device.kfsession");
+		this.log(\recordDevice);
+		if(condition.isThreshold) { ^this.prRunThreshold };
+		pilot = FrictionPilot(conditionDevice, s[\mapping], s[\friction], s[\origin], if(s[\audio]) { s[\amp] } { 0 },
+			participantOut);
+		pilot.play;
+		server.sync;
+		listenSynth = Synth.after(pilot.synth, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
+		buttonsSynth = Synth.tail(server, \frictionStudyButtons, [\device, conditionDevice.index]);
+		buttonsResponder = OSCFunc({ this.done(\button) }, '/kfStudyButton', server.addr,
+			argTemplate: [buttonsSynth.nodeID]);
+		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
+		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
+		server.sync;
+		while { recorder.isRecording.not } { 0.01.wait };
+		this.log(\recordAudio);
+		coverage = study.coverageFor(condition);
+		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: s[\friction], audio: s[\audio]);
+		// 50 frames a second; the cells between two frames are covered too (FrictionStudyCoverage).
+		lastPositionMm = nil;
+		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m, resumed| this.prFrame(m, resumed) });
+		participantWindow !? { participantWindow.showInstruction(condition.instruction) };
+		experimenterWindow !? { experimenterWindow.showCondition };
+		ending = nil;
+		endedBy = nil;
+		conditionT0 = Main.elapsedTime;
+		state = \running;
+		this.log(\start, condition.name);
+		while { ending.isNil } {
+			0.05.wait;
+			if(paused.not) {
+				if(simulated.notNil and: { simulated.isDone(coverage, this.elapsedS, condition) }) {
+					this.done(\participant)
+				};
+				if(ending.isNil and: { this.elapsedS >= condition.maxTimeS }) { ending = \maxTime; endedBy = \time };
+			};
+		};
+		state = \stopping;
+		this.log(ending, endedBy ? "");
+		this.log(\coverage, coverage.fraction.round(0.001));
+		recorder.stopRecording;
+		monitor.free;
+		listenSynth.free;
+		buttonsResponder.free;
+		buttonsSynth.free;
+		pilot.free;
+		server.sync;
+		conditionDevice.stopRecording;
+		if(simulated.notNil) { conditionDevice.close };
+		server.sync;
+		if(ending == \repeat or: { ending == \abort }) { ^ending };
+		^this.prQuestions
+	}
+
+	// The questions after a condition, each answer written and flushed as it is given.
+	prQuestions {
+		state = \questions;
+		condition.questions.do { |q|
+			if(ending != \abort) {
+				question = q;
+				answerValue = nil;
+				participantWindow !? { participantWindow.ask(q) };
+				experimenterWindow !? { experimenterWindow.refresh };
+				if(simulated.notNil) { this.answer(simulated.answer(q, this.prStats), \simulated) };
+				while { answerValue.isNil and: { ending != \abort } } { 0.05.wait };
+				if(answerValue.notNil) {
+					FrictionStudyFiles.appendCsv(folder +/+ "answers.csv", [participant, position + 1, condition.name,
+						attempt, q.key, q.kind, answerValue[0], answerValue[1], this.prLogTime,
+						FrictionStudyFiles.now], answersHeader);
+					this.log(\answer, q.key);
+				};
+			}
+		};
+		question = nil;
+		if(ending == \abort) { this.log(\abort); ^\abort };
+		this.log(\end, condition.name);
+		^\end
+	}
+
+	// A threshold condition: the experiment's trials (each a line of trials.csv, flushed), its
+	// estimate in the events, then the questions. The experiment plays on the participant's pair. A
+	// simulated participant answers through the condition's makeObserver, or its own observer for
+	// the experiment's kind; the experiment and the observer (its known threshold) are logged.
+	prRunThreshold {
+		var experiment = condition.makeExperiment.value, estimate, how, right = 0, count = 0;
+		how = if(simulated.notNil) {
+			condition.makeObserver !? { |make| make.value(simulated.seed) } ?? {
+				if(experiment.respondsTo(\kind).not) {
+					Error("threshold condition %: no makeObserver, and the experiment has no kind for the simulated "
+						"participant's observer".format(condition.name)).throw
+				};
+				simulated.observerFor(experiment.kind)
+			}
+		} { condition.answers };
+		if(experiment.respondsTo(\asEvent)) { this.log(\experiment, FrictionStudyFiles.json(experiment.asEvent)) };
+		if(how.respondsTo(\asEvent)) { this.log(\observer, FrictionStudyFiles.json(how.asEvent)) };
+		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
+		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
+		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
+		server.sync;
+		while { recorder.isRecording.not } { 0.01.wait };
+		this.log(\recordAudio);
+		coverage = study.coverageFor(condition);
+		participantWindow !? {
+			participantWindow.showInstruction(condition.instruction);
+			participantWindow.doneButton.visible = false;  // the experiment ends it
+		};
+		experimenterWindow !? { experimenterWindow.refresh };
+		ending = nil;
+		endedBy = nil;
+		conditionT0 = Main.elapsedTime;
+		state = \running;
+		this.log(\start, condition.name);
+		estimate = experiment.run(conditionDevice, how, { |trial|
+			FrictionStudyFiles.appendCsv(folder +/+ "trials.csv", [participant, position + 1, condition.name, attempt]
+				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
+					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
+			this.log(\trial, trial[\trial]);
+			count = count + 1;
+			if(trial[\correct] == true) { right = right + 1 };
+		}, nil, participantOut);
+		endedBy = \procedure;
+		this.log(\done, \procedure);
+		this.log(\estimate, FrictionStudyFiles.json(estimate));
+		stats = (trials: count, correct: right);
+		state = \stopping;
+		recorder.stopRecording;
+		listenSynth.free;
+		server.sync;
+		conditionDevice.stopRecording;
+		if(simulated.notNil) { conditionDevice.close };
+		server.sync;
+		^this.prQuestions
+	}
+
+	prFrame { |m, resumed|
+		var area = condition.areaMm;
+		if(resumed == true) { lastPositionMm = nil };
+		coverage.add(lastPositionMm ? m.positionMm, m.positionMm, m.speedMmPerS);
+		lastPositionMm = m.positionMm;
+		if(m.positionMm >= area[0] and: { m.positionMm < area[1] }) {
+			stats[\speedSum] = stats[\speedSum] + m.speedMmPerS.abs;
+			stats[\speedCount] = stats[\speedCount] + 1;
+		};
+		m.commandedForceN !? { |f| stats[\maxForceN] = max(stats[\maxForceN], f) };
+		experimenterWindow !? { experimenterWindow.frame };
+	}
+
+	prStats {
+		if(stats[\trials].notNil) { ^stats.copy };
+		^(meanSpeedMmPerS: stats[\speedSum] / max(1, stats[\speedCount]), maxForceN: stats[\maxForceN],
+			coverage: coverage.fraction, friction: stats[\friction], audio: stats[\audio])
+	}
+
+	// The folder of attempt (1, 2, ...) of the condition at k in the order.
+	prConditionDir { |k, attempt = 1|
+		var dir = folder +/+ "%-%".format((k + 1).asString.padLeft(2, "0"), order[k].name);
+		^if(attempt > 1) { dir ++ "-attempt" ++ attempt } { dir }
+	}
+
+	// The last attempt made at the condition at k (0: none).
+	prLastAttempt { |k|
+		var n = 0;
+		while { File.exists(this.prConditionDir(k, n + 1)) } { n = n + 1 };
+		^n
+	}
+
+	prSessionLog { |event, detail|
+		FrictionStudyFiles.appendCsv(folder +/+ "session.csv",
+			[Main.elapsedTime.round(0.001), event, detail, FrictionStudyFiles.now], eventsHeader);
+	}
+
+	prWriteManifest {
+		var dev = device, manifest;
+		manifest = (
+			study: study.asEvent, participant: participant, participantIndex: participantIndex, seed: seed,
+			order: order.collect(_.name), date: FrictionStudyFiles.now, version: this.class.projectVersion,
+			sampleRateHz: server.sampleRate, blockSize: server.options.blockSize,
+			hardwareBufferSize: server.options.hardwareBufferSize, messageLatencyS: server.latency,
+			participantOut: participantOut, experimenterOut: experimenterOut,
+			device: if(dev.notNil) {
+				(kind: dev.kind, index: dev.index, specs: dev.specs, overrides: dev.overrides,
+					source: dev.source.asString, board: dev.boardSetup !? { |b|
+						(serial: b[\serial], emulate: b[\emulate], calibration: b[\calibration].asString)
+					}, audioDelayS: dev.audioDelay)
+			} {
+				(kind: \sim, index: deviceIndex, specs: FrictionDevice.paperSpecs, board: nil,
+					source: "FrictionHand.explore of the simulated participant, one device per condition",
+					audioDelayS: FrictionPilot.paperAudioDelayS)
+			},
+			simulatedParticipant: simulated !? { simulated.asEvent }
+		);
+		FrictionStudyFiles.writeText(folder +/+ "manifest.json", FrictionStudyFiles.json(manifest) ++ "\n");
+	}
+
+	// The project's version (the extension folder's quark file), or "unknown".
+	*projectVersion {
+		var path = KineticFriction.extensionDir +/+ "KineticFriction.quark";
+		^if(File.exists(path)) { File.readAllString(path).interpret[\version] } { "unknown" }
+	}
+
+	prResume { |manifest|
+		var names = manifest["order"];
+		if(names.size != order.size or: { names.any { |n| study.conditionNamed(n.asSymbol).isNil } }) {
+			Error("FrictionStudySession.resume: the session's conditions % are not the study's %".format(
+				names, study.conditions.collect(_.name))).throw
+		};
+		order = names.collect { |n| study.conditionNamed(n.asSymbol) };
+		// The first condition without its end: the one the session was in.
+		position = order.size;
+		order.do { |c, k|
+			var events = this.prConditionDir(k, this.prLastAttempt(k)) +/+ "events.csv";
+			if(position == order.size and: {
+				File.exists(events).not or: { File.readAllString(events).contains("\"end\"").not }
+			}) { position = k }
+		};
+		this.prSessionLog(\resume, "at % of %".format(position + 1, order.size));
+		this.prPlay;
+	}
+
+	prInit { |argStudy, argParticipant, root, argServer, argIndex, argSeed, argDevice, argSimulated, argWindows,
+		argParticipantOut, argExperimenterOut, argDeviceIndex, resuming|
+		var where = "FrictionStudy.%".format(if(resuming) { "resume" } { "run" }), channels;
+		if(argStudy.isKindOf(FrictionStudy).not) { Error("%: study must be a FrictionStudy".format(where)).throw };
+		participant = argParticipant.asString;
+		if(participant.isEmpty or: { participant.every { |c| c.isAlphaNum or: { "_-".includes(c) } }.not }) {
+			Error("%: the participant code must be letters, digits, _ and -, got %".format(where,
+				argParticipant.cs)).throw
+		};
+		FrictionStudyFiles.checkWritable(root, where);
+		folder = root.standardizePath +/+ participant;
+		if(resuming.not and: { File.exists(folder) }) {
+			Error("%: participant code % already has a session in %; resume it (FrictionStudy.resume) or choose "
+				"another code".format(where, participant, folder)).throw
+		};
+		if(argDevice.notNil == argSimulated.notNil) {
+			Error("%: give either device (an open FrictionDevice) or simulated (a FrictionStudySimParticipant)".format(
+				where)).throw
+		};
+		if(argDevice.notNil and: { argDevice.isKindOf(FrictionDevice).not or: { argDevice.isOpen.not } }) {
+			Error("%: device must be an open FrictionDevice, got %".format(where, argDevice)).throw
+		};
+		if(argSimulated.notNil and: { argSimulated.isKindOf(FrictionStudySimParticipant).not }) {
+			Error("%: simulated must be a FrictionStudySimParticipant, got %".format(where, argSimulated)).throw
+		};
+		if(argServer.isKindOf(Server).not) {
+			Error("%: server must be a Server, got %".format(where, argServer)).throw
+		};
+		FrictionCheck.serverRunning(argServer, where);
+		[\participantOut, argParticipantOut, \experimenterOut, argExperimenterOut].pairsDo { |name, bus|
+			if(bus.isInteger.not or: { bus < 0 }) {
+				Error("%: % must be an Integer >= 0, got %".format(where, name, bus)).throw
+			}
+		};
+		if((argParticipantOut - argExperimenterOut).abs < 2) {
+			Error("%: the participant's pair (%, %) and the experimenter's (%, %) overlap".format(where,
+				argParticipantOut, argParticipantOut + 1, argExperimenterOut, argExperimenterOut + 1)).throw
+		};
+		channels = argServer.options.numOutputBusChannels;
+		if(max(argParticipantOut, argExperimenterOut) + 2 > channels) {
+			Error("%: the server has % output channels; the pairs at % and % need % (set "
+				"s.options.numOutputBusChannels and reboot)".format(where, channels, argParticipantOut,
+					argExperimenterOut, max(argParticipantOut, argExperimenterOut) + 2)).throw
+		};
+		if(argIndex.isInteger.not or: { argIndex < 0 }) {
+			Error("%: participantIndex must be an Integer >= 0, got %".format(where, argIndex)).throw
+		};
+		if(argSeed.notNil and: { argSeed.isInteger.not }) {
+			Error("%: seed must be an Integer or nil".format(where)).throw
+		};
+		study = argStudy;
+		server = argServer;
+		participantIndex = argIndex;
+		seed = argSeed ?? { 2147483647.rand };
+		device = argDevice;
+		simulated = argSimulated;
+		windows = FrictionCheck.boolean(argWindows, "windows", where);
+		participantOut = argParticipantOut;
+		experimenterOut = argExperimenterOut;
+		deviceIndex = argDeviceIndex;
+		order = study.conditionsFor(participantIndex, seed);
+		File.mkdir(folder);
+		if(File.exists(folder).not) { Error("%: the folder % cannot be made".format(where, folder)).throw };
+	}
+}

@@ -1,0 +1,175 @@
+// A ready-made threshold experiment on a FrictionDevice: two-interval forced choice trials whose
+// levels a procedure (FrictionStaircase, FrictionQuestPlus, FrictionConstantStimuli) chooses.
+// Each trial plays the reference and the target (the reference changed by the level) in two
+// intervals, in an order drawn from the experiment's seed; the answer (which interval held the
+// target) comes from the keys (1 or 2, a small window, or `answer` from code), the puck's
+// buttons (left 1, right 2: FrictionButtons) or a model observer (FrictionObserver). The three
+// experiments (FrictionThresholdStimuli): *force (a friction-level difference, N), *asynchrony
+// (how late the sound may come after the force, ms) and *grating (a grating period difference, mm).
+FrictionThreshold {
+	var <kind, <procedure, <settings, <intervalS, <gapS, <seed;
+	// false: with \keys, no window of its own; the answers come through `answer` (a study's window).
+	var <>showKeysWindow = true;
+	var rng, answered, givenAnswer, keysWindow, buttonsResponder, buttonsSynth;
+
+	// base: the reference's force (N) above which the target adds the level.
+	*force { |procedure, baseForceN = 0.3, intervalS = 1.5, gapS = 0.5, seed|
+		^this.new(\force, procedure, (baseForceN: baseForceN), intervalS, gapS, seed)
+	}
+
+	// The pilot's sound and friction (FrictionPilot.ar, mapping of Table 1): the reference with the
+	// device's audioDelay (sound and touch together), the target with the sound level ms later.
+	*asynchrony { |procedure, mapping = \mapping2, amp = 0.5, intervalS = 1.5, gapS = 0.5, seed|
+		^this.new(\asynchrony, procedure,
+			(samplesPerMm: FrictionCheck.samplesPerMm(mapping, "FrictionThreshold.asynchrony"), amp: amp),
+			intervalS, gapS, seed)
+	}
+
+	// A grating (FrictionPattern.grating) of periodMm in the reference, periodMm + level in the target.
+	*grating { |procedure, periodMm = 2, duty = 0.5, loForceN = 0.14, hiForceN = 0.8, intervalS = 1.5, gapS = 0.5,
+		seed|
+		^this.new(\grating, procedure, (periodMm: periodMm, duty: duty, loForceN: loForceN, hiForceN: hiForceN),
+			intervalS, gapS, seed)
+	}
+
+	*new { |kind, procedure, settings, intervalS = 1.5, gapS = 0.5, seed|
+		^super.new.prInit(kind, procedure, settings, intervalS, gapS, seed)
+	}
+
+	prInit { |argKind, argProcedure, argSettings, argIntervalS, argGapS, argSeed|
+		var where = "FrictionThreshold";
+		if(FrictionThresholdStimuli.kinds.includes(argKind).not) {
+			Error("%: kind must be one of %, got %".format(where, FrictionThresholdStimuli.kinds, argKind)).throw
+		};
+		if(#[next, respond, isFinished, estimate, trials].every { |m| argProcedure.respondsTo(m) }.not) {
+			Error("%: procedure must be a procedure (next, respond, estimate...), got %".format(where,
+				argProcedure)).throw
+		};
+		argSettings.keysValuesDo { |key, value| FrictionCheck.finite(value, key, where) };
+		[\intervalS, argIntervalS, \gapS, argGapS].pairsDo { |name, s|
+			FrictionCheck.finite(s, name, where);
+			if(s <= 0) { Error("%: % must be > 0 s, got %".format(where, name, s)).throw }
+		};
+		kind = argKind;
+		procedure = argProcedure;
+		settings = argSettings;
+		intervalS = argIntervalS;
+		gapS = argGapS;
+		seed = argSeed ?? { 2147483647.rand };
+		rng = FrictionObserver.randomSource(seed);
+	}
+
+	// The hand of a simulated device that strokes back and forth over strokeMm at speedMmPerS
+	// for durationS: the puck moves during every interval, as a participant's hand would.
+	*hand { |durationS = 60, strokeMm = 40, speedMmPerS = 80|
+		var strokeS = strokeMm / speedMmPerS;
+		^FrictionHand.path(Array.fill((durationS / strokeS).ceil.asInteger + 1, { |i|
+			[i * strokeS, if(i.odd) { strokeMm } { 0 }]
+		}))
+	}
+
+	// Runs the trials until the procedure is finished, inside a Routine. answers: \keys, \buttons
+	// or a FrictionObserver. onTrial: called with an Event per trial (trial, level, target (the
+	// interval of the target, 1 or 2), answer, correct, startS, interval1S, interval2S, answerS:
+	// s from the run's start). out: the first of two output channels (the asynchrony's sound).
+	// Returns the procedure's estimate (and passes it to onEnd).
+	run { |device, answers = \keys, onTrial, onEnd, out = 0|
+		var where = "FrictionThreshold.run", server, def, synth, buffer, loaded, startS, level, estimate;
+		if(thisThread.isKindOf(Routine).not) { Error("%: call it inside a Routine (fork)".format(where)).throw };
+		if(device.isKindOf(FrictionDevice).not) {
+			Error("%: device must be a FrictionDevice, got %".format(where, device)).throw
+		};
+		if(answers != \keys and: { answers != \buttons } and: { answers.isKindOf(FrictionObserver).not }) {
+			Error("%: answers must be \\keys, \\buttons or a FrictionObserver, got %".format(where, answers)).throw
+		};
+		server = FrictionCheck.serverRunning(device.server, where);
+		def = FrictionThresholdStimuli.synthDef(kind, device, settings).add;
+		if(kind == \asynchrony) {
+			// The signal is sent in parts: the run starts once all of it is on the server.
+			loaded = Condition(false);
+			buffer = FrictionPilot.loadSignal(server, { loaded.test = true; loaded.signal });
+			loaded.wait
+		};
+		answered = Condition(false);
+		this.prStartAnswers(answers, device);
+		server.sync;
+		server.bind { synth = Synth(def.name, [\out, out, \bufnum, buffer !? _.bufnum ? 0]) };
+		startS = thisThread.seconds;
+		while { (level = procedure.next).notNil } {
+			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
+				target: target, startS: thisThread.seconds - startS);
+			[1, 2].do { |interval|
+				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
+				server.bind { synth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
+				intervalS.wait;
+				server.bind { synth.set(\active, 0) };
+				gapS.wait
+			};
+			trial[\answer] = this.prAwaitAnswer(answers, level, target);
+			trial[\answerS] = thisThread.seconds - startS;
+			trial[\correct] = trial[\answer] == target;
+			procedure.respond(level, trial[\correct]);
+			onTrial.value(trial)
+		};
+		server.bind { synth.free };
+		// The bundles play server.latency after they are sent: the synth is gone when run returns.
+		(server.latency ? 0).wait;
+		this.prStopAnswers;
+		buffer !? { buffer.free };
+		estimate = procedure.estimate;
+		onEnd.value(estimate);
+		^estimate
+	}
+
+	// The answer of the trial waiting for one: which interval (1 or 2) held the target. The keys'
+	// window and the buttons call it; so may any window of a study.
+	answer { |interval|
+		if(interval != 1 and: { interval != 2 }) {
+			Error("FrictionThreshold.answer: interval must be 1 or 2, got %".format(interval)).throw
+		};
+		if(answered.notNil and: { answered.test.not }) {
+			givenAnswer = interval;
+			answered.test = true;
+			answered.signal
+		}
+	}
+
+	prAwaitAnswer { |answers, level, target|
+		if(answers.isKindOf(FrictionObserver)) { ^if(answers.answer(level)) { target } { 3 - target } };
+		answered.test = false;
+		givenAnswer = nil;
+		answered.wait;
+		^givenAnswer
+	}
+
+	prStartAnswers { |answers, device|
+		switch(answers,
+			\keys, {
+				if(showKeysWindow) { defer {
+					keysWindow = Window("Which interval? 1 or 2", Rect(100, 100, 320, 80)).front;
+					StaticText(keysWindow, keysWindow.view.bounds.insetBy(10)).string_(
+						"Press 1 if the first interval was the different one, 2 if the second.");
+					keysWindow.view.keyDownAction = { |view, char|
+						case { char == $1 } { this.answer(1) } { char == $2 } { this.answer(2) }
+					}
+				} }
+			},
+			\buttons, {
+				buttonsResponder = OSCFunc({ |msg| this.answer(msg[3].asInteger) }, '/kfThresholdButton',
+					device.server.addr);
+				buttonsSynth = { FrictionThresholdStimuli.buttonsReply(device) }.play(device.server)
+			}
+		)
+	}
+
+	prStopAnswers {
+		keysWindow !? { |w| defer { w.close } };
+		buttonsResponder !? _.free;
+		buttonsSynth !? _.free;
+		keysWindow = buttonsResponder = buttonsSynth = nil
+	}
+
+	asEvent {
+		^(kind: kind, settings: settings, intervalS: intervalS, gapS: gapS, seed: seed, procedure: procedure.asEvent)
+	}
+}

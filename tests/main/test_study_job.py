@@ -1,0 +1,172 @@
+"""scripts/study.sh, the README's study command, shortened: each simulated exploration cut to 3 s
+and each threshold experiment to 24 trials of 0.2 s intervals. It sets up, builds, runs the pilot
+study and its threshold part with five simulated participants side by side on a realtime server,
+and writes the sessions and the report (FrictionStudy.report, from sclang) into KF_STUDY_JOB_OUT.
+The test checks the sessions, the report's figures (PNG) and tables (CSV) against the sessions,
+the binds statistic (where it measures, and its test), and the threshold fits against the model
+observers' known thresholds."""
+import csv
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+from kfharness import paths
+from kfstudy import psychometric, session_folder
+
+OUT = Path(os.environ["KF_STUDY_JOB_OUT"])
+PILOT = ["mapping1-off", "mapping1-on", "mapping2-off", "mapping2-on", "mapping3-off", "mapping3-on"]
+THRESHOLDS = {"forceStep": "force", "asynchrony": "asynchrony", "gratingStep": "grating"}
+CONDITIONS = PILOT + list(THRESHOLDS)
+EXPLORE_S, TRIALS, INTERVAL_S, GAP_S = 3, 24, 0.2, 0.05
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def png_size(path):
+    from PIL import Image
+    with Image.open(path) as image:
+        pixels = np.asarray(image.convert("L"))
+    assert pixels.std() > 10, f"{path.name} is blank"
+    return pixels.shape
+
+
+def test_the_study_job_writes_five_sessions_and_their_report():
+    shutil.rmtree(OUT, ignore_errors=True)
+    run = subprocess.run(["bash", str(paths.REPO_DIR / "scripts" / "study.sh"), "--out", str(OUT),
+                          "--explore-s", str(EXPLORE_S), "--trials", str(TRIALS), "--interval-s", str(INTERVAL_S),
+                          "--gap-s", str(GAP_S)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         timeout=840)
+    assert run.returncode == 0, run.stdout[-4000:]
+
+    # Five sessions, each the pilot's six conditions in the paper's order and the three threshold
+    # experiments, each run to its end once.
+    sessions = session_folder.sessions(OUT / "sessions")
+    assert [s.participant for s in sessions] == ["P1", "P2", "P3", "P4", "P5"]
+    for s in sessions:
+        assert s.finished and s.manifest["order"] == CONDITIONS
+        assert [c.complete and c.attempts == 0 for c in s.conditions] == [True] * 9
+        for c in s.conditions[:6]:
+            # Ended by the participant: when covered enough, or after its 3 s of exploring (checked
+            # every 0.05 s; 1 s for sclang's clock to wake up late on a busy machine).
+            assert c.ended_by == "participant" and 0.5 < c.duration_s < EXPLORE_S + 1.0, (s.participant, c.name)
+            assert (c.folder / "audio.wav").stat().st_size > 0 and (c.folder / "device.kfsession").stat().st_size > 0
+        for c in s.conditions[6:]:
+            # Ended by the procedure after its trials, each a line of trials.csv; the participant's
+            # model observer logged with its known threshold, the one its manifest holds.
+            assert c.ended_by == "procedure" and c.is_threshold, (s.participant, c.name)
+            observer = c.event_json("observer")
+            assert observer["threshold"] == s.manifest["simulatedParticipant"]["thresholds"][THRESHOLDS[c.name]]
+            assert c.event_json("experiment")["kind"] == THRESHOLDS[c.name]
+        trials = rows(s.folder / "trials.csv")
+        assert [t["condition"] for t in trials] == [name for name in THRESHOLDS for _ in range(TRIALS)]
+        assert {(a["condition"], a["question"]) for a in s.answers} == {
+            (c, q) for c in PILOT for q in (["audio"] if c.endswith("off") else ["touch", "relation"])} | {
+            (c, "how") for c in THRESHOLDS}
+
+    # The report: a row per condition run, its figures there and drawn.
+    report = (OUT / "report.md").read_text()
+    table = rows(OUT / "conditions.csv")
+    assert len(table) == 45
+    for r in table:
+        assert f"![{r['condition']}]({r['figure3']})" in report
+        assert png_size(OUT / r["figure3"]) == (540, 810)  # 9 x 6 in at 90 dpi
+        if r["threshold"] == "False":
+            # The map the experimenter saw (50 frames a second) and the one from the recording
+            # (125 reports a second, speeds over 40 ms) differ by the cells one sees and the other
+            # misses at the map's edges and at speed steps: measured at most 0.083 apart over three
+            # runs of this job (90 conditions); 0.17 once in a full run, mapping 1's 6 mm crossed
+            # at 250 mm/s.
+            assert abs(float(r["coverage_live"]) - float(r["coverage_recording"])) < 0.15, r
+    for name in ["speeds.png", "binds.png"] + [f"{kind}-P{i}.png" for i in range(1, 6) for kind in ("coverage", "speeds")]:
+        assert f"({name})" in report
+        png_size(OUT / name)
+    check_binds()
+    check_threshold_fits(sessions, report)
+
+
+def check_binds():
+    """Where the statistic measures, and its test. The paper's participants were slowed where the
+    friction is: the report measures the speed in the parts of the fragment where the force
+    commanded with friction on is raised (how it picks them and what it makes of the speeds there
+    is tested on data made for it: tests/scenes/test_study_report.py). Here, that the parts it
+    picked in the runs are where the pilot's signal puts the friction. In mappings 1 and 2 the
+    signal is a sine of amplitude 1 whose cycles (0.025 and 0.2 mm) are far shorter than a part
+    (0.5 mm): every part crossed is loud, and raised. In mapping 3 a cycle is 12.5 mm and the force
+    follows |sine| (1 ms of it is under 0.4 mm at the speeds explored), low at its zero crossings
+    every 6.25 mm; it is felt where the puck is when it acts, 10 to 15 ms after the position it was
+    computed from (the report's interpolation, the block, the frame), so the low parts lie up to
+    0.5 mm past a crossing when crossed at 40 mm/s and further when faster. A part 1.5 mm or more
+    from a crossing (|sine| >= 0.71, -3 dB: 0.45 N when crossed slowly) is raised whatever the
+    speed it was crossed at (measured: all 50 of them in a run of this job); some parts, at the
+    crossings, are not."""
+    parts = rows(OUT / "binds-parts.csv")
+    judged = {m: [p for p in parts if p["mapping"] == m and p["mean_force_n"] not in ("", "nan")]
+              for m in ("mapping1", "mapping2", "mapping3")}
+    for mapping in ("mapping1", "mapping2"):
+        raised = [p["raised"] == "True" for p in judged[mapping]]
+        # At a fragment's ends the puck turns, slowly (the 1 ms window holds less than a cycle):
+        # two parts may be lower (measured: none in mapping 1, two in mapping 2).
+        assert len(raised) >= 10 and raised.count(False) <= 2, (mapping, raised)
+    middles = np.array([(float(p["from_mm"]) + float(p["to_mm"])) / 2 for p in judged["mapping3"]])
+    raised = np.array([p["raised"] == "True" for p in judged["mapping3"]])
+    from_crossing_mm = np.abs((middles + 3.125) % 6.25 - 3.125)
+    crest = from_crossing_mm >= 1.5
+    assert crest.sum() >= 10 and raised[crest].mean() > 0.9, list(zip(middles, raised))
+    assert 0 < raised.sum() < len(raised), raised
+
+    # The test is the paired t test of the per-participant differences, per mapping.
+    pairs = rows(OUT / "binds.csv")
+    tests = {r["mapping"]: r for r in rows(OUT / "binds-test.csv")}
+    assert len(pairs) == 15 and sorted(tests) == ["mapping1", "mapping2", "mapping3"]
+    for mapping, test in tests.items():
+        d = np.array([float(p["speed_off"]) - float(p["speed_on"]) for p in pairs if p["mapping"] == mapping])
+        t = d.mean() / (d.std(ddof=1) / np.sqrt(len(d)))
+        assert int(test["n"]) == 5 and abs(float(test["t"]) - t) < 1e-9 * abs(t), (mapping, test, t)
+    # Mapping 1's 6 mm of 0.5 N bind every simulated participant's typical speed there (the
+    # participants learn a constant resistance within 2 to 4 s, but each crossing of the fragment
+    # is shorter than that). Mapping 3's bumps are another matter (stick and slip: released past a
+    # peak, the puck slides fast to the next), so no sign is asserted there.
+    assert float(tests["mapping1"]["mean_difference"]) > 0, tests["mapping1"]
+
+
+def check_threshold_fits(sessions, report):
+    """Each threshold fit against the known threshold of the model observer that answered it.
+    The answers are the observer's (its own seeded random numbers) and QUEST+ chooses each level
+    from them, so a run gives the same 15 fits every time: the bound is what theory says such a fit
+    can do. The theory's smallest sd of an unbiased log10 threshold from a run's levels is the
+    Cramer-Rao bound (psychometric.cramer_rao_sd_log10: the Fisher information of the answers at
+    the observer's threshold, slope 3.5 and lapse 0.02), 0.09 to 0.19 log10 for these runs of 24
+    trials. The fit holds its lapse rate within [0, 0.05] and its slope within [0.2, 20], so it
+    varies less than the bound, with a small bias (the bench: 48 QUEST+ trials, fit sd 0.055
+    against a bound of 0.072, bias +0.017). So each fit lies within 3 bounds of its observer's
+    threshold (a normal estimate with the bound's sd stays within 3 sd 99.7 % of the time; these
+    fits were within 1.05), and the mean over the five participants of an experiment within 3
+    bounds / sqrt(5) (the mean's sd); the procedure's own estimate (QUEST+'s posterior mean) the
+    same."""
+    fits = rows(OUT / "thresholds.csv")
+    assert len(fits) == 15
+    by_experiment = {}
+    for fit in fits:
+        session = next(s for s in sessions if s.participant == fit["participant"])
+        trials = [t for t in rows(session.folder / "trials.csv") if t["condition"] == fit["condition"]]
+        known = session.manifest["simulatedParticipant"]["thresholds"][THRESHOLDS[fit["condition"]]]
+        assert int(fit["trials"]) == TRIALS and float(fit["observer_threshold"]) == known
+        bound = psychometric.cramer_rao_sd_log10([float(t["level"]) for t in trials], known, 3.5, 0.5, 0.02)
+        errors = [np.log10(float(fit[key]) / known) for key in ("threshold", "estimate")]
+        assert all(abs(e) < 3 * bound for e in errors), (fit, bound)
+        by_experiment.setdefault(fit["condition"], []).append((errors, bound))
+        assert f"({fit['participant']}-{fit['condition']}-psychometric.png)" in report
+        png_size(OUT / f"{fit['participant']}-{fit['condition']}-psychometric.png")
+    for condition, entries in by_experiment.items():
+        bound = np.sqrt(np.mean([b ** 2 for _, b in entries]) / len(entries))
+        for k in (0, 1):
+            mean = np.mean([e[k] for e, _ in entries])
+            assert abs(mean) < 3 * bound, (condition, k, mean, bound)
+    assert sorted((f["participant"], f["condition"]) for f in fits) == sorted(
+        (s.participant, name) for s in sessions for name in THRESHOLDS)

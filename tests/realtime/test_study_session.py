@@ -1,0 +1,216 @@
+"""A FrictionStudy session on a realtime server: bad input refused before anything starts, and a
+session killed mid-condition (scsynth and sclang, by pid) that loses nothing and resumes from
+sclang at the condition it was in."""
+import csv
+import json
+import os
+import shutil
+import signal
+import threading
+import time
+
+from kfharness import paths, sclang
+from kfstudy import readers
+
+# Two conditions of mapping 1 (its 6 mm), each explored for 2.5 s by a simulated participant
+# (explore-s: 6 speed steps of 0.42 s), and a free-text and a rating question after each.
+STUDY = r"""
+var questions = [FrictionStudyQuestion.text(\say, "Describe it."), FrictionStudyQuestion.rating(\hold, "How held?", 1, 5)];
+~study = FrictionStudy("resume test", [
+	FrictionStudyCondition(\first, (mapping: \mapping1, friction: false), "Explore.", questions, 60),
+	FrictionStudyCondition(\second, (mapping: \mapping1, friction: true), "Explore again.", questions, 60)]);
+"""
+
+
+def test_bad_input_is_refused_before_anything_starts(jack):
+    root = paths.work_dir() / "study-refusals"
+    shutil.rmtree(root, ignore_errors=True)
+    (root / "P1").mkdir(parents=True)
+    code = sclang.fill(r"""
+var root = @ROOT@, sim = FrictionStudySimParticipant(1, 2), refused = { |tag, f|
+	try { f.value; "KF-ACCEPTED %".format(tag).postln } { |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
+};
+""" + STUDY + r"""
+refused.(\noConditions, { FrictionStudy("empty", []) });
+refused.(\unknownParameter, { FrictionStudyCondition(\a, (mapping: \mapping1, frictionn: true)) });
+refused.(\badMapping, { FrictionStudyCondition(\a, (mapping: -3)) });
+refused.(\unwritable, { ~study.run("P2", "/proc/kf-study-cannot-write", s, simulated: sim, windows: false) });
+refused.(\reused, { ~study.run("P1", root, s, simulated: sim, windows: false) });
+refused.(\channels, { ~study.run("P3", root, s, simulated: sim, windows: false, experimenterOut: 2) });
+refused.(\overlap, { ~study.run("P3", root, s, simulated: sim, windows: false, experimenterOut: 1) });
+refused.(\badCode, { ~study.run("P 3/..", root, s, simulated: sim, windows: false) });
+refused.(\noDevice, { ~study.run("P3", root, s, windows: false) });
+""", ROOT=sclang.sc_string(str(root)))
+    run = sclang.require_ok(sclang.run_with_server(code, jack, timeout=60, name="study-refusals"))
+    refused = {fields[0]: " ".join(fields[1:]) for fields in run.lines("KF-REFUSED")}
+    assert not run.lines("KF-ACCEPTED"), run.lines("KF-ACCEPTED")
+    expected = {
+        "noConditions": "needs at least one condition",
+        "unknownParameter": "unknown scene parameter 'frictionn'",
+        "badMapping": "samplesPerMm",
+        "unwritable": "cannot be written",
+        "reused": "participant code P1 already has a session",
+        "channels": "the server has 2 output channels",
+        "overlap": "overlap",
+        "badCode": "participant code must be letters",
+        "noDevice": "give either device",
+    }
+    for tag, words in expected.items():
+        assert tag in refused and words in refused[tag], (tag, refused.get(tag), run.output[-3000:])
+    # Nothing was written for the refused sessions: only the folder the test made is there.
+    assert sorted(p.name for p in root.iterdir()) == ["P1"]
+    assert not any((root / "P1").iterdir())
+
+
+def read_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def events_of(folder):
+    return [row["event"] for row in read_rows(folder / "events.csv")]
+
+
+def test_a_killed_session_resumes_with_nothing_lost(jack):
+    root = paths.work_dir() / "study-resume"
+    pids = paths.work_dir() / "study-resume-pids.txt"
+    session = root / "P7"
+    shutil.rmtree(root, ignore_errors=True)
+    pids.unlink(missing_ok=True)
+    # Run 1: the session starts; the test kills scsynth and sclang once the second condition runs.
+    first = STUDY + sclang.fill(r"""
+~session = ~study.run("P7", @ROOT@, s, 0, 11, simulated: FrictionStudySimParticipant(3, 2.5), windows: false,
+	experimenterOut: 2);
+File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
+while { ~session.isOver.not } { 0.1.wait };
+"KF-NOT-KILLED".postln;
+""", ROOT=sclang.sc_string(str(root)), PIDS=sclang.sc_string(str(pids)))
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(run=sclang.run_with_server(
+        first, jack, timeout=120, name="study-run", server_options={"numOutputBusChannels": 4})))
+    thread.start()
+    second_events = session / "02-second" / "events.csv"
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline and not (second_events.exists() and "start" in second_events.read_text()):
+        time.sleep(0.05)
+    assert second_events.exists(), "the second condition never started"
+    # Mid-condition: 0.6 s into its 2.5 s of exploring (1.9 s to spare for a slow wake-up here).
+    time.sleep(0.6)
+    sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
+    os.kill(scsynth_pid, signal.SIGKILL)
+    os.kill(sclang_pid, signal.SIGKILL)
+    thread.join(60)
+    assert "KF-NOT-KILLED" not in result["run"].output
+
+    # What the kill left: the manifest, the first condition whole with its answers, the second begun.
+    manifest = json.loads((session / "manifest.json").read_text())
+    assert manifest["participant"] == "P7" and manifest["seed"] == 11 and manifest["order"] == ["first", "second"]
+    assert manifest["sampleRateHz"] == jack.sample_rate and manifest["device"]["kind"] == "sim"
+    assert manifest["device"]["specs"]["tactileLatencyS"] == 0.0024 and manifest["version"] != "unknown"
+    answers_before = (session / "answers.csv").read_bytes()
+    rows = read_rows(session / "answers.csv")
+    assert [(r["condition"], r["question"]) for r in rows] == [("first", "say"), ("first", "hold")]
+    assert events_of(session / "01-first")[-1] == "end"
+    killed = events_of(session / "02-second")
+    assert "start" in killed and "end" not in killed, killed
+    killed_recording = (session / "02-second" / "device.kfsession").read_text()
+    # Recorded from before the start line: at least 0.6 s of reports at 125 Hz (75), less a margin.
+    assert killed_recording.count("\nR ") > 40, "the killed condition's recording lost its lines"
+
+    # Run 2: resume from sclang; the second condition runs again, the first is kept as it was.
+    second = STUDY + sclang.fill(r"""
+~session = ~study.resume(@SESSION@, s, simulated: FrictionStudySimParticipant(3, 2.5), windows: false);
+while { ~session.isOver.not } { 0.1.wait };
+"KF-RESUMED % %".format(~session.state, ~session.position).postln;
+""", SESSION=sclang.sc_string(str(session)))
+    run = sclang.require_ok(sclang.run_with_server(second, jack, timeout=120, name="study-resume",
+                                                   server_options={"numOutputBusChannels": 4}))
+    assert run.lines("KF-RESUMED") == [["finished", "2"]], run.output[-3000:]
+    assert (session / "answers.csv").read_bytes().startswith(answers_before)
+    rows = read_rows(session / "answers.csv")
+    assert [(r["condition"], r["question"], r["attempt"]) for r in rows] == [
+        ("first", "say", "1"), ("first", "hold", "1"), ("second", "say", "2"), ("second", "hold", "2")]
+    # The killed attempt is kept whole; the second attempt ran beside it.
+    assert events_of(session / "02-second") == killed
+    assert (session / "02-second" / "device.kfsession").read_text() == killed_recording
+    assert events_of(session / "02-second-attempt2")[-1] == "end"
+    log = [row["event"] for row in read_rows(session / "session.csv")]
+    assert log == ["start", "resume", "finish"], log
+    for folder in ("01-first", "02-second-attempt2"):
+        data, rate = readers.read_wav(session / folder / "audio.wav")
+        assert rate == jack.sample_rate and data.shape[1] == 2 and len(data) > rate, folder
+        assert readers.Session(session / folder / "device.kfsession").frames.shape[0] > 1000, folder
+
+
+# A person's session on a replayed recording whose puck's right button goes down 2.0 s after the
+# device opens (bit 2 of the reports' buttons, 0.2 s long); then a simulated participant's session
+# that the experimenter aborts 0.5 s into its second condition.
+DONE_AND_ABORT = r"""
+var root = @ROOT@, device, session, sim, aborted;
+~study = FrictionStudy("button and abort", [
+	FrictionStudyCondition(\first, (mapping: \mapping1), "Explore; press a button when done.",
+		[FrictionStudyQuestion.text(\say, "Describe it.")], 20),
+	FrictionStudyCondition(\second, (mapping: \mapping2), "Explore again.", [], 20)]);
+device = FrictionDevice.replay(s, @RECORDING@, 0);
+s.sync;
+session = ~study.run("B1", root, s, device: device, windows: false, experimenterOut: 2);
+while { session.state != \questions } { 0.05.wait };
+session.answer("pressed the right button");
+while { session.state != \running } { 0.05.wait };
+session.abort;  // the experimenter: the second condition has no use here
+while { session.isOver.not } { 0.05.wait };
+"KF-BUTTON %".format(session.state).postln;
+device.close;
+aborted = ~study.run("A1", root, s, simulated: FrictionStudySimParticipant(2, 1.5), windows: false,
+	experimenterOut: 2);
+while { aborted.position < 1 or: { aborted.state != \running } or: { aborted.elapsedS < 0.5 } } { 0.05.wait };
+aborted.abort;
+while { aborted.isOver.not } { 0.05.wait };
+// The server's count of synths comes with its status, polled every 0.7 s.
+1.0.wait;
+"KF-ABORTED % % synths".format(aborted.state, s.numSynths).postln;
+"""
+
+
+def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
+    root = paths.work_dir() / "study-button-abort"
+    shutil.rmtree(root, ignore_errors=True)
+    root.mkdir(parents=True)
+    recording = root / "presses.kfs"
+    lines = ["kf-session 1 countMm=0.021 updateRateHz=125"]
+    for i in range(1, 1000):
+        t = i * 0.008
+        lines.append(f"R {t:.3f} {t:.3f} 1 0 {2 if 2.0 <= t < 2.2 else 0} 0")
+    recording.write_text("\n".join(lines) + "\n")
+    run = sclang.require_ok(sclang.run_with_server(
+        sclang.fill(DONE_AND_ABORT, ROOT=sclang.sc_string(str(root)), RECORDING=sclang.sc_string(str(recording))),
+        jack, timeout=90, name="study-button-abort", server_options={"numOutputBusChannels": 4}))
+    assert run.lines("KF-BUTTON") == [["aborted"]], run.output[-3000:]
+
+    # The button ended the first condition: its "done" says so, at the press (2.0 s after the
+    # device opened, which the prepare line follows within a few ms; a block and a status poll
+    # late at most: 0.03 s measured, 0.5 s allowed on a busy machine).
+    events = read_rows(root / "B1" / "01-first" / "events.csv")
+    done = [e for e in events if e["event"] == "done"]
+    assert [e["detail"] for e in done] == ["button"], events
+    assert 1.9 < float(done[0]["timeS"]) < 2.5, done
+    assert [e["event"] for e in events][-2:] == ["answer", "end"]
+
+    # The abort: the session ends at once, what was written is kept and the abort logged, in the
+    # condition's events and the session's log; nothing is left playing on the server.
+    assert run.lines("KF-ABORTED") == [["aborted", "0", "synths"]], run.output[-3000:]
+    session = root / "A1"
+    log = read_rows(session / "session.csv")
+    assert [(r["event"], r["detail"]) for r in log] == [("start", ""), ("abort", "second")], log
+    assert events_of(session / "01-first")[-1] == "end"
+    second = events_of(session / "02-second")
+    assert second[second.index("start"):] == ["start", "abort", "coverage"], second
+    assert [(r["condition"], r["question"]) for r in read_rows(session / "answers.csv")] == [("first", "say")]
+    # The aborted condition's recordings are kept: the device's (0.5 s and more of reports at
+    # 125 Hz: 62, less a margin), the audio as long as the condition ran.
+    recording = readers.Session(session / "02-second" / "device.kfsession")
+    assert len(recording.reports) > 40
+    data, rate = readers.read_wav(session / "02-second" / "audio.wav")
+    assert len(data) > 0.5 * rate
+    assert not (session / "03-second").exists() and sorted(p.name for p in session.iterdir()) == [
+        "01-first", "02-second", "answers.csv", "manifest.json", "session.csv"]

@@ -1,0 +1,84 @@
+"""A threshold condition in a FrictionStudy: the study calls FrictionThreshold's run(device,
+answers, onTrial, onEnd, out) inside its Routine, a FrictionObserver answering for the simulated
+participant; each trial goes into trials.csv as it comes; start, the experiment, the observer,
+each trial, the end and the estimate are logged; its questions follow. The report fits the trials
+(kfstudy.psychometric) and draws them beside the observer's known function."""
+import csv
+import json
+import shutil
+
+import numpy as np
+
+from kfharness import paths, sclang
+from kfstudy import psychometric, report
+
+LEVELS, REPEATS, THRESHOLD = [0.05, 0.1, 0.2], 4, 0.1
+
+SCRIPT = r"""
+var study, session, rows = [], path = @ROOT@ +/+ "T1/trials.csv";
+study = FrictionStudy("threshold", [
+	FrictionStudyCondition.threshold(\forceStep, {
+		FrictionThreshold.force(FrictionConstantStimuli(@LEVELS@, @REPEATS@, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+	}, "Which interval held more friction?", [FrictionStudyQuestion.text(\how, "How did you decide?")], 60, \keys,
+	{ |seed| FrictionObserver(@THRESHOLD@, 3.5, 0.02, seed: seed) })]);
+session = study.run("T1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
+// What the folder holds while the trials run (a trial every 0.4 s), looked at every 0.05 s.
+while { session.isOver.not } {
+	if(File.exists(path)) { rows = rows.add(File.readAllString(path).split($\n).reject(_.isEmpty).size - 1) };
+	0.05.wait
+};
+"KF-ROWS %".format(rows.asSet.asArray.sort.join(" ")).postln;
+"KF-STATE %".format(session.state).postln;
+"""
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
+    root = paths.work_dir() / "study-threshold"
+    shutil.rmtree(root, ignore_errors=True)
+    count = len(LEVELS) * REPEATS
+    run = sclang.require_ok(sclang.run_with_server(
+        sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root)), LEVELS=LEVELS, REPEATS=REPEATS, THRESHOLD=THRESHOLD),
+        jack, timeout=60, name="study-threshold", server_options={"numOutputBusChannels": 4}))
+    assert run.lines("KF-STATE") == [["finished"]], run.output[-3000:]
+    # Written and flushed as each trial comes: the folder held every count on the way.
+    seen = [int(n) for n in run.lines("KF-ROWS")[0]]
+    assert seen == list(range(0, count + 1)) or seen == list(range(1, count + 1)), seen
+    folder = root / "T1"
+    trials = rows(folder / "trials.csv")
+    assert [t["trial"] for t in trials] == [str(n) for n in range(1, count + 1)]
+    assert sorted(float(t["level"]) for t in trials) == sorted(LEVELS * REPEATS)
+    assert all(t["condition"] == "forceStep" and t["participant"] == "T1" for t in trials)
+    assert [t["correct"] == "true" for t in trials] == [t["answer"] == t["target"] for t in trials]
+    events = rows(folder / "01-forceStep" / "events.csv")
+    names = [e["event"] for e in events]
+    assert names == ["prepare", "recordDevice", "experiment", "observer", "recordAudio", "start"] + [
+        "trial"] * count + ["done", "estimate", "answer", "end"], names
+    detail = {e["event"]: e["detail"] for e in events}
+    assert json.loads(detail["experiment"])["kind"] == "force"
+    assert json.loads(detail["observer"])["threshold"] == THRESHOLD
+    estimate = json.loads(detail["estimate"])
+    right = sum(t["correct"] == "true" for t in trials)
+    assert [(a["question"], a["source"], a["answer"]) for a in rows(folder / "answers.csv")] == [
+        ("how", "simulated", f"simulated: {right} of {count} trials answered right by its model observer")]
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert manifest["study"]["conditions"][0]["threshold"] is True
+
+    # The report fits these trials (psychometric.fit, as on its own) and draws them.
+    summary = report.write_report(root, root / "report")
+    (fit,) = summary["thresholds"]
+    own = psychometric.fit([float(t["level"]) for t in trials], [t["correct"] == "true" for t in trials])
+    assert fit["threshold"] == own["threshold"] and fit["trials"] == count
+    assert fit["observer_threshold"] == THRESHOLD and fit["unit"] == "N"
+    assert fit["estimate"] == estimate["threshold"]
+    md = (root / "report" / "report.md").read_text()
+    assert f"| forceStep | {count} | {own['threshold']:.4g} N |" in md
+    assert "(T1-forceStep-psychometric.png)" in md
+    from PIL import Image
+    with Image.open(root / "report" / "T1-forceStep-psychometric.png") as image:
+        assert np.asarray(image.convert("L")).std() > 10
+    assert [r["condition"] for r in rows(root / "report" / "thresholds.csv")] == ["forceStep"]

@@ -1,0 +1,63 @@
+"""What FrictionThreshold's intervals play (FrictionThresholdStimuli), rendered in NRT on simulated
+devices whose hands move at a steady speed: the grating's period against the puck's position is
+the reference's, plus the level in the target; the asynchrony experiment's sound starts the
+device's audio delay plus the level (ms) after it is switched on."""
+import numpy as np
+
+from kfharness import nrt, paths
+from kfstudy import readers
+
+RATE = 48000
+ON_S = 0.5  # \active set to 1
+
+
+def _period_mm(path):
+    """Twice the median travel between the grating's switches (duty 0.5), from a lockstep
+    recording: the frames' audio times against the reports' (the same clock in NRT)."""
+    session = readers.Session(path)
+    count_mm = float(session.header["countMm"])
+    x_mm = np.interp(session.frames[:, 1], session.reports[:, 0], np.cumsum(session.reports[:, 2]) * count_mm)
+    high = session.frames[:, 2] > 0.22
+    switches = np.flatnonzero(np.diff(high.astype(int)))
+    travel = np.abs(np.diff(x_mm[switches]))
+    assert len(travel) >= 10, len(travel)
+    return 2 * float(np.median(travel))
+
+
+def test_grating_period_and_sound_delay_follow_the_level():
+    rec = [paths.work_dir() / f"stimuli-grating-{i}.kfs" for i in (0, 1)]
+    data, log = nrt.score_and_render("threshold-stimuli", f"""
+        var grating = (periodMm: 2, duty: 0.5, loForceN: 0.14, hiForceN: 0.3);
+        var sound = (samplesPerMm: 500, amp: 0.5);
+        var defs = [FrictionThresholdStimuli.synthDef(\\grating, 0, grating),
+            FrictionThresholdStimuli.synthDef(\\grating, 1, grating),
+            FrictionThresholdStimuli.synthDef(\\asynchrony, 2, sound),
+            FrictionThresholdStimuli.synthDef(\\asynchrony, 3, sound)];
+        var hand = FrictionHand.speeds([[40, 3]]);
+        score = Score(FrictionPilot.loadSignalMsgs(0).collect {{ |m| [0.0, m] }} ++ [
+            [0.0] ++ defs.collect {{ |d| ['/d_recv', d.asBytes] }},
+            [0.0] ++ (0..3).collect {{ |i| ['/cmd', \\kfOpenSim, i] ++ hand.asCommandArgs }},
+            [0.0, ['/cmd', \\kfRecord, 0, "{rec[0]}"], ['/cmd', \\kfRecord, 1, "{rec[1]}"]],
+            [0.1, Synth.basicNew(defs[0].name, nil, 1000).newMsg(nil, [\\level, 0, \\active, 1]),
+                Synth.basicNew(defs[1].name, nil, 1001).newMsg(nil, [\\level, 1, \\active, 1]),
+                Synth.basicNew(defs[2].name, nil, 1002).newMsg(nil, [\\level, 0, \\out, 0, \\bufnum, 0]),
+                Synth.basicNew(defs[3].name, nil, 1003).newMsg(nil, [\\level, 10, \\out, 2, \\bufnum, 0])],
+            [{ON_S}, ['/n_set', 1002, \\active, 1], ['/n_set', 1003, \\active, 1]],
+            [2.5, ['/c_set', 0, 0]]]);
+    """, channels=4)
+    assert "FAILURE" not in log, log[-2000:]
+    # The grating: 2 mm in the reference, 2 + 1 mm in the target; the switches fall on 1 ms frames
+    # (0.04 mm at 40 mm/s) and the median is over tens of half periods: within 5 %.
+    assert abs(_period_mm(rec[0]) / 2 - 1) < 0.05
+    assert abs(_period_mm(rec[1]) / 3 - 1) < 0.05
+    # The sound: silent until switched on, then delayed by the paper's 1 ms (a slot index has the
+    # paper's audioDelay) plus the level. \active is a control: the sound's amplitude ramps from 0
+    # over the block of the bundle (SC interpolates a control into an audio product), whose first
+    # sample is still 0, so the sound starts delay + 1 samples after that block begins; DelayL
+    # delays by a whole number of samples here. The level's 10 ms is exactly 480 samples.
+    on = nrt.bundle_start_sample(ON_S)
+    first = [int(np.flatnonzero(np.abs(data[:, channel]) > 1e-7)[0]) for channel in (0, 2)]
+    assert first[0] == on + round(0.001 * RATE) + 1, (first, on)
+    assert first[1] - first[0] == round(0.010 * RATE), first
+    for channel, start in zip((0, 2), first):
+        assert np.abs(data[start:start + 4800, channel]).max() > 0.1, "the pilot's sound plays"
