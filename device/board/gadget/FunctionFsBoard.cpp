@@ -282,29 +282,40 @@ bool FunctionFsBoard::halt(bool out, std::string& error) {
   // FunctionFS halts an endpoint on I/O in the wrong direction, and says so with EBADMSG. A
   // device controller halts an IN endpoint only with nothing queued on it (EAGAIN otherwise):
   // the status frame is taken back first (its completion reaped here; the tick queues the next
-  // one, which waits behind the halt until the host clears it).
-  for (int attempt = 0; attempt < 10; ++attempt) {
+  // one, which waits behind the halt until the host clears it). dummy_hcd was seen to answer
+  // EAGAIN with no frame of ours queued, ten times in a row at once (1 run in 6): so between
+  // tries the completions of up to 1 ms are reaped, 50 times at most (a hook, not the firmware:
+  // its halt only has to happen).
+  const auto reap = [&](long timeoutNs) {
+    io_event event{};
+    timespec limit{0, timeoutNs};
+    while (io_getevents(aio_, 1, 1, &event, &limit) == 1) {
+      if (event.obj == &status_.cb) {
+        status_.queued = status_.cancelling = false;
+        if (!out) return;
+        continue;
+      }
+      for (Read& read : reads_)
+        if (event.obj == &read.cb) onRead(read, static_cast<long>(event.res));
+      if (!out && !status_.queued) return;
+    }
+  };
+  int lastErrno = 0;
+  for (int attempt = 0; attempt < 50; ++attempt) {
     if (!out && status_.queued) {
       if (!status_.cancelling) cancel(status_.cb);
       status_.cancelling = true;
-      io_event event{};
-      timespec limit{0, 100000000};
-      while (status_.queued && io_getevents(aio_, 1, 1, &event, &limit) == 1) {
-        if (event.obj == &status_.cb) {
-          status_.queued = status_.cancelling = false;
-          continue;
-        }
-        for (Read& read : reads_)
-          if (event.obj == &read.cb) onRead(read, static_cast<long>(event.res));
-      }
+      reap(100000000);
     }
     const ssize_t result = out ? ::write(out_, none, 0) : ::read(in_, none, 0);
     if (result < 0 && errno == EBADMSG) return true;
-    if (!(result < 0 && errno == EAGAIN)) break;
+    lastErrno = result < 0 ? errno : 0;
+    if (lastErrno != EAGAIN) break;
     std::fprintf(stderr, "kf_board_gadget: halt %s: EAGAIN (status queued %d cancelling %d)\n", out ? "out" : "in",
                  status_.queued, status_.cancelling);
+    reap(1000000);
   }
-  error = std::string("the endpoint did not halt: ") + std::strerror(errno);
+  error = std::string("the endpoint did not halt: ") + (lastErrno ? std::strerror(lastErrno) : "no error, no halt");
   return false;
 }
 
