@@ -386,8 +386,9 @@ TEST_CASE(
   REQUIRE(lastBeforeNs > 0);
   REQUIRE(firstAfterNs > 0);
   const int64_t offAfterNs = off->timeNs - lastBeforeNs;
-  // The 1 ms tick notices it: 20 ms after the last set-point, later by up to one tick and by as
-  // much as the gadget measured its tick late in this run.
+  // The 1 ms tick notices it: 20 ms after the last set-point (the same clock reading stamps the
+  // frame and feeds the firmware), at the first tick due after that, whose work (the pin set) is
+  // done late by at most what the gadget measured for its ticks' work in this run.
   const int64_t boundNs = 20 * kTickNs + kTickNs + report.tickLateMaxNs;
   char figures[240];
   std::snprintf(figures, sizeof figures,

@@ -249,8 +249,10 @@ void FunctionFsBoard::onTick() {
   const int64_t now = nowNs();
   const int64_t dueNs = nextTickNs_ + static_cast<int64_t>(expirations - 1) * kTickNs;
   nextTickNs_ += static_cast<int64_t>(expirations) * kTickNs;
-  log_.tick(now - dueNs, expirations - 1);
   firmware_.advance(seconds(now));
+  // Late: when the tick's work is done (the coil's pin set, in advance), not when it woke, since
+  // that is when its effects show; the thread can be preempted in between.
+  log_.tick(nowNs() - dueNs, expirations - 1);
   if (!enabled_) return;
   if (!status_.queued) {
     submitStatus();  // the tick after the previous frame was taken
