@@ -166,7 +166,7 @@ void FunctionFsBoard::queueReads() {
     if (result == 1) {
       read.queued = true;
     } else {
-      if (result != -EAGAIN)  // EAGAIN: disabled meanwhile; ENABLE queues them again
+      if (result != -EAGAIN && result != -ESHUTDOWN)  // disabled meanwhile; ENABLE queues them again
         std::fprintf(stderr, "kf_board_gadget: cannot queue a set-point read: %s\n", std::strerror(-result));
       return;
     }
@@ -227,8 +227,12 @@ void FunctionFsBoard::onRead(Read& read, long result) {
                                        : decoded                             ? GadgetLog::Verdict::kStale
                                                                              : GadgetLog::Verdict::kBad;
     log_.frame(now, static_cast<int>(result), setPoint.sequence, setPoint.drive, verdict, firmware_.validFrames());
+    queueReads();  // not while reading is off or the endpoint disabled
   }
-  queueReads();  // cancelled or disabled: not while reading is off or the endpoint disabled
+  // A read that failed (cancelled, the endpoint going away, halted) is queued again by the next
+  // tick, not here: while the gadget is unbound a new read can fail at once, and queueing it
+  // again from its own completion spun this realtime thread in onCompletions, so that it never
+  // read ep0's UNBIND and starved the guest's one CPU (seen: the unplug case hung the run).
 }
 
 void FunctionFsBoard::onStatus(long result) {
@@ -254,6 +258,7 @@ void FunctionFsBoard::onTick() {
   // that is when its effects show; the thread can be preempted in between.
   log_.tick(nowNs() - dueNs, expirations - 1);
   if (!enabled_) return;
+  queueReads();  // those that failed since the last tick
   if (!status_.queued) {
     submitStatus();  // the tick after the previous frame was taken
   } else if (!status_.cancelling && now - status_.builtNs >= kTickNs) {
