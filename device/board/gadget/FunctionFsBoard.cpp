@@ -251,7 +251,8 @@ void FunctionFsBoard::onTick() {
   uint64_t expirations = 0;
   if (::read(timer_, &expirations, sizeof expirations) != sizeof expirations || expirations == 0) return;
   const int64_t now = nowNs();
-  const int64_t dueNs = nextTickNs_ + static_cast<int64_t>(expirations - 1) * kTickNs;
+  // Late from the first tick this read covers: a watchdog due just after it waited until now.
+  const int64_t dueNs = nextTickNs_;
   nextTickNs_ += static_cast<int64_t>(expirations) * kTickNs;
   firmware_.advance(seconds(now));
   // Late: when the tick's work is done (the coil's pin set, in advance), not when it woke, since
