@@ -32,6 +32,7 @@ PACKAGES=(
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
   qemu-system-x86 linux-image-amd64 busybox-static udev systemd  # tests/kernel: the QEMU guest (python/kfharness/guest.py)
+  libaio-dev  # the board gadget (device/board/gadget): FunctionFS through kernel AIO
 )
 source scripts/packages.sh
 if $all; then

@@ -69,6 +69,8 @@ class EmulatedPort : public usb::Port {
     return bus_->serial_;
   }
 
+  usb::InterfaceEndpoints openEndpoints() const override { return {kSetPointEndpoint, kStatusEndpoint}; }
+
   usb::Result claimInterface(int number) override {
     std::lock_guard<std::mutex> lock(bus_->mutex_);
     if (!alive()) return usb::Result::kNoDevice;
@@ -141,9 +143,11 @@ class EmulatedPort : public usb::Port {
         return usb::Result::kBusy;
       }
     const double nowS = bus_->nowS();
-    EmulatedUsb::Pending pending{this, &transfer, nowS, generation_, false, false, false};
+    EmulatedUsb::Pending pending{this, &transfer, nowS, generation_, false, false, false, false};
     if (transfer.endpoint == kSetPointEndpoint) {
-      if (bus_->timeOutOut_ > 0) {
+      if (bus_->failOut_) {
+        pending.failed = true;  // done at once
+      } else if (bus_->timeOutOut_ > 0) {
         --bus_->timeOutOut_;
         pending.timeOut = true;
         pending.dueS = nowS + transfer.timeoutMs * 1e-3;
@@ -251,6 +255,8 @@ class EmulatedPort : public usb::Port {
       transfer.status = usb::TransferStatus::kCancelled;
     } else if (pending.timeOut) {
       transfer.status = usb::TransferStatus::kTimedOut;
+    } else if (pending.failed) {
+      transfer.status = usb::TransferStatus::kError;
     } else if (transfer.endpoint == kSetPointEndpoint) {
       if (bus_->outHalted_) {
         transfer.status = usb::TransferStatus::kStall;
@@ -377,6 +383,10 @@ void EmulatedUsb::timeOutNextOut(int count) {
 void EmulatedUsb::partialNextOut(int count) {
   std::lock_guard<std::mutex> lock(mutex_);
   partialOut_ += count;
+}
+void EmulatedUsb::failOut(bool fail) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  failOut_ = fail;
 }
 void EmulatedUsb::partialNextIn(int count) {
   std::lock_guard<std::mutex> lock(mutex_);

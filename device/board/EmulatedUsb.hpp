@@ -1,7 +1,7 @@
 // EmulatedUsb: one emulated friction board (BoardEmulator) on an emulated bus, reached through
 // usb::Port like the real one, on the steady clock: interrupt endpoints serve one transfer
 // per 1 ms frame each, control requests at once. It fails as USB fails, on request: transfers
-// that time out, partial transfers, a stalled endpoint, unplugging (transfers in flight end
+// that time out or fail at once, partial transfers, a stalled endpoint, unplugging (transfers in flight end
 // with kNoDevice) and plugging back in, permission denied at open, a board that never arms,
 // a bus reset or suspend, an over-current fault, a board of another protocol version, a
 // stranger sharing the test IDs, callbacks that arrive late or never, an ARM whose reply comes
@@ -37,6 +37,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void setRefuseArm(bool refuse);
   void timeOutNextOut(int count);   // these OUT transfers are never taken: kTimedOut
   void partialNextOut(int count);   // only 4 of 8 bytes arrive (the board rejects them)
+  void failOut(bool fail);          // OUT transfers fail at once (kError), as to a device going away
   void partialNextIn(int count);    // short status transfers
   void stallOut();                  // EP 0x01 halts until the host clears it
   void busReset();                  // the board is reset by the bus (disarmed, USB_RESET)
@@ -90,6 +91,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
     bool cancelled;
     bool timeOut;
     bool partial;
+    bool failed;
   };
 
   explicit EmulatedUsb(std::string serial);
@@ -103,6 +105,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   int generation_ = 1;
   bool denyAccess_ = false;
   bool outHalted_ = false;
+  bool failOut_ = false;
   int timeOutOut_ = 0, partialOut_ = 0, partialIn_ = 0;
   double nextOutS_ = 0.0, nextInS_ = 0.0;  // the next free frame of each endpoint
   std::vector<Pending> pending_;

@@ -59,9 +59,10 @@ TransferStatus statusOf(libusb_transfer_status status) {
   }
 }
 
-// The identity of interface `number` (alternate setting 0) of the active configuration, read
-// from the cached descriptors without opening the device (Linux: sysfs).
-bool readInterface(libusb_device* device, int number, InterfaceIdentity& out) {
+// The identity of interface `number` (alternate setting 0) of the active configuration and its
+// first interrupt OUT and IN endpoints, read from the cached descriptors without opening the
+// device (Linux: sysfs).
+bool readInterface(libusb_device* device, int number, InterfaceIdentity& out, InterfaceEndpoints& endpoints) {
   libusb_config_descriptor* config = nullptr;
   if (libusb_get_active_config_descriptor(device, &config) != 0 || config == nullptr) return false;
   bool found = false;
@@ -70,6 +71,13 @@ bool readInterface(libusb_device* device, int number, InterfaceIdentity& out) {
     if (iface.num_altsetting < 1 || iface.altsetting[0].bInterfaceNumber != number) continue;
     const libusb_interface_descriptor& alt = iface.altsetting[0];
     out = {number, alt.bInterfaceClass, alt.bInterfaceSubClass, alt.bInterfaceProtocol};
+    endpoints = {};
+    for (int e = 0; e < alt.bNumEndpoints; ++e) {
+      const libusb_endpoint_descriptor& endpoint = alt.endpoint[e];
+      if ((endpoint.bmAttributes & LIBUSB_TRANSFER_TYPE_MASK) != LIBUSB_TRANSFER_TYPE_INTERRUPT) continue;
+      uint8_t& slot = (endpoint.bEndpointAddress & LIBUSB_ENDPOINT_IN) ? endpoints.in : endpoints.out;
+      if (slot == 0) slot = endpoint.bEndpointAddress;
+    }
     found = true;
   }
   libusb_free_config_descriptor(config);
@@ -119,8 +127,11 @@ class LibusbPort : public Port {
       if (descriptor.idVendor != ids.vendorId || descriptor.idProduct != ids.productId) continue;
       // Ours only if the interface is: a stranger with the same (shared test) IDs is not opened.
       InterfaceIdentity found;
-      const bool present = readInterface(list[i], ids.iface.number, found);
-      const std::string mismatch = interfaceMismatch(present ? &found : nullptr, ids.iface);
+      InterfaceEndpoints endpoints;
+      const bool present = readInterface(list[i], ids.iface.number, found, endpoints);
+      std::string mismatch = interfaceMismatch(present ? &found : nullptr, ids.iface);
+      if (mismatch.empty() && (endpoints.out == 0 || endpoints.in == 0))
+        mismatch = "interface " + std::to_string(ids.iface.number) + " lacks an interrupt OUT or IN endpoint";
       if (!mismatch.empty()) {
         char where[64];
         std::snprintf(where, sizeof where, "bus %d device %d", libusb_get_bus_number(list[i]),
@@ -144,6 +155,7 @@ class LibusbPort : public Port {
       }
       handle_ = handle;
       serial_ = serial;
+      endpoints_ = endpoints;
       result = Result::kOk;
     }
     libusb_free_device_list(list, 1);
@@ -152,6 +164,7 @@ class LibusbPort : public Port {
 
   std::string skipped() const override { return skipped_; }
   std::string openSerial() const override { return serial_; }
+  InterfaceEndpoints openEndpoints() const override { return endpoints_; }
 
   Result claimInterface(int number) override {
     if (handle_ == nullptr) return Result::kInvalid;
@@ -290,6 +303,7 @@ class LibusbPort : public Port {
   libusb_context* context_ = nullptr;
   libusb_device_handle* handle_ = nullptr;
   std::string serial_;
+  InterfaceEndpoints endpoints_;
   std::string skipped_;
   bool leaked_ = false;
   std::mutex transfersMutex_;

@@ -14,6 +14,7 @@ class AbsentPort : public Port {
   Result open(const DeviceIds&) override { return Result::kNotBuilt; }
   std::string skipped() const override { return {}; }
   std::string openSerial() const override { return {}; }
+  InterfaceEndpoints openEndpoints() const override { return {}; }
   Result claimInterface(int) override { return Result::kNotBuilt; }
   void releaseInterface(int) override {}
   void close(double) override {}

@@ -25,14 +25,10 @@ std::string idsText(const usb::DeviceIds& ids) {
 
 UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions options)
     : port_(std::move(port)), options_(options), ids_(options.ids) {
-  for (usb::Transfer& transfer : outTransfers_) {
-    transfer.endpoint = board::kSetPointEndpoint;
-    transfer.length = board::kSetPointSize;
-  }
-  zeroTransfer_.endpoint = board::kSetPointEndpoint;
+  for (usb::Transfer& transfer : outTransfers_) transfer.length = board::kSetPointSize;
   zeroTransfer_.length = board::kSetPointSize;
-  statusTransfer_.endpoint = board::kStatusEndpoint;
   statusTransfer_.length = board::kStatusSize;
+  useEndpoints({board::kSetPointEndpoint, board::kStatusEndpoint});
   for (usb::Transfer* transfer :
        {&outTransfers_[0], &outTransfers_[1], &outTransfers_[2], &outTransfers_[3], &statusTransfer_, &zeroTransfer_}) {
     transfer->timeoutMs = options_.transferTimeoutMs;
@@ -42,6 +38,13 @@ UsbBoardBackend::UsbBoardBackend(std::unique_ptr<usb::Port> port, BoardOptions o
 }
 
 UsbBoardBackend::~UsbBoardBackend() { close(); }
+
+void UsbBoardBackend::useEndpoints(const usb::InterfaceEndpoints& endpoints) {
+  endpoints_ = endpoints;
+  for (usb::Transfer& transfer : outTransfers_) transfer.endpoint = endpoints.out;
+  zeroTransfer_.endpoint = endpoints.out;
+  statusTransfer_.endpoint = endpoints.in;
+}
 
 void UsbBoardBackend::setError(const std::string& error) {
   std::lock_guard<PiMutex> lock(telemetryMutex_);
@@ -65,6 +68,9 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     error = "cannot open the friction board (" + idsText(ids_) + "): " + usb::describe(result);
     return false;
   }
+  // No transfer is in flight here (before the event thread, or after every callback of the
+  // handle before): the transfers take this board's endpoints.
+  useEndpoints(port_->openEndpoints());
   result = port_->claimInterface(board::kInterfaceNumber);
   if (result != usb::Result::kOk) {
     error = std::string("cannot claim the friction board's interface: ") + usb::describe(result);
@@ -287,7 +293,7 @@ BoardTelemetry UsbBoardBackend::telemetry() const {
 
 void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
   auto* self = static_cast<UsbBoardBackend*>(transfer.user);
-  if (transfer.endpoint == board::kStatusEndpoint)
+  if (&transfer == &self->statusTransfer_)
     self->onStatus(transfer);
   else
     self->onSetPoint(transfer);
@@ -320,7 +326,7 @@ void UsbBoardBackend::submitStatus() {
 }
 
 void UsbBoardBackend::submitIdle() {
-  if (stopping_.load() || unplugged_ || !connected_.load()) return;
+  if (stopping_.load() || unplugged_ || !connected_.load() || steadyS() < retryAfterS_) return;
   const int inFlight = std::clamp(options_.transfersInFlight, 1, kMaxInFlight);
   for (int slot = 0; slot < inFlight && !haltOut_ && !unplugged_; ++slot)
     if (!outBusy_[slot]) submitSetPoint(slot);
@@ -377,6 +383,7 @@ void UsbBoardBackend::onSetPoint(usb::Transfer& transfer) {
     markUnplugged();
     return;
   }
+  if (failedAtOnce(transfer.status)) return;  // the loop sends it again, a millisecond on
   if (!stopping_.load() && !unplugged_ && !haltOut_) submitSetPoint(slot);
 }
 
@@ -406,7 +413,19 @@ void UsbBoardBackend::onStatus(usb::Transfer& transfer) {
       ++telemetry_.badStatus;
     }
   }
+  if (failedAtOnce(transfer.status)) return;
   if (!stopping_.load() && !unplugged_) submitStatus();
+}
+
+bool UsbBoardBackend::failedAtOnce(usb::TransferStatus status) {
+  // A transfer that failed (not a timeout, stall, cancel or unplug) may fail again as soon as it
+  // is sent: a device going away fails every transfer at once (EPROTO, before the kernel has
+  // seen it go). Sent again from its callback, it would keep this realtime thread busy, and on a
+  // machine with one CPU starve the kernel's own hub work, so that the unplug is never seen
+  // (tests/kernel: test_board_gadget.cpp). So it waits a set-point period, sent by the loop.
+  if (status != usb::TransferStatus::kError && status != usb::TransferStatus::kOverflow) return false;
+  retryAfterS_ = steadyS() + kRetryAfterErrorS;
+  return true;
 }
 
 bool UsbBoardBackend::anyOutInFlight() const {
@@ -468,11 +487,11 @@ void UsbBoardBackend::run() {
       }
       // A halt is cleared only on an endpoint with nothing in flight (libusb_clear_halt).
       if (haltOut_ && !anyOutInFlight()) {
-        if (port_->clearHalt(board::kSetPointEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        if (port_->clearHalt(endpoints_.out) == usb::Result::kNoDevice) markUnplugged();
         haltOut_ = false;
       }
       if (haltIn_ && !statusBusy_) {
-        if (port_->clearHalt(board::kStatusEndpoint) == usb::Result::kNoDevice) markUnplugged();
+        if (port_->clearHalt(endpoints_.in) == usb::Result::kNoDevice) markUnplugged();
         haltIn_ = false;
       }
       submitIdle();

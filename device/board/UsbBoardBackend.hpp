@@ -127,9 +127,12 @@ class UsbBoardBackend : public ForceBackend {
   bool connectLocked(std::string& error);  // portMutex_ held
   // CLEAR_ERRORS (through control()): what was set and what persists, counted in the telemetry.
   bool clearErrorsLocked(board::ClearReply& reply, std::string& error);
+  void useEndpoints(const usb::InterfaceEndpoints& endpoints);  // the transfers' endpoints
   void submitSetPoint(int slot);
   void submitStatus();
   void submitIdle();
+  // After a transfer failed at once: no transfer is sent before retryAfterS_ (true: not now).
+  bool failedAtOnce(usb::TransferStatus status);
   void markUnplugged();
   void dropHandle();
   bool anyInFlight() const;
@@ -149,7 +152,8 @@ class UsbBoardBackend : public ForceBackend {
   usb::DeviceIds ids_;
   std::mutex portMutex_;  // open/claim/release/close: by open() before the event thread, then by it
 
-  // Event thread only.
+  // Event thread only (and open() before it starts).
+  usb::InterfaceEndpoints endpoints_;  // of the open board's interface
   usb::Transfer outTransfers_[kMaxInFlight];
   bool outBusy_[kMaxInFlight] = {};
   usb::Transfer statusTransfer_;
@@ -161,7 +165,9 @@ class UsbBoardBackend : public ForceBackend {
   bool haltOut_ = false;  // EP 0x01 stalled: cleared once no OUT transfer is in flight
   bool haltIn_ = false;   // EP 0x81 likewise
   bool unplugged_ = false;
-  bool leaked_ = false;  // a transfer was given up: the board is not opened again
+  bool leaked_ = false;                               // a transfer was given up: the board is not opened again
+  static constexpr double kRetryAfterErrorS = 0.001;  // a set-point period
+  double retryAfterS_ = 0.0;                          // after a transfer failed at once, nothing is sent before this
   double nextReopenS_ = 0.0;
 
   std::atomic<uint32_t> latestDrive_{0};  // drive bits, and kRestartPending

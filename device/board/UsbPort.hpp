@@ -70,6 +70,15 @@ struct InterfaceIdentity {
 // found == nullptr: the device has no such interface.
 std::string interfaceMismatch(const InterfaceIdentity* found, const InterfaceIdentity& wanted);
 
+// The interface's interrupt endpoints, read from its descriptors: set-points OUT, status IN.
+// PROTOCOL.md section 1 asks for 0x01 and 0x81, but a device controller may number them
+// otherwise (dummy_hcd gives a FunctionFS function's interrupt OUT endpoint 0x02), so the host
+// takes them from the interface. 0: none.
+struct InterfaceEndpoints {
+  uint8_t out = 0;
+  uint8_t in = 0;
+};
+
 struct DeviceIds {
   uint16_t vendorId = 0;
   uint16_t productId = 0;
@@ -87,7 +96,8 @@ class Port {
   // names the devices that had the IDs but not the interface (left untouched).
   virtual Result open(const DeviceIds& ids) = 0;
   virtual std::string skipped() const = 0;
-  virtual std::string openSerial() const = 0;  // of the open device
+  virtual std::string openSerial() const = 0;            // of the open device
+  virtual InterfaceEndpoints openEndpoints() const = 0;  // of the open device's interface
   // Never detaches a kernel driver: kBusy when one (or another program) holds the interface.
   virtual Result claimInterface(int number) = 0;
   virtual void releaseInterface(int number) = 0;

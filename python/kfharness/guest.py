@@ -50,6 +50,7 @@ SEAT0 = "ACTIVE=c1\nACTIVE_UID=1000\nSESSIONS=c1\nUIDS=1000\n"
 @dataclass
 class GuestSpec:
     programs: list  # [(name, [argv...])], run in order; argv[0] a host path, copied in with its libraries
+    executables: list = field(default_factory=list)  # host programs a test starts itself, copied in with their libraries
     modules: list = field(default_factory=list)  # module names as modprobe takes them (hid-generic, uhid)
     udev_rules: list = field(default_factory=list)  # rule files of ours, into /etc/udev/rules.d/
     files: list = field(default_factory=list)  # host files or folders, copied in at the same path
@@ -211,7 +212,7 @@ def build_initramfs(spec, release):
     archive = Cpio()
     archive.data("/init", INIT_SCRIPT.read_bytes(), 0o755)
     archive.host("/bin/busybox")
-    executables = UDEV_PROGRAMS + [argv[0] for _, argv in spec.programs]
+    executables = UDEV_PROGRAMS + list(spec.executables) + [argv[0] for _, argv in spec.programs]
     for executable in executables:
         if not Path(executable).exists():
             raise GuestError(f"{executable} is not there (scripts/setup.sh installs and builds it)")
@@ -243,7 +244,7 @@ def qemu_command(spec, release, initramfs, console_path, hook_path, qmp_path):
     return ["qemu-system-x86_64", "-accel", "tcg", "-machine", "pc,vmport=off", "-cpu", "max", "-smp", "1",
             "-m", str(spec.memory_mb), "-nodefaults", "-display", "none", "-no-reboot",
             "-kernel", f"/boot/vmlinuz-{release}", "-initrd", str(initramfs),
-            "-append", "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init",
+            "-append", "console=ttyS0 quiet loglevel=3 panic=-1 sysrq_always_enabled rdinit=/init",
             "-serial", f"file:{console_path}",
             "-chardev", f"socket,id=hook,path={hook_path},server=on,wait=on", "-serial", "chardev:hook",
             "-qmp", f"unix:{qmp_path},server=on,wait=off", *spec.qemu_args]
@@ -345,7 +346,9 @@ def _converse(spec, proc, hook_path, qmp_path, result, start):
     def read_more():
         remaining = deadline - time.monotonic()
         if remaining <= 0:
-            raise GuestError(_stage_failure(result, f"the guest did not finish within {spec.timeout_s:.0f} s"))
+            _dump_blocked_tasks(qmp)
+            raise GuestError(_stage_failure(result, f"the guest did not finish within {spec.timeout_s:.0f} s; "
+                                                    "the tasks blocked in it are in console.log (sysrq w, l)"))
         hook.settimeout(min(remaining, 1.0))
         try:
             chunk = hook.recv(65536)
@@ -409,6 +412,17 @@ def _converse(spec, proc, hook_path, qmp_path, result, start):
             return
         elif text.strip():
             result.logs.append(f"(unknown line from the guest) {text}")
+
+
+def _dump_blocked_tasks(qmp, settle_s=3.0):
+    """A guest that hangs: where. SysRq 8 (every kernel message to the console, which runs at
+    loglevel 3), then w (the tasks in uninterruptible sleep, with their stacks) and l (what the
+    CPU runs: a realtime thread that spins), typed on the guest's keyboard through QMP; the
+    kernel writes them to the console before QEMU is stopped."""
+    for key in ("8", "w", "l"):
+        keys = [{"type": "qcode", "data": name} for name in ("alt", "sysrq", key)]
+        qmp.command({"execute": "send-key", "arguments": {"keys": keys}})
+    time.sleep(settle_s)
 
 
 def _stage_failure(result, what):

@@ -155,6 +155,34 @@ TEST_CASE("board driver: timeouts, partial transfers and a stall are counted and
   CHECK(bus->resubmitsInFlight() == 0);
 }
 
+TEST_CASE("board driver: transfers that fail at once are sent again a set-point period later, not at once", "[board]") {
+  // A device going away fails every transfer at once before the kernel has seen it go; sent
+  // again from the callback, the realtime USB thread spun and, on one CPU, starved the kernel's
+  // hub work so that the unplug was never seen (tests/kernel/test_board_gadget.cpp).
+  auto bus = EmulatedUsb::create();
+  auto backend = openBoard(bus);
+  std::string error;
+  REQUIRE(armAlone(*backend, error));
+  REQUIRE(waitFor([&] { return bus->validFrames() > 5; }));
+  const uint64_t lostBefore = backend->telemetry().lostTransfers;
+  const auto start = std::chrono::steady_clock::now();
+  bus->failOut(true);
+  std::this_thread::sleep_for(100ms);
+  const uint64_t failed = backend->telemetry().lostTransfers - lostBefore;
+  const double elapsedMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  bus->failOut(false);
+  // Each failure holds its transfer back a set-point period (1 ms): at most one per queued
+  // transfer (2) a millisecond, and the two in flight when it began.
+  const double bound = 2.0 * elapsedMs + 2.0;
+  std::printf("transfers failing at once: %llu failures in %.1f ms (bound %.0f)\n",
+              static_cast<unsigned long long>(failed), elapsedMs, bound);
+  CHECK(failed >= 2);
+  CHECK(static_cast<double>(failed) <= bound);
+  const uint64_t frames = bus->validFrames();
+  CHECK(waitFor([&] { return bus->validFrames() > frames + 20; }));  // and the stream goes on
+  CHECK(backend->telemetry().connected);
+}
+
 TEST_CASE("board driver: unplug mid-transfer, replug stays disarmed until armed", "[board]") {
   auto bus = EmulatedUsb::create();
   BoardOptions options;
