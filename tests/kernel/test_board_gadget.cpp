@@ -67,6 +67,16 @@ struct HostBoard {
     backend->takeRestartFromOff();
   }
   BoardTelemetry telemetry() const { return backend->telemetry(); }
+  // Opens the gadget's board, arms it and streams half its drive for 100 ms: the set-point's drive.
+  uint16_t streamHalf() {
+    std::string error;
+    INFO(error);
+    REQUIRE(open(GadgetBoard::kSerial, error));
+    arm();
+    backend->commandDrive(0.0, 0.0f, 0.5f);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return backend->latestDrive();
+  }
 };
 
 // The sequences the gadget applied: how many were missing between them and how many came twice.
@@ -294,11 +304,7 @@ TEST_CASE("board gadget: 10 s of set-points, each received once and in order", "
 TEST_CASE("board gadget: a halted endpoint is cleared by the host, and set-points and status go on", "[gadget]") {
   GadgetBoard gadget;
   HostBoard host;
-  std::string error;
-  REQUIRE(host.open(GadgetBoard::kSerial, error));
-  host.arm();
-  host.backend->commandDrive(0.0, 0.0f, 0.5f);
-  std::this_thread::sleep_for(100ms);
+  host.streamHalf();
   // The host's counts first, then the gadget's report: a set-point lost in between is counted
   // by the host and not missed by the gadget (the test's thread may wait behind the realtime
   // ones on the guest's one CPU).
@@ -357,12 +363,7 @@ TEST_CASE(
     "[gadget]") {
   GadgetBoard gadget;
   HostBoard host;
-  std::string error;
-  REQUIRE(host.open(GadgetBoard::kSerial, error));
-  host.arm();
-  host.backend->commandDrive(0.0, 0.0f, 0.5f);
-  const uint16_t drive = host.backend->latestDrive();
-  std::this_thread::sleep_for(100ms);
+  const uint16_t drive = host.streamHalf();
   const BoardTelemetry before = host.telemetry();  // first, as in the halt's case
   gadget.report();
   const int64_t pauseNs = nowNs();
@@ -423,12 +424,7 @@ TEST_CASE(
     "[gadget]") {
   GadgetBoard gadget;
   HostBoard host;
-  std::string error;
-  REQUIRE(host.open(GadgetBoard::kSerial, error));
-  host.arm();
-  host.backend->commandDrive(0.0, 0.0f, 0.5f);
-  const uint16_t drive = host.backend->latestDrive();
-  std::this_thread::sleep_for(100ms);
+  const uint16_t drive = host.streamHalf();
   gadget.report();
   const int64_t unplugNs = nowNs();
   gadget.unplug();
