@@ -530,7 +530,7 @@ TEST_CASE("board gadget: closed with transfers in flight, every callback comes b
 }
 
 TEST_CASE(
-    "board gadget: the firmware's reference behaviour over a real bus; a status frame nobody takes is built "
+    "board gadget: the firmware's reference behaviour over a real bus: a status frame nobody takes is built "
     "anew every tick",
     "[gadget]") {
   GadgetBoard gadget;
@@ -599,7 +599,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "board gadget: its coil on a PWM pin and its temperature from a sensor; too hot, it refuses to arm until "
+    "board gadget: its coil on a PWM pin and its temperature from a sensor: too hot, it refuses to arm until "
     "it cools",
     "[gadget]") {
   // A PWM channel and a sensor as sysfs shows them, as plain files: the guest has no PWM chip.

@@ -84,7 +84,7 @@ std::string drivesOf(const std::vector<GadgetFrame>& frames, size_t from) {
 }  // namespace
 
 TEST_CASE(
-    "scene: sclang on the host plays the pilot on scsynth in the guest; the USB mouse moves it and the "
+    "scene: sclang on the host plays the pilot on scsynth in the guest, the USB mouse moves it and the "
     "gadget board receives its forces",
     "[scene]") {
   // The board is a machine of its own; here it shares the guest's one CPU with the audio chain
