@@ -1,5 +1,5 @@
 // The psychometric function of the threshold procedures, one form for all of them (the model
-// observer, QUEST+, the constant stimuli's fit, python/kfharness/psychometric.py): a Weibull in
+// observer, QUEST+, the constant stimuli's fit, python/kfstudy/psychometric.py): a Weibull in
 // the stimulus level x > 0 (a difference in N, ms or mm) for a forced choice,
 //   p(x) = guess + (1 - guess - lapse) * (1 - exp(-(x / threshold) ^ slope)),
 // guess = 1/2 for two intervals. At x = threshold, p = guess + (1 - guess - lapse) * (1 - 1/e):
