@@ -70,8 +70,9 @@ struct HostBoard {
   // Opens the gadget's board, arms it and streams half its drive for 100 ms: the set-point's drive.
   uint16_t streamHalf() {
     std::string error;
-    INFO(error);
-    REQUIRE(open(GadgetBoard::kSerial, error));
+    const bool opened = open(GadgetBoard::kSerial, error);
+    INFO(error);  // captured here: after the open has written it
+    REQUIRE(opened);
     arm();
     backend->commandDrive(0.0, 0.0f, 0.5f);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
