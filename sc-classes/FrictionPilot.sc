@@ -5,6 +5,9 @@
 FrictionPilot {
 	classvar <mappings, <signalFrames, <cycleFrames;
 	classvar <paperLoForceN, <paperHiForceN, <paperAudioDelayS;
+	// The heard sound's DC blocker (Hz): a resting puck's constant decays with a time constant of
+	// 1 / (2 pi 5) = 32 ms; above 20 Hz, where hearing starts, the loss is under 0.3 dB.
+	classvar <dcBlockerHz = 5;
 	classvar <recordChannelNames;
 
 	var <device, <mapping, <samplesPerMm, <friction, <origin, <amp, <out;
@@ -115,11 +118,17 @@ FrictionPilot {
 		loudness = LoudnessToFriction.ar(audio, loForce: loForceN, hiForce: hiForceN);
 		force = loForceN + (friction.clip(0, 1) * (loudness - loForceN));
 		commanded = FrictionOut.ar(device, force);
-		// Audio latency 1.4 ms, tactile 2.4 ms: audio waits the difference (1 ms).
-		delayed = DelayL.ar(audio * amp, maxAudioDelay, audioDelay);
+		// Audio latency 1.4 ms, tactile 2.4 ms: audio waits the difference (1 ms). What is heard
+		// passes a DC blocker: a puck resting on the fragment reads one sample again and again, a
+		// constant no speaker should get. The force is computed before it, from the signal as read.
+		delayed = LeakDC.ar(DelayL.ar(audio * amp, maxAudioDelay, audioDelay), this.prDcBlockerCoef);
 		^(position: mouse[0], speed: mouse[2], audio: audio, delayedAudio: delayed,
 			force: force, commandedForce: commanded)
 	}
+
+	// LeakDC's coefficient for a cutoff of dcBlockerHz at the server's sample rate (a 1-pole
+	// high-pass: y = x - x1 + coef * y1, coef = exp(-2 pi fc / sr)).
+	*prDcBlockerCoef { ^exp(-2pi * dcBlockerHz * SampleDur.ir) }
 
 	// A SynthDef of the pilot for device (a FrictionDevice or a slot index). Controls: device,
 	// bufnum, samplesPerMm, origin (mm), friction (0 off .. 1 on), amp, out (stereo), audioDelay

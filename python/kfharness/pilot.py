@@ -28,6 +28,12 @@ SPEED_STEP = _DEVICE["countMm"] * _DEVICE["updateRateHz"]  # 2.625 mm/s: one cou
 MAX_SPEED = profile.max_speed_mm_per_s()         # 333.375 mm/s
 PAPER_SPEEDS = (2.6, 334.0)                      # as the paper rounds them
 AUDIO_DELAY_S = profile.audio_delay_s()
+DC_BLOCKER_HZ = 5.0                              # FrictionPilot.dcBlockerHz: LeakDC on what is heard
+
+
+def dc_blocker_coef(sample_rate):
+    """LeakDC's coefficient in FrictionPilot: a one-pole high-pass at DC_BLOCKER_HZ."""
+    return np.exp(-2 * np.pi * DC_BLOCKER_HZ / sample_rate)
 
 # Channels of a FrictionPilot.score render with recordBus 2.
 CHANNELS = ["out_left", "out_right", "position", "speed", "audio", "delayed_audio", "force", "commanded_force"]
