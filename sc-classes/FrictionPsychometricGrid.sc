@@ -6,7 +6,7 @@ FrictionPsychometricGrid {
 	var <thresholds, <slopes, <lapses, <guess;
 	// Per grid point: its threshold, slope and lapse (Arrays of the grid's size).
 	var <thresholdOf, <slopeOf, <lapseOf;
-	var <logPosterior, probabilitiesAt, logSignalsAt;
+	var <logPosterior, probabilitiesAt, logSignalsAt, logsAt;
 
 	*new { |thresholds, slopes, lapses, guess = 0.5|
 		^super.new.prInit(thresholds, slopes, lapses, guess)
@@ -27,6 +27,7 @@ FrictionPsychometricGrid {
 		} } };
 		probabilitiesAt = Dictionary.new;
 		logSignalsAt = Dictionary.new;
+		logsAt = Dictionary.new;
 		this.reset
 	}
 
@@ -55,12 +56,34 @@ FrictionPsychometricGrid {
 	}
 
 	// Bayes' rule for one trial: log p(answer | level, parameters) added to each grid point, then
-	// normalised (the log posterior's exp sums to 1).
+	// normalised (the log posterior's exp sums to 1). In place, in inlined loops: a trial allocates
+	// nothing. (Array arithmetic made about 10 arrays of the grid's size a trial; SuperCollider
+	// 3.13's collector, run that often after a long session, once broke on its own heap in the
+	// QUEST+ example: ARCHITECTURE.md, sclang 3.13's stack and caught errors.)
 	update { |level, correct|
-		var p = this.probabilities(level), top;
-		logPosterior = logPosterior + this.prLogOf(if(correct) { p } { 1 - p });
-		top = logPosterior.maxItem;
-		logPosterior = logPosterior - (top + (logPosterior - top).exp.sum.log)
+		var logs = this.prLogsAt(level)[if(correct) { 0 } { 1 }];
+		var n = logPosterior.size, k = 0, v, top = -inf, sum = 0.0;
+		while { k < n } {
+			v = logPosterior[k] + logs[k];
+			logPosterior[k] = v;
+			if(v > top) { top = v };
+			k = k + 1
+		};
+		k = 0;
+		while { k < n } { sum = sum + (logPosterior[k] - top).exp; k = k + 1 };
+		top = top + sum.log;
+		k = 0;
+		while { k < n } { logPosterior[k] = logPosterior[k] - top; k = k + 1 };
+	}
+
+	// [log p, log(1 - p)] at level for every grid point (Arrays of Floats), kept per level.
+	prLogsAt { |level|
+		^logsAt[level] ?? {
+			var p = this.probabilities(level);
+			var logs = [this.prLogOf(p), this.prLogOf(1 - p)];
+			logsAt[level] = logs;
+			logs
+		}
 	}
 
 	// log of probabilities, 0 taken as 1e-300: an answer a grid point calls impossible (a lapse of

@@ -6,7 +6,7 @@
 // both the same answers and compare).
 FrictionQuestPlus {
 	var <levels, <grid, <maxTrials, <trials;
-	// Per level (as Signals over the grid): p(correct), and p log p + (1 - p) log(1 - p).
+	// Per level (Arrays over the grid): p(correct), and p log p + (1 - p) log(1 - p).
 	var correctOf, negEntropyOf;
 
 	// levels: the levels to choose from (> 0); thresholds, slopes, lapses: the grid (nil: 40
@@ -29,11 +29,11 @@ FrictionQuestPlus {
 		grid = FrictionPsychometricGrid(
 			thresholds ?? { FrictionPsychometric.logLevels(levels.minItem, levels.maxItem, 40) },
 			slopes ? #[1.5, 2, 3, 4, 6], lapses ? #[0, 0.02, 0.04], guess);
-		correctOf = levels.collect { |l| Signal.newFrom(grid.probabilities(l)) };
+		correctOf = levels.collect { |l| grid.probabilities(l) };
 		negEntropyOf = levels.collect { |l|
 			var p = grid.probabilities(l);
 			// 0 log 0 = 0: a grid point certain of the answer adds no entropy.
-			Signal.newFrom((p * p.max(1e-300).log) + ((1 - p) * (1 - p).max(1e-300).log))
+			(p * p.max(1e-300).log) + ((1 - p) * (1 - p).max(1e-300).log)
 		};
 		trials = [];
 	}
@@ -42,17 +42,33 @@ FrictionQuestPlus {
 
 	// The expected entropy after a trial at levels[i] is, up to a constant of all levels,
 	// -H(p) + sum posterior * (-H(p per grid point)), where p = sum posterior * p(correct): the
-	// two outcomes' entropies written out, their posterior log terms cancel. Signals (float)
-	// make the sums primitive calls; the posterior itself stays double.
+	// two outcomes' entropies written out, their posterior log terms cancel. The sums in double,
+	// in inlined loops: a trial allocates only the posterior (FrictionPsychometricGrid.update says
+	// why that matters).
 	next {
-		var posterior, expected;
+		var posterior, n, i = 0, k, w, p, negEntropy, correct, expected, best, bestIndex;
 		if(this.isFinished) { ^nil };
-		posterior = Signal.newFrom(grid.posterior);
-		expected = correctOf.collect { |correct, i|
-			var p = (posterior * correct).integral.clip(1e-12, 1 - 1e-12);
-			(p * p.log) + ((1 - p) * (1 - p).log) - (posterior * negEntropyOf[i]).integral
+		posterior = grid.posterior;
+		n = posterior.size;
+		while { i < levels.size } {
+			correct = correctOf[i];
+			negEntropy = negEntropyOf[i];
+			p = 0.0;
+			expected = 0.0;
+			k = 0;
+			while { k < n } {
+				w = posterior[k];
+				p = p + (w * correct[k]);
+				expected = expected - (w * negEntropy[k]);
+				k = k + 1
+			};
+			p = p.clip(1e-12, 1 - 1e-12);
+			expected = expected + (p * p.log) + ((1 - p) * (1 - p).log);
+			// The first of equal ones, as minIndex.
+			if(bestIndex.isNil or: { expected < best }) { best = expected; bestIndex = i };
+			i = i + 1
 		};
-		^levels[expected.minIndex]
+		^levels[bestIndex]
 	}
 
 	respond { |level, correct|

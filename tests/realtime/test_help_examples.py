@@ -69,6 +69,11 @@ PIECE_PAUSE_S = 0.3
 BLOCK_TIME_S = 1.2
 # A person waits for a fork's waits; one still running after this is left running.
 FORK_WAIT_MAX_S = 10.0
+# The soak after the guides: runs of each threshold procedure in one Routine (QUEST+ 0.25 s a run
+# here, the constant stimuli's fit 0.3 s, a staircase 1 ms), about 25 s in all. sclang's alone: the
+# pass against the sanitized plugin (KF_SERVER_PRELOAD) leaves it out, as it would add nothing.
+SOAK_RUNS = {"questPlus": 60, "constantStimuli": 30, "staircase2down": 200, "staircase3down": 200}
+SOAK = not os.environ.get("KF_SERVER_PRELOAD")
 # A boot takes ~1 s here; a server not back after this is a failure.
 BOOT_WAIT_MAX_S = 30.0
 # After a guide's clean-up: how long the runner listens for synths still running.
@@ -87,6 +92,7 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
+var runPiece, pieceStack;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -118,6 +124,35 @@ piecesOf = { |code|
 		pieces = [code];
 	};
 	pieces
+};
+// Each piece runs in a Routine of its own, as the IDE runs each at the top level, on a stack that
+// starts empty. In SuperCollider 3.13 a non-local return (how try catches an error, how ^ leaves a
+// block) leaves the arguments pending in the frames it unwinds on the thread's stack: in one Routine
+// for the whole run they piled up past its fixed-size stack, into the heap (sclang's "grey count
+// error", then a SIGSEGV, in the QUEST+ block after the other guides). The piece's environment
+// (a ProxySpace pushed) carries on, as the IDE's does. Returns (threw:, value:, stack:): stack is
+// the slots on the piece's stack at its end; a piece that threw nothing and leaves more than an
+// empty one (pieceStack) is reported (KF-HELP-STACK-LEFT): its code piles them up in a long Routine.
+// (Seen: FrictionCheck's example catching three refusals left 4 slots.)
+runPiece = { |fn|
+	var value, threw = false, stack, environment, routine, ended = Condition(false);
+	routine = Routine {
+		// The value is kept before it is posted: with "-> " ++ fn.value inside the try,
+		// an error caught within the piece left 1.0 in place of the pending "-> ".
+		try { value = fn.value } { |error| error.reportError; threw = true };
+		environment = currentEnvironment;
+		ended.test = true;
+		ended.signal;
+		\kfPieceEnd.yield;  // suspended (AppClock does not call it again), its stack is there to read
+	};
+	routine.play(AppClock);
+	// Waiting on a Condition, the runner is on no clock's queue: a piece's Cmd-. (CmdPeriod.run)
+	// clears the queues, and would have dropped a runner waiting there.
+	ended.wait;
+	stack = routine.instVarAt(\stack).size;
+	routine.stop;
+	currentEnvironment = environment;
+	(threw: threw, value: value, stack: stack)
 };
 serverAlive = { s.pid.notNil and: { s.pid.pidRunning } };
 restart = {
@@ -187,6 +222,7 @@ nodesBesidesDefault = {
 };
 
 "KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
+pieceStack = runPiece.({ nil })[\stack];
 files.do { |path, f|
 	var doc = SCDoc.parseFileFull(path), blocks, known = routinesQueued.(), fileStart = Main.elapsedTime;
 	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%".format(path).postln } {
@@ -204,17 +240,18 @@ files.do { |path, f|
 				lines.do { |line| line.find("//") !? { |at| ("KF-HELP-COMMENT " ++ line.drop(at + 2)).postln } };
 			};
 			pieces.do { |piece, p|
-				var fn = piece.compile, value, threw = false;
+				var fn = piece.compile, run;
 				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
 				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%".format(path, b, p).postln } {
-					// The value is kept before it is posted: with "-> " ++ fn.value inside the try,
-					// an error caught within the piece left 1.0 in place of the pending "-> ".
-					try { value = fn.value } { |error|
-						error.reportError;
-						threw = true;
-						"KF-HELP-THROWN %% %% %%".format(path, b, p).postln;
+					run = runPiece.(fn);
+					if(run[\threw]) { "KF-HELP-THROWN %% %% %%".format(path, b, p).postln } {
+						("-> " ++ run[\value].asString).postln;
+						// (A piece that catches errors itself leaves them there, as any caught error
+						// does in SC 3.13: not ours to fix, and its Routine ends with the piece.)
+						if(run[\stack] > pieceStack and: { piece.find("try").isNil and: { piece.find("protect").isNil } }) {
+							"KF-HELP-STACK-LEFT %% %% %% %% slots".format(path, b, p, run[\stack] - pieceStack).postln
+						};
 					};
-					if(threw.not) { ("-> " ++ value.asString).postln };
 				};
 				waitLikeAPerson.(known, path, b);
 			};
@@ -240,6 +277,33 @@ files.do { |path, f|
 		"KF-HELP-FILE-DONE %% in %% s".format(path, (Main.elapsedTime - fileStart).round(0.1)).postln;
 	};
 };
+// The soak, after the guides in their interpreter: every threshold procedure run again and again in one
+// Routine, as a study session runs them, its stack read after every run (a procedure that leaves slots
+// on it would overflow it in a long session), then the heap walked by a full collection.
+if(%(soak)s and: { guides.includes(true) }) {
+	var levels = FrictionPsychometric.logLevels(0.01, 1, 30);
+	[
+		[\questPlus, { FrictionQuestPlus(levels, maxTrials: 40) }],
+		[\constantStimuli, { |i| FrictionConstantStimuli(levels.copyRange(8, 22), 4, seed: i) }],
+		[\staircase2down, { FrictionStaircase(0.3, 2, maxTrials: 60) }],
+		[\staircase3down, { FrictionStaircase(0.3, 3, maxTrials: 60) }]
+	].do { |named|
+		var stacks = List.new, start = Main.elapsedTime, routine = Routine {
+			(%(soak_runs)s[named[0]]).do { |i|
+				FrictionObserver(0.1, 3.5, 0.02, seed: i).runProcedure(named[1].(i));
+				\kfSoakRun.yield
+			}
+		};
+		while { routine.next == \kfSoakRun } { stacks.add(routine.instVarAt(\stack).size) };
+		"KF-HELP-SOAK %% runs %% stack %% to %% in %% s".format(named[0], stacks.size, stacks.first, stacks.maxItem,
+			(Main.elapsedTime - start).round(0.1)).postln;
+		0.01.wait;
+	};
+	// The collector's own check of its heap: it prints what it finds wrong ("grey count off", a list's
+	// "color wrong"), which FAILURES reads.
+	this.gcSanity;
+	"KF-HELP-GC-CHECKED".postln;
+};
 "KF-HELP-ALL-DONE".postln;
 """
 
@@ -255,6 +319,10 @@ FAILURES = [
     (re.compile(r"^KF-HELP-SERVER-DIED"), "scsynth exited"),
     (re.compile(r"^KF-HELP-BOOT-TIMEOUT"), "the server did not finish booting"),
     (re.compile(r"^KF-HELP-NO-DEFAULT-GROUP"), "the server has no default group (node 1)"),
+    (re.compile(r"grey count|color wrong|gcset wrong|next->prev != obj|grey obj on free list"),
+     "sclang's heap is inconsistent (its collector's own check)"),
+    (re.compile(r"^KF-HELP-STACK-LEFT"), "a piece left slots on its thread's stack (non-local returns through "
+     "pending arguments: sclang 3.13 overflows a long Routine's stack into its heap)"),
     (re.compile(r"^KF-HELP-LEFT-RUNNING"), "a node left running after the guide's clean-up"),
     # A reboot's quit ends scsynth with 0; a server that died unasked is KF-HELP-SERVER-DIED.
     (re.compile(r"^Server '\w+' exited with exit code (?!0\.)"), "scsynth exited"),
@@ -354,10 +422,11 @@ def check_written(text, temp_dir, since):
     return None
 
 
-def run_examples(files, jack, timeout=240, after=None, booted=None):
+def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
     """Runs every example of `files`, in this order, on one server booted against `jack`, once the
     Event `after` (if any) is set; sets `booted` when its server is up. Returns (run, examples,
-    problems, notes): problems are the failures and unmet expectations, each naming its example."""
+    problems, notes): problems are the failures and unmet expectations, each naming its example.
+    soak: the threshold procedures' soak after the guides (if `files` has guides)."""
     if after is not None:
         after.wait()
     since = time.time()
@@ -365,7 +434,8 @@ def run_examples(files, jack, timeout=240, after=None, booted=None):
                          guides=", ".join(str(is_guide(f)).lower() for f in files),
                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
                          boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
-                         free_each_block=str(FREE_EACH_BLOCK).lower())
+                         free_each_block=str(FREE_EACH_BLOCK).lower(), soak=str(soak).lower(),
+                         soak_runs="(" + ", ".join(f"{k}: {v}" for k, v in SOAK_RUNS.items()) + ")")
     run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
                                  # The study's examples: the participant's pair and the experimenter's.
                                  server_options={"numOutputBusChannels": 4})
@@ -520,7 +590,7 @@ def test_every_help_example_runs_on_a_realtime_server():
         booted = [threading.Event() for _ in shards]
         with ThreadPoolExecutor(len(shards)) as pool:
             results = list(pool.map(lambda i: run_examples(shards[i], jacks[i], after=booted[i - 1] if i else None,
-                                                           booted=booted[i]), range(len(shards))))
+                                                           booted=booted[i], soak=SOAK), range(len(shards))))
         jacks_alive = all(jack.alive() for jack in jacks)
 
     problems = [p for _, _, shard_problems, _ in results for p in shard_problems]
@@ -536,6 +606,13 @@ def test_every_help_example_runs_on_a_realtime_server():
             assert f"KF-HELP-FILE-DONE {f}" in run.output, f"{f} did not run, log {run.log_path}"
     assert not problems, "help examples with problems:\n" + "\n".join(problems)
     assert sum(len(e.expects) for e in examples) >= 10, "the help's output annotations were not read"
+    if SOAK:
+        guides_run = results[0][0]
+        soaks = re.findall(r"^KF-HELP-SOAK (\w+) runs (\d+) stack (\d+) to (\d+)", guides_run.output, re.M)
+        assert {name: int(runs) for name, runs, *_ in soaks} == SOAK_RUNS, f"the soak did not run whole: {soaks}"
+        for name, _, first, most in soaks:
+            assert first == most, f"{name} left {int(most) - int(first)} slots on its Routine's stack over the soak"
+        assert "KF-HELP-GC-CHECKED" in guides_run.output, "the heap was not checked after the soak"
 
 
 # Broken examples, one way each, and good blocks: every broken one must be reported, the good
@@ -578,6 +655,11 @@ s.sendMsg("/n_free", 99998);
 
 code::
 (1 + 1).postln;  // posts: 2
+::
+
+code::
+// a catch the runner cannot see in the piece, as a class's method would hide it
+{ [1, 2].collect { |x| Error("caught, in the middle of collect").throw } }.perform(("tr" ++ "y").asSymbol, { 0 });
 ::
 
 code::
@@ -625,7 +707,8 @@ BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found")
           ("BrokenExamples", 3, "FAILURE IN SERVER /n_free Node 99996 not found"),
           ("BrokenExamples", 3, '// fails with "Node 99997 not found": not posted'),
           ("BrokenExamples", 5, "a test marker of an earlier version, not read: // posts: 2"),
-          ("BrokenExamples", 6, "the server has no default group"),
+          ("BrokenExamples", 6, "left slots on its thread's stack"),
+          ("BrokenExamples", 7, "the server has no default group"),
           ("BrokenGuide", 3, "a slot with no device"), ("BrokenGuide", 3, "a node left running")]
 GOOD = [("BrokenExamples", 4), ("BrokenGuide", 0), ("BrokenGuide", 1), ("BrokenGuide", 2)]
 
@@ -640,7 +723,7 @@ def test_broken_examples_are_reported(tmp_path):
         run, examples, problems, notes = run_examples(help_files, jack, timeout=120)
     print("\n".join(problems))
     assert run.ok and [(Path(e.path).stem, e.block) for e in examples] == \
-        [("BrokenExamples", b) for b in range(7)] + [("BrokenGuide", b) for b in range(4)], run.output[-3000:]
+        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(4)], run.output[-3000:]
     named = {path.stem: path for path in help_files}
     for name, block, what in BROKEN:
         assert any(p.startswith(f"{named[name]} block {block} ") and what in p for p in problems), \
