@@ -30,14 +30,14 @@ FrictionOut : UGen {
 	optimizeGraph {
 		var envelope;
 		if(followsGate.not) { ^this };
-		envelope = this.class.gateEnvelopeOf(synthDef);
+		envelope = this.class.prGateEnvelopeOf(synthDef);
 		if(envelope.notNil) { inputs[2] = envelope };
 	}
 
 	// The envelope that releases a synth: an EnvGen whose gate is the control named gate and
 	// whose doneAction is 2 (it frees the synth). The last built when there are several (in a
 	// NodeProxy, the proxy's own fade). nil when there is none.
-	*gateEnvelopeOf { |def|
+	*prGateEnvelopeOf { |def|
 		var found;
 		def.children.do { |ugen|
 			if(ugen.isKindOf(EnvGen) and: { ugen.inputs[4] == 2 }
