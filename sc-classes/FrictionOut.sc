@@ -56,9 +56,8 @@ FrictionOut : UGen {
 		if(input.isKindOf(OutputProxy).not or: { input.source.isKindOf(Control).not }) { ^nil };
 		index = input.source.specialIndex + input.outputIndex;
 		def.allControlNames.do { |cn|
-			if(cn.index.notNil and: { index >= cn.index } and: { index < (cn.index + cn.defaultValue.asArray.size.max(1)) }) {
-				name = cn.name
-			}
+			var size = cn.defaultValue.asArray.size.max(1);
+			if(cn.index.notNil and: { index >= cn.index } and: { index < (cn.index + size) }) { name = cn.name }
 		};
 		^name
 	}
