@@ -2,12 +2,15 @@
 //
 // The writers of a slot add their force of each block into one per-slot sum; the slot frames
 // that sum once, so the device receives exactly one frame per millisecond. The rule, at every
-// sample (forces in N, NaN/Inf as the minimum):
-//     combined = minForce + sum over writers of max(0, force - minForce)
+// sample (forces in N, NaN/Inf as the minimum; weights clamped to [0, 1], NaN/Inf as 0):
+//     combined = minForce + sum over writers of weight * max(0, force - minForce)
 // then each 1 ms frame is the mean of `combined`, clamped to [minForce, maxForce] (ForceFramer),
 // and the device applies its own limits (ForceSafety). So one writer commands its own force
 // (a force below the minimum counts as the minimum), idle writers stay at the floor together
-// (two do not double the magnet-off force), and forces above the floor add up.
+// (two do not double the magnet-off force), and forces above the floor add up. The weight is
+// FrictionOut's fade (by default its synth's gate envelope): two versions crossfading with
+// complementary weights (w and 1 - w, as JITLib's fades are) command a force between theirs,
+// never more than the larger one.
 //
 // Writers register with the slot (constructor, destructor: FrictionOut), so the last writer of
 // a block knows it is the last and frames the block at once: no added latency. (A writer that
@@ -39,13 +42,24 @@ class SlotForce {
   int registeredWriters() const { return registered_; }
 
   // A writer's force for block `clock`: `forceN` has `numSamples` values, one per sample of the
-  // block (audio rate) or a single value held over it (numSamples 1: control rate). `sink`
+  // block (audio rate) or a single value held over it (numSamples 1: control rate); so has its
+  // weight `fade` (`fadeSamples` values), which scales the force above the minimum. `sink`
   // (double frameTimeS, float forceN, double frameEndS) -> float receives the frames of blocks
   // that complete here and returns the force the device actually commanded for it (after its
   // safety path), which the commanded output shows from then on. Returns true when this block has been framed (this
   // writer was the last).
   template <class Sink>
-  bool write(const BlockClock& clock, const float* forceN, int numSamples, Sink& sink);
+  bool write(const BlockClock& clock, const float* forceN, int numSamples, const float* fade, int fadeSamples,
+             Sink& sink);
+  // A writer of weight 1.
+  template <class Sink>
+  bool write(const BlockClock& clock, const float* forceN, int numSamples, Sink& sink) {
+    const float one = 1.0f;
+    return write(clock, forceN, numSamples, &one, 1, sink);
+  }
+
+  // A writer's weight as the rule takes it: clamped to [0, 1], NaN and Inf as 0 (the safe value).
+  static double weightOf(float fade) { return std::isfinite(fade) ? std::clamp(fade, 0.0f, 1.0f) : 0.0; }
 
   // A writer went away (destructor, after unregisterWriter) during `clock`'s block: if it was
   // the last one missing, the block is framed now. If no writer is left, the frame in progress
@@ -91,7 +105,8 @@ class SlotForce {
 };
 
 template <class Sink>
-bool SlotForce::write(const BlockClock& clock, const float* forceN, int numSamples, Sink& sink) {
+bool SlotForce::write(const BlockClock& clock, const float* forceN, int numSamples, const float* fade, int fadeSamples,
+                      Sink& sink) {
   // A writer whose synth starts this block registers in its first calc (scsynth constructs
   // units then): if the writers before it have framed the block already, its force joins from
   // the next block, so no millisecond is framed twice.
@@ -104,7 +119,8 @@ bool SlotForce::write(const BlockClock& clock, const float* forceN, int numSampl
   for (int i = 0; i < n; ++i) {
     const float f = forceN[numSamples == 1 ? 0 : std::min(i, numSamples - 1)];
     // NaN and Inf are the minimum (magnet off, the safe value): they add nothing.
-    if (std::isfinite(f) && f > minForceN_) excessN_[i] += f - minForceN_;
+    if (std::isfinite(f) && f > minForceN_)
+      excessN_[i] += weightOf(fade[fadeSamples == 1 ? 0 : std::min(i, fadeSamples - 1)]) * (f - minForceN_);
   }
   ++arrived_;
   if (arrived_ >= registered_) {

@@ -5,14 +5,17 @@
 // device actually commanded after its safety path (slew, drive limits, watchdog), so it can be
 // scoped and recorded: per sample for the last writer of a block (the only one when there is
 // one), held from the previous block for the others.
-// Inputs: device (slot index), force (N).
+// Inputs: device (slot index), force (N), fade (0..1, optional: 1 when absent), the weight of
+// this writer's force above the minimum (by default its synth's gate envelope, FrictionOut.sc).
 #include "AudioClock.hpp"
 #include "DeviceSlots.hpp"
 #include "PluginShared.hpp"
 
 namespace {
 
-enum Input { kDevice, kForceN };
+enum Input { kDevice, kForceN, kFade };
+
+constexpr float kFullWeight = 1.0f;  // the fade of a writer without that input
 
 // Pushes the slot's frames to its device, each stamped with the device-clock time its
 // millisecond ended: now, less the audio time between the frame's end and the end of the
@@ -76,7 +79,11 @@ class FrictionOut : public SCUnit {
     FrameSink sink{device, device->nowS(), blockEndS};
     // A control-rate force is held over the block.
     const bool audioRate = isAudioRateIn(kForceN);
-    const bool framed = force->write(clock, in(kForceN), audioRate ? clock.numSamples : 1, sink);
+    // The fade likewise; a SynthDef built before it had the input (two inputs) weighs 1.
+    const bool hasFade = numInputs() > kFade;
+    const float* fade = hasFade ? in(kFade) : &kFullWeight;
+    const int fadeSamples = hasFade && isAudioRateIn(kFade) ? clock.numSamples : 1;
+    const bool framed = force->write(clock, in(kForceN), audioRate ? clock.numSamples : 1, fade, fadeSamples, sink);
     if (framed && mCalcRate == calc_FullRate) {
       std::copy_n(force->commanded(), std::min(numSamples, kf::sc::SlotForce::kMaxBlockSamples), out(0));
     } else if (framed) {

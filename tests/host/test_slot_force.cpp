@@ -1,9 +1,12 @@
 // SlotForce: however many writers a slot has, the device gets one frame per millisecond, by
-// the documented rule (forces above the minimum add up), without added latency.
+// the documented rule (forces above the minimum add up, each weighted by its writer's fade),
+// without added latency.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "SlotForce.hpp"
@@ -229,4 +232,97 @@ TEST_CASE("a writer that registers after the block was framed joins from the nex
     REQUIRE(sink.frames[i].timeS - sink.frames[i - 1].timeS == Approx(0.001).margin(1e-12));
   CHECK(sink.frames[5].forceN == Approx(0.3));
   CHECK(sink.frames[20].forceN == Approx(1.16));
+}
+
+// --- weights (FrictionOut's fade: by default its synth's gate envelope) -------------------------
+
+TEST_CASE("a writer's weight scales its force above the minimum, clamped to [0, 1], NaN and Inf as 0") {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  // weight -> expected frame for a writer asking 0.8 N (0.66 N above the minimum of 0.14 N)
+  const std::vector<std::pair<float, float>> cases = {{1.0f, 0.8f},  {0.5f, 0.47f},  {0.0f, 0.14f},   {1.5f, 0.8f},
+                                                      {1e30f, 0.8f}, {-0.5f, 0.14f}, {-1e30f, 0.14f}, {nan, 0.14f},
+                                                      {inf, 0.14f},  {-inf, 0.14f}};
+  for (const auto& [weight, expected] : cases) {
+    INFO("weight " << weight);
+    for (int fadeSamples : {1, 64}) {  // control-rate and audio-rate weights
+      auto slot = makeSlot(1);
+      Recorder sink;
+      std::vector<float> force(64, 0.8f), fade(64, weight);
+      for (int64_t blk = 0; blk < 75; ++blk)
+        slot->write(clockOf(blk), force.data(), 64, fade.data(), fadeSamples, sink);
+      REQUIRE(sink.frames.size() == 100);
+      for (const Frame& f : sink.frames) REQUIRE(f.forceN == Approx(expected).margin(1e-6));
+    }
+  }
+}
+
+TEST_CASE("a weight of 1 is the writer's own force, exactly, and a weight never lifts a force below the minimum") {
+  auto slot = makeSlot(2);
+  Recorder sink;
+  std::vector<float> force(64, 0.731f), low(64, 0.05f), one(64, 1.0f), two(64, 2.0f);
+  for (int64_t blk = 0; blk < 75; ++blk) {
+    slot->write(clockOf(blk), force.data(), 64, one.data(), 64, sink);
+    slot->write(clockOf(blk), low.data(), 64, two.data(), 64, sink);  // 0.05 N counts as the minimum
+  }
+  for (const Frame& f : sink.frames) REQUIRE(f.forceN == 0.731f);
+}
+
+namespace {
+
+// JITLib's crossfade (EnvGate, curve 'sin'): the new version rises 0 -> 1 on a half cosine over
+// the fade, the old one falls 1 -> 0 on the same shape, both from the same block. Their weights
+// are w and 1 - w at every sample. Returns the frames of two writers asking oldN and newN,
+// fading over fadeS after 0.1 s at full weight of the old one; `sampleRate` per sample weights
+// (audio rate), `controlRate` one weight per block (EnvGen.kr, as EnvGate is).
+std::vector<Frame> crossfade(float oldN, float newN, double fadeS, bool controlRate) {
+  auto slot = makeSlot(2);
+  Recorder sink;
+  const double rate = 48000.0;
+  std::vector<float> oldF(64, oldN), newF(64, newN), wOld(64), wNew(64);
+  const int64_t blocks = static_cast<int64_t>((0.2 + fadeS) * rate / 64);
+  for (int64_t blk = 0; blk < blocks; ++blk) {
+    for (int i = 0; i < 64; ++i) {
+      const int64_t n = blk * 64 + (controlRate ? 0 : i);
+      const double x = std::clamp((n / rate - 0.1) / fadeS, 0.0, 1.0);
+      wNew[i] = static_cast<float>(0.5 - 0.5 * std::cos(std::acos(-1.0) * x));
+      wOld[i] = 1.0f - wNew[i];
+    }
+    sink.currentBlock = blk;
+    slot->write(clockOf(blk), oldF.data(), 64, wOld.data(), controlRate ? 1 : 64, sink);
+    slot->write(clockOf(blk), newF.data(), 64, wNew.data(), controlRate ? 1 : 64, sink);
+  }
+  return sink.frames;
+}
+
+}  // namespace
+
+TEST_CASE("a crossfade of complementary weights between two 0.5 N versions stays at 0.5 N, not their sum 0.86 N") {
+  for (bool controlRate : {false, true}) {
+    INFO((controlRate ? "control-rate" : "audio-rate") << " weights");
+    const std::vector<Frame> frames = crossfade(0.5f, 0.5f, 2.0, controlRate);
+    REQUIRE(frames.size() >= 2199);
+    // w + (1 - w) is 1 within a float's rounding (6e-8 of 0.36 N above the minimum): 1e-6 N.
+    for (const Frame& f : frames) REQUIRE(f.forceN == Approx(0.5).margin(1e-6));
+  }
+}
+
+TEST_CASE("a crossfade from 0.5 N to 0.8 N moves from old to new, monotonic, never above the larger") {
+  for (bool controlRate : {false, true}) {
+    INFO((controlRate ? "control-rate" : "audio-rate") << " weights");
+    const std::vector<Frame> frames = crossfade(0.5f, 0.8f, 2.0, controlRate);
+    float hi = 0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      hi = std::max(hi, frames[i].forceN);
+      REQUIRE(frames[i].forceN >= 0.5f - 1e-6f);
+      REQUIRE(frames[i].forceN <= 0.8f + 1e-6f);
+      if (i > 0) REQUIRE(frames[i].forceN >= frames[i - 1].forceN - 1e-6f);
+      if (frames[i].timeS < 0.1 - 0.002) REQUIRE(frames[i].forceN == Approx(0.5).margin(1e-6));
+      if (frames[i].timeS > 2.1 + 0.002) REQUIRE(frames[i].forceN == Approx(0.8).margin(1e-6));
+    }
+    CHECK(hi == Approx(0.8).margin(1e-6));
+    // Halfway through the fade, halfway between the forces (the half cosine's midpoint).
+    for (const Frame& f : frames)
+      if (std::abs(f.timeS + 0.0005 - 1.1) < 0.0006) CHECK(f.forceN == Approx(0.65).margin(2e-3));
+  }
 }

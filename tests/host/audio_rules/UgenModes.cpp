@@ -255,8 +255,8 @@ std::unique_ptr<Synth> patternsSynth(FakeServer& server) {
   return synth;
 }
 
-// More writers of slot 0 (with the chain's, four): force at audio and control rate, bad forces,
-// bad device inputs, and one moving between slots 0 and 1.
+// More writers of slot 0: force at audio and control rate, bad forces, fades at audio and control
+// rate (NaN and above 1 too), bad device inputs, and one moving between slots 0 and 1.
 std::unique_ptr<Synth> writersSynth(FakeServer& server) {
   auto synth = server.newSynth("writers");
   const auto& out = server.unitDef("FrictionOut");
@@ -266,6 +266,9 @@ std::unique_ptr<Synth> writersSynth(FakeServer& server) {
   synth->add(out, kr, {c(0), alternating(0.3f, 1.5f)}, 1, "device 0");
   synth->add(out, ar, {c(0), Input::audio([](int64_t sample) { return sample % 2 == 0 ? kNaN : kInf; })}, 1,
              "device 0, force NaN and inf");
+  synth->add(out, ar, {c(0), c(0.9f), Input::audio([](int64_t sample) { return (sample % 480) / 479.0f; })}, 1,
+             "device 0, fade ar");
+  synth->add(out, kr, {c(0), c(0.9f), alternating(kNaN, 1.5f)}, 1, "device 0, fade kr NaN and above 1");
   synth->add(out, ar, {alternating(0, 1), c(1)}, 1, "device moving between 0 and 1");
   synth->add(out, ar, {c(-1), c(1)}, 1, "device -1");
   synth->add(out, ar, {c(kNaN), c(1)}, 1, "device NaN");

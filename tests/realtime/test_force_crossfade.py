@@ -1,0 +1,184 @@
+"""Forces that crossfade as the sound does (issue 41, item 1), through the real JITLib and
+pattern classes on a realtime server (JACK dummy) with a simulated device: FrictionOut weighs
+its force above the minimum by its synth's gate envelope, so an Ndef re-evaluated with a
+fadeTime moves the force from the old version's to the new one's and never above the larger
+(the slot summed them before: 0.86 N for two 0.5 N versions), .release fades it to the minimum,
+and a Pbind note's ADSR shapes it.
+
+The device's commanded force is read from its session record: one frame per millisecond, each
+the force the device commanded (after its safety path), on audio time.
+
+Tolerance of "never above the larger version": tolerance_n(excess). Measured first with 1e-4 N
+(a frame's float32 rounding, < 1e-6 N, and the 'sin' recurrence's): the 0.5 -> 0.5 N crossfade
+rose 3.77e-4 N above 0.5 N in the middle of the fade, a smooth bump. That is one control block:
+the new synth's EnvGate and the old one's release run one block apart (scsynth), so their weights
+sum to 1 + w' * T at most, w' = (pi / 2) / fadeTime the 'sin' fade's steepest slope, T = 64 /
+48000 s: 1.047e-3, times the 0.36 N above the minimum, 3.77e-4 N. The sound's two envelopes sum
+the same (the force does as the sound does). So the bound is that block's worth of the fade, plus
+1e-5 N for the float32 frames, calibration and recurrence; the old rule's excess (0.36 N) is
+about 1000 times larger.
+
+Each test prints its measured figures on a line starting with KF-FIGURE.
+"""
+import numpy as np
+
+from kfharness import paths, sclang
+from kfstudy import readers
+
+MIN_N = 0.14  # the simulated device's minimum (the paper's)
+FADE_S = 2.0
+BLOCK_S = 64 / 48000  # scsynth's control block on the tests' JACK server (48 kHz)
+ROUNDING_N = 1e-5
+
+
+def tolerance_n(excess_n, fade_s=FADE_S):
+    """How far a crossfade of versions `excess_n` above the minimum may go above the larger one:
+    one control block of the 'sin' fade at its steepest, plus rounding (module docstring)."""
+    return excess_n * (np.pi / 2) / fade_s * BLOCK_S + ROUNDING_N
+
+
+TOLERANCE_N = tolerance_n(0.5 - MIN_N)  # 3.87e-4 N
+MARGIN_S = 0.1  # a fade's start is the bundle's time, a few blocks from where the frames show it
+
+
+def figure(name, value):
+    print(f"KF-FIGURE {name} {value}")
+
+
+def commanded_frames(path):
+    """(audio time s, commanded force N) of every frame of a session record."""
+    header, records = readers.read_session(path)
+    frames = np.array([f for tag, f in records if tag == "F"]).reshape(-1, 4)
+    return frames[:, 1], frames[:, 3]
+
+
+def fade_start(t_seen, excess_n):
+    """When a 'sin' fade over `excess_n` began, from the time it first moved TOLERANCE_N: its
+    half cosine is flat at first, (1 - cos(pi x)) / 2 * excess_n reaches TOLERANCE_N at x =
+    acos(1 - 2 TOLERANCE_N / excess_n) / pi."""
+    return t_seen - FADE_S * np.arccos(1 - 2 * TOLERANCE_N / excess_n) / np.pi
+
+
+def first(mask):
+    idx = np.flatnonzero(mask)
+    assert idx.size, "no frame matches"
+    return int(idx[0])
+
+
+def test_an_ndef_crossfade_moves_the_force_from_old_to_new_never_above_the_larger(jack):
+    assert jack.sample_rate == 48000, "BLOCK_S assumes 48 kHz"
+    record = paths.work_dir() / "ndef-crossfade.kfs"
+    record.unlink(missing_ok=True)
+    sclang.require_ok(sclang.run_with_server(f"""
+        var dev = FrictionDevice.sim(s, 0);
+        s.sync;
+        dev.record({sclang.sc_string(record)});
+        Ndef(\\kf).fadeTime = {FADE_S};
+        Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.5)); Silent.ar }});
+        3.wait;
+        // Another 0.5 N version: the crossfade must keep 0.5 N.
+        Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.25) + DC.ar(0.25)); Silent.ar }});
+        3.wait;
+        // A 0.8 N version: from 0.5 to 0.8 N within the fade, never above 0.8 N.
+        Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.8)); Silent.ar }});
+        3.wait;
+        // Released with the proxy's fadeTime: down to the minimum.
+        Ndef(\\kf).release;
+        3.wait;
+        dev.close;
+        Ndef(\\kf).clear;
+    """, jack, name="ndef-crossfade", timeout=90))
+    t, f = commanded_frames(record)
+    failed = []  # every claim is checked, and all that fail are told
+
+    def check(ok, claim):
+        if not ok:
+            failed.append(claim)
+
+    # The script's steps on audio time, whatever the rule: the last frame is the released synth's
+    # last block, fadeTime after the release; the evaluations before it are 3 s apart (sclang's
+    # logical time; NodeProxy's bundles share one latency). (The first version's first frame is
+    # later than its step by the time its SynthDef takes to reach the server.)
+    t_release = t[-1] - FADE_S
+    t_up_eval, t_same_eval = t_release - 3, t_release - 6
+    same = (t >= t_same_eval - 0.5) & (t < t_up_eval - MARGIN_S)  # the 0.5 -> 0.5 N crossfade
+    figure("first_version_reached_0.5N_after_s", round(float(t[first(f >= 0.5 - TOLERANCE_N)] - t[0]), 4))
+    figure("first_version_settled_before_the_second_s", round(float(t_same_eval - t[0] - FADE_S), 4))
+    assert t_same_eval - 0.5 > t[0] + FADE_S, "the first version had settled"
+    figure("same_force_crossfade_min_max_N", (float(f[same].min()), float(f[same].max())))
+    # 0.5 N -> 0.5 N: the whole crossfade at 0.5 N.
+    check(f[same].max() <= 0.5 + TOLERANCE_N, "0.5 -> 0.5 N: never above 0.5 N")
+    check(f[same].min() >= 0.5 - TOLERANCE_N, "0.5 -> 0.5 N: never below 0.5 N")
+
+    # 0.5 N -> 0.8 N: from the last frame at 0.5 N to the first at 0.8 N.
+    to_new = (t >= t_up_eval - MARGIN_S) & (t < t_release - MARGIN_S)
+    figure("to_0.8N_max_N", float(f[to_new].max()))
+    check(f[to_new].max() <= 0.8 + TOLERANCE_N, "0.5 -> 0.8 N: never above 0.8 N")
+    i_up = np.flatnonzero(to_new & (t < t[first(to_new & (f > 0.51))]) & (f <= 0.5 + TOLERANCE_N))[-1]
+    i_new = first(to_new & (t > t[i_up]) & (f >= 0.8 - TOLERANCE_N))
+    t_up, t_new = t[i_up], t[i_new]
+    up = (t >= t_up) & (t <= t_new)
+    up_mid = fade_start(t_up, 0.3) + FADE_S / 2
+    figure("to_0.8N_starts_after_evaluation_s", round(float(fade_start(t_up, 0.3) - t_up_eval), 4))
+    figure("to_0.8N_old_to_new_s", round(float(t_new - t_up), 4))
+    figure("to_0.8N_midway_N", float(np.interp(up_mid, t, f)))
+    check(np.all(np.diff(f[up]) >= -TOLERANCE_N), "rising only")
+    check(FADE_S - 0.2 <= t_new - t_up <= FADE_S + MARGIN_S, "from old to new within fadeTime")
+    check(abs(np.interp(up_mid, t, f) - 0.65) < 0.02, "halfway through, halfway between")
+
+    # .release: falling only, halfway at half the fade, the minimum by its end.
+    released = t >= t_release - MARGIN_S
+    falling = np.flatnonzero(released & (f < 0.8 - TOLERANCE_N))
+    check(falling.size > 0, "the release lowers the force before the synth is freed")
+    t_down = t[falling[0] - 1] if falling.size else t_release
+    down = t >= t_down
+    down_mid = fade_start(t_down, 0.8 - MIN_N) + FADE_S / 2
+    figure("release_midway_N", float(np.interp(down_mid, t, f)))
+    figure("release_last_frame_s_N", (round(float(t[-1] - t_down), 4), float(f[-1])))
+    figure("release_starts_after_evaluation_s", round(float(fade_start(t_down, 0.8 - MIN_N) - t_release), 4))
+    check(np.all(np.diff(f[down]) <= TOLERANCE_N), "falling only")
+    check(abs(np.interp(down_mid, t, f) - (MIN_N + 0.8) / 2) < 0.02, "halfway through, halfway down")
+    check(f[-1] <= MIN_N + 1e-3, "the minimum at the release's end")
+    assert not failed, failed
+
+
+def test_a_pbind_notes_adsr_shapes_its_force(jack):
+    record = paths.work_dir() / "pbind-adsr.kfs"
+    record.unlink(missing_ok=True)
+    sclang.require_ok(sclang.run_with_server(f"""
+        var dev = FrictionDevice.sim(s, 0), player;
+        SynthDef(\\kfNote, {{ |gate = 1, force = 0.8, freq = 440, amp = 0.1|
+            var env = EnvGen.kr(Env.adsr(0.02, 0.05, 1, 0.3, curve: \\lin), gate, doneAction: 2);
+            FrictionOut.ar(0, DC.ar(force));
+            Out.ar(0, SinOsc.ar(freq) * env * amp);
+        }}).add;
+        s.sync;
+        dev.record({sclang.sc_string(record)});
+        // Notes of 0.5 s every second: attack 20 ms, sustain, a linear release of 0.3 s.
+        player = Pbind(\\instrument, \\kfNote, \\force, 0.8, \\dur, 1, \\legato, 0.5).play;
+        3.5.wait;
+        player.stop;
+        1.wait;
+        dev.close;
+    """, jack, name="pbind-adsr", timeout=90))
+    t, f = commanded_frames(record)
+    # Each note starts a synth: its first frame follows a gap (the synth before was freed).
+    starts = t[np.r_[0, np.flatnonzero(np.diff(t) > 0.1) + 1]]
+    # The gate goes off 0.5 s in (dur 1, legato 0.5): the linear release halves the force above
+    # the minimum 0.15 s later and ends 0.3 s later (then the synth is freed).
+    midway = [float(np.interp(s + 0.5 + 0.15, t, f)) for s in starts]
+    sustain = [float(np.interp(s + 0.3, t, f)) for s in starts]
+    figure("pbind_notes", len(starts))
+    figure("pbind_max_N", float(f.max()))
+    figure("pbind_sustain_N", [round(v, 4) for v in sustain])
+    figure("pbind_release_midway_N", [round(m, 4) for m in midway])
+    figure("pbind_last_frame_after_gate_off_s", [round(float(t[t < s + 0.95][-1] - s - 0.5), 4) for s in starts])
+    assert len(starts) >= 3
+    assert f.max() <= 0.8 + TOLERANCE_N
+    for v in sustain:
+        assert abs(v - 0.8) < 1e-3
+    for m in midway:
+        assert abs(m - (MIN_N + 0.8) / 2) < 0.03, "the force fades with the note's release"
+    for s in starts:
+        tail = f[(t > s + 0.5 + 0.3 + 0.01) & (t < s + 0.95)]
+        assert tail.size == 0 or tail.max() <= MIN_N + 1e-3, "the minimum once the release is over"
