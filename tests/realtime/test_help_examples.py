@@ -67,8 +67,9 @@ from kfharness.jack import JackServer
 HELP_DIR = Path(os.environ.get("KF_HELP_DIR") or paths.REPO_DIR / "HelpSource")
 PIECE_PAUSE_S = 0.3
 BLOCK_TIME_S = 1.2
-# A person waits for a fork's waits; one still running after this is left running.
-FORK_WAIT_MAX_S = 10.0
+# A person waits for a fork's waits; one still running after this is left running. (The Study
+# guide's report, a fork around FrictionStudy.report's Python, took 13 s beside a build.)
+FORK_WAIT_MAX_S = 30.0
 # The soak after the guides: runs of each threshold procedure in one Routine (QUEST+ 0.25 s a run
 # here, the constant stimuli's fit 0.3 s, a staircase 1 ms), about 25 s in all. sclang's alone: the
 # pass against the sanitized plugin (KF_SERVER_PRELOAD) leaves it out, as it would add nothing.
@@ -176,8 +177,11 @@ routinesQueued = {
 // After a piece, as a person waits before the next one: a pause (noting the routines the piece
 // started), the boot if one is under way, then those routines' ends (a routine waiting on a
 // Condition is off the clocks but not done: its state is kept, 6 when done).
-waitLikeAPerson = { |known, path, b|
+waitLikeAPerson = { |known, path, b, value|
 	var started = IdentitySet.new, until = Main.elapsedTime + %(piece_pause)f, note, waited = 0;
+	// The Routine a piece returns (fork's): waited for even when it waits off the clocks' queues (on a
+	// Condition: a report's Python), where the queues never show it.
+	if(value.isKindOf(Routine) and: { known.includes(value).not }) { started.add(value) };
 	note = { routinesQueued.().do { |r| if(known.includes(r).not) { started.add(r) } } };
 	while { Main.elapsedTime < until } { note.(); 0.05.wait };
 	while { (s.serverRunning.not or: { treePending }) and: { waited < %(boot_wait)f } } {
@@ -253,7 +257,7 @@ files.do { |path, f|
 						};
 					};
 				};
-				waitLikeAPerson.(known, path, b);
+				waitLikeAPerson.(known, path, b, run !? { run[\value] });
 			};
 			if(pieces.notEmpty) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 			"KF-HELP-BLOCK-END %% %%".format(path, b).postln;
