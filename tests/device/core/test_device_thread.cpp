@@ -62,9 +62,11 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   for (size_t i = 1; i < reports.size(); ++i)
     CHECK(reports[i].deviceTimeS - reports[i - 1].deviceTimeS == Approx(0.008));
   CHECK(pushed.load() > 150);
-  // Every frame reached the magnet but those a pump that missed its deadlines skipped as stale.
+  // Every frame reached the magnet but those a pump that missed its deadlines skipped as stale: a
+  // pump that missed k skips at most k + 1 <= 2k, so at most twice the missed deadlines in all
+  // (test_frame_timing.cpp; a fresh clone's ASan run saw 16 skipped for 15 missed).
   CHECK(telemetry.frames + telemetry.skippedFrames == static_cast<uint64_t>(pushed.load()));
-  CHECK(telemetry.skippedFrames <= telemetry.missedDeadlines + 1);
+  CHECK(telemetry.skippedFrames <= 2 * telemetry.missedDeadlines);
   CHECK(sink->commands() == telemetry.frames);
   CHECK(sink->lastForceN() == 0.3f);
   CHECK(telemetry.watchdogTrips == 0);
