@@ -160,8 +160,13 @@ def test_the_windows_driven_as_people_would(jack, display):
                                       "answer", "answer", "end"], events
     assert ("done", "key") in events and all(a["attempt"] == "2" for a in answers)
 
-    # The experimenter hears the participant: its pair carries the same audio as heard.
-    heard, rate = readers.read_wav(folder / "01-explore-attempt2" / "audio.wav")
+    # The experimenter hears the participant: its pair carries the same audio as heard, over both
+    # attempts (the pilot's DC blocker makes a transient's peak differ from one attempt to the other:
+    # measured 0.74 in the first, 0.58 in the second, and 0.74 at the experimenter).
+    peaks = [np.abs(readers.read_wav(folder / attempt / "audio.wav")[0]).max()
+             for attempt in ("01-explore", "01-explore-attempt2")]
+    heard = max(peaks)
     listened, _ = readers.read_wav(ARTEFACTS / "experimenter.wav")
+    print(f"peaks heard per attempt {peaks}, listened {np.abs(listened).max()}")
     assert np.abs(listened).max() > 0.2
-    assert np.abs(listened).max() == pytest.approx(np.abs(heard).max(), rel=0.05)
+    assert np.abs(listened).max() == pytest.approx(heard, rel=0.05)
