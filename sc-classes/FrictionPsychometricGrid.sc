@@ -58,8 +58,8 @@ FrictionPsychometricGrid {
 	// Bayes' rule for one trial: log p(answer | level, parameters) added to each grid point, then
 	// normalised (the log posterior's exp sums to 1). In place, in inlined loops: a trial allocates
 	// nothing. (Array arithmetic made about 10 arrays of the grid's size a trial; SuperCollider
-	// 3.13's collector, run that often after a long session, once broke on its own heap in the
-	// QUEST+ example: ARCHITECTURE.md, sclang 3.13's stack and caught errors.)
+	// 3.13's collector, run that often after a long session, now and then broke on its own heap in
+	// the QUEST+ example: ARCHITECTURE.md, sclang 3.13's stack, caught errors and its collector.)
 	update { |level, correct|
 		var logs = this.prLogsAt(level)[if(correct) { 0 } { 1 }];
 		var n = logPosterior.size, k = 0, v, top = -inf, sum = 0.0;
@@ -105,11 +105,10 @@ FrictionPsychometricGrid {
 		^sum
 	}
 
-	// [log p, log(1 - p)] at level for every grid point, as Signals, kept per level.
+	// prLogsAt's as Signals, kept per level.
 	prLogSignalsAt { |level|
 		^logSignalsAt[level] ?? {
-			var p = this.probabilities(level);
-			var logs = [Signal.newFrom(this.prLogOf(p)), Signal.newFrom(this.prLogOf(1 - p))];
+			var logs = this.prLogsAt(level).collect { |values| Signal.newFrom(values) };
 			logSignalsAt[level] = logs;
 			logs
 		}
