@@ -129,8 +129,8 @@ piecesOf = { |code|
 // Each piece runs in a Routine of its own, as the IDE runs each at the top level, on a stack that
 // starts empty. In SuperCollider 3.13 a non-local return (how try catches an error, how ^ leaves a
 // block) leaves the arguments pending in the frames it unwinds on the thread's stack: in one Routine
-// for the whole run they piled up past its fixed-size stack, into the heap (sclang's "grey count
-// error", then a SIGSEGV, in the QUEST+ block after the other guides). The piece's environment
+// for the whole run they would pile up past its fixed-size stack, into the heap (ARCHITECTURE.md,
+// sclang 3.13's stack, caught errors and its collector). The piece's environment
 // (a ProxySpace pushed) carries on, as the IDE's does. Returns (threw:, value:, stack:): stack is
 // the slots on the piece's stack at its end; a piece that threw nothing and leaves more than an
 // empty one (pieceStack) is reported (KF-HELP-STACK-LEFT): its code piles them up in a long Routine.
