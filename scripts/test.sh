@@ -1,14 +1,96 @@
 #!/usr/bin/env bash
-# Sets everything up (scripts/setup.sh), runs the checks CI enforces (scripts/check.sh:
-# formatting, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the fuzz targets,
-# the scene and realtime tests against the sanitized plugin), then runs every
-# test of build/: Catch2 (dsp, device), the NRT scene tests (with scsynth and, when installed,
-# supernova), the help files, and the realtime tests against JACK's dummy driver: as many at a
-# time as there are cores, except the realtime tests and the main job, which run alone (RUN_SERIAL).
-# Extra arguments go to ctest, e.g. scripts/test.sh -R scenes/
-set -euo pipefail
+# Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
+# (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
+# fuzz targets, the scene and realtime tests against the sanitized plugin, the cross builds), then
+# every test of build/: Catch2 (dsp, device, host), the NRT scene tests (scsynth and supernova),
+# the help files, the QEMU guest, and the realtime tests against JACK's dummy driver: as many at
+# a time as there are cores, except the realtime tests and the main jobs, which run alone
+# (RUN_SERIAL). A failing stage does not stop the next: every stage runs, and the command fails
+# if any did (with ctest's exit code when ctest was the one).
+#
+# At the end each stage's wall time is printed and written to build/test-stages.txt, with what
+# the machine was (cores, realtime scheduling allowed, the CPU time the hypervisor stole), so
+# that a slower stage, or a slower machine, is seen the day it happens.
+#
+# Usage: scripts/test.sh [--quick] [ctest arguments...]
+#   --quick  the inner loop (after a first build): build/ only, then the C++ suites (dsp, device,
+#            host), the NRT scene tests on scsynth, and one realtime scene
+#            (realtime/test_device_realtime). No sanitizers, fuzzing, cross builds, supernova,
+#            help files, main jobs or guest: CI runs the whole command.
+#   extra arguments go to the final ctest, e.g. scripts/test.sh -R scenes/
+set -uo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh --all
+
+quick=false
+if [ "${1:-}" = --quick ]; then
+  quick=true
+  shift
+fi
+
+stages=() seconds=() results=()
+rc=0
+# stage <name> <command...>: runs it, records its wall time and exit code; the first failure's
+# code becomes the command's.
+stage() {
+  local name=$1 start=$SECONDS code=0
+  shift
+  "$@" || code=$?
+  stages+=("$name") seconds+=($((SECONDS - start))) results+=("$code")
+  if ((code != 0)); then
+    echo "== stage $name FAILED (exit $code)" >&2
+    ((rc == 0)) && rc=$code
+  fi
+  return 0
+}
+
+# user + nice + system + ... + steal jiffies, and steal alone, from /proc/stat's cpu line.
+cpu_jiffies() { awk '/^cpu / { t = 0; for (i = 2; i <= 9; i++) t += $i; print t, $9 }' /proc/stat; }
+
+machine() {
+  local rt=no
+  chrt -f 1 true 2>/dev/null && rt=yes
+  echo "cores $(nproc); realtime scheduling allowed: $rt; load average at start $(cut -d' ' -f1-3 /proc/loadavg)"
+}
+
+summary() {
+  local total=0 i line
+  read -r total_end steal_end < <(cpu_jiffies)
+  local stolen="?"
+  ((total_end > total_start)) && stolen=$(((steal_end - steal_start) * 1000 / (total_end - total_start)))
+  {
+    echo "$machine_line"
+    echo "CPU time stolen by the hypervisor during the run: ${stolen} per mille"
+    printf '%-18s %8s  %s\n' stage seconds result
+    for i in "${!stages[@]}"; do
+      total=$((total + seconds[i]))
+      line=passed
+      ((results[i] != 0)) && line="FAILED (exit ${results[i]})"
+      printf '%-18s %8d  %s\n' "${stages[i]}" "${seconds[i]}" "$line"
+    done
+    printf '%-18s %8d\n' total "$total"
+  } > "$1"
+  echo "== stage timings (also in $1)"
+  cat "$1"
+}
+
+machine_line=$(machine)
+read -r total_start steal_start < <(cpu_jiffies)
+echo "== $machine_line"
+
+stage setup scripts/setup.sh --all
+if ((rc != 0)); then
+  mkdir -p build && summary build/test-stages.txt
+  exit "$rc"
+fi
 source scripts/env.sh
-scripts/check.sh
-ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
+if $quick; then
+  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(nproc)" \
+    -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
+else
+  for check in format pyflakes sanitize fuzz sanitize-plugin cross; do
+    stage "$check" scripts/check.sh "$check"
+  done
+  stage ctest ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
+fi
+summary build/test-stages.txt
+exit "$rc"
