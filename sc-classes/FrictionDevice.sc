@@ -209,6 +209,11 @@ FrictionDevice {
 
 	printOn { |stream| stream << this.class.name << "(" << kind << ", " << index << ")" }
 
+	// A device stands for its slot wherever a UGen input or a synth argument wants one, as a
+	// Buffer stands for its bufnum: FrictionMouseIn.ar(~device), Synth(\x, [\device, ~device]).
+	asUGenInput { ^index }
+	asControlInput { ^index }
+
 	*prSim { |server, index, hand, profile, replace, method|
 		if(hand.notNil and: { hand.isKindOf(FrictionHand).not }) {
 			Error("FrictionDevice.%: hand must be a FrictionHand or nil, got %".format(method, hand)).throw

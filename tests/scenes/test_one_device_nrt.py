@@ -67,3 +67,31 @@ def test_several_writers_in_a_score_one_frame_per_millisecond_by_the_rule():
     assert per_ms[1:999].min() == 1 and per_ms[1:999].max() == 1
     assert np.allclose(commanded[(t > 0.05) & (t < 0.49)], 1.16, atol=1e-4)
     assert np.allclose(commanded[(t > 0.51) & (t < 0.99)], 0.3, atol=1e-4)  # one writer freed
+
+
+def test_a_device_object_stands_for_its_slot_in_ugens_and_synth_arguments():
+    """FrictionMouseIn.ar(dev), FrictionOut.ar(dev, ...) and Synth's [\\device, dev] take the
+    FrictionDevice as a Buffer is taken for its bufnum: slot 3 is read and written."""
+    rec = paths.work_dir() / "nrt-device-object.kfs"
+    data, _ = nrt.score_and_render("devobject", f"""
+        var dev = FrictionDevice.describeSim(3, FrictionHand.speeds([[20, 2]]));
+        var reader = SynthDef(\\devreader, {{ Out.ar(0, [FrictionMouseIn.ar(dev)[0], FrictionMouseIn.ar(3)[0]]) }});
+        var writer = SynthDef(\\devwriter, {{ |device = 0| FrictionOut.ar(device, DC.ar(0.2)) }});
+        score = Score([
+            [0.0, dev.openMsg],
+            [0.0, dev.recordMsg("{rec}")],
+            [0.0, ['/d_recv', reader.asBytes]],
+            [0.0, ['/d_recv', writer.asBytes]],
+            [0.0, Synth.basicNew(\\devreader, nil, 1000).newMsg(nil)],
+            [1.0, Synth.basicNew(\\devwriter, nil, 1001).newMsg(nil, [\\device, dev])],
+            [1.2, dev.closeMsg],
+            [1.25, ['/c_set', 0, 0]]]);
+    """, sample_rate=SR, channels=2)
+    by_object, by_number = data[:, 0], data[:, 1]
+    print(f"KF-FIGURE nrt_device_object_reader_max_x_mm {by_object.max():.3f}")
+    assert by_object.max() > 1, "the puck moved"
+    assert np.array_equal(by_object, by_number), "the object reads slot 3"
+    frames = read_frames(rec)
+    assert frames.ndim == 2, "no force frame on slot 3"
+    t, commanded = frames[:, 1], frames[:, 3]
+    assert np.allclose(commanded[(t > 1.02) & (t < 1.18)], 0.2, atol=1e-4), "the writer drives slot 3"
