@@ -10,6 +10,20 @@ set(KF_GENERATED_DIR "${CMAKE_BINARY_DIR}/generated")
 set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${KF_PROFILE_FILE}")
 file(READ "${KF_PROFILE_FILE}" kf_profile_json)
 
+# string(JSON GET) gives a number with 17 significant digits (0.14 becomes 0.14000000000000001),
+# which would reach the sclang defaults and every file written from them: the literal as the
+# profile writes it is used instead, found by its key, the one equal in value.
+function(kf_profile_literal var key)
+  string(REGEX MATCHALL "\"${key}\"[ \t\r\n]*:[ \t\r\n]*-?[0-9][0-9.eE+-]*" found "${kf_profile_json}")
+  foreach(entry IN LISTS found)
+    string(REGEX REPLACE "^.*:[ \t\r\n]*" "" literal "${entry}")
+    if(literal EQUAL ${var})
+      set(${var} "${literal}" PARENT_SCOPE)
+      return()
+    endif()
+  endforeach()
+endfunction()
+
 set(kf_profile_cpp "")
 set(kf_profile_sc "")
 foreach(section device mapping pilot)
@@ -26,6 +40,7 @@ foreach(section device mapping pilot)
     if(NOT value MATCHES "^-?[0-9]+(\\.[0-9]+)?([eE][-+]?[0-9]+)?$")
       message(FATAL_ERROR "${KF_PROFILE_FILE}: ${section}.${key} must be a number, got '${value}'")
     endif()
+    kf_profile_literal(value "${key}")
     string(APPEND cpp_entries "inline constexpr double ${key} = ${value};\n")
     list(APPEND sc_entries "${key}: ${value}")
     set(KF_PAPER_${section}_${key} "${value}")

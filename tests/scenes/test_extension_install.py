@@ -26,3 +26,16 @@ def test_user_extension_dir_is_sclangs_and_the_folder_is_a_quark():
     assert f"QUARK KineticFriction {version} Overviews/KineticFriction" in out
     assert "QUARK-HELP true" in out
     assert "QUARK-CLASSES true" in out
+
+
+def test_generated_defaults_are_the_profiles_numbers_as_written():
+    """The classes made from profiles/paper.json carry its numbers as it writes them (0.14, not
+    CMake's 0.14000000000000001): what a user reads in the source and every file written from
+    the defaults."""
+    classes = paths.extension_dir() / "Classes"
+    profile = (paths.REPO_DIR / "profiles" / "paper.json").read_text()
+    generated = ["LoudnessToFriction.sc", "FrictionPattern.sc", "PaperProfile.sc"]
+    noisy = [(name, number) for name in generated
+             for number in re.findall(r"\d+\.\d{12,}", (classes / name).read_text())]
+    assert not noisy, noisy
+    assert "loForce = 0.14," in (classes / "LoudnessToFriction.sc").read_text() and '"loForceN": 0.14,' in profile
