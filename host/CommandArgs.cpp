@@ -273,6 +273,10 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
              noneLeft(args, error, errorSize);
     case CommandShape::kFlag:
       return readWhole(args, 0.0, 1.0, "flag", out.numbers[0], error, errorSize) && noneLeft(args, error, errorSize);
+    case CommandShape::kStatus:
+      out.numbers[0] = 1.0;
+      return (args.atEnd() || readWhole(args, 0.0, 1.0, "post", out.numbers[0], error, errorSize)) &&
+             noneLeft(args, error, errorSize);
     case CommandShape::kPosition:
       out.positionMm[0] = out.positionMm[1] = 0.0;
       for (int axis = 0; axis < 2 && !args.atEnd(); ++axis) {

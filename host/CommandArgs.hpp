@@ -49,7 +49,8 @@ class OscArgReader {
 };
 
 enum class CommandShape {
-  kIndex,       // kfStatus, kfClose: index
+  kIndex,       // kfClose: index
+  kStatus,      // kfStatus: index [post(0/1), 1 by default]
   kOpenSim,     // index kind count values... [key value]...
   kOpenReplay,  // index path [key value]...
   kRecord,      // index path ("" stops)
@@ -72,7 +73,7 @@ struct CommandArgs {
   double positionMm[2] = {0.0, 0.0};  // kPosition: x, y
   char which[kMaxPathChars];          // kOpenMouse: the mouse selector ("" the first)
   char backend[kMaxKeyChars];         // kOpenMouse, kListMice: "hidapi", "evdev" ("" default)
-  double numbers[2] = {0.0, 0.0};     // kBoardOpen: emulate, inFlight; kFlag: the flag
+  double numbers[2] = {0.0, 0.0};     // kBoardOpen: emulate, inFlight; kFlag, kStatus: the flag
 };
 
 // Storage for `count` hand script values (RTAlloc in the plugin); null: out of memory.

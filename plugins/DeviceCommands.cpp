@@ -10,9 +10,9 @@
 //                gainNSPerM, adaptS: a participant, sim/ExploringHand)
 //   kfOpenReplay index path [key value]...   (also startS, skipIdle 0/1, loop 0/1, rate)
 //   kfRecord     index path        (an empty path stops recording)
-//   kfStatus     index             (posts telemetry and replies /kfStatus with its figures as
-//                                   numbers, to /notify clients: index, then kStatusFields
-//                                   values in StatusField order)
+//   kfStatus     index [post]      (posts telemetry, unless post is 0, and replies /kfStatus with
+//                                   its figures as numbers, to /notify clients: index, then
+//                                   kStatusFields values in StatusField order)
 //   kfClose      index
 //   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
 //                                   default, for every reader, from the next block on)
@@ -234,6 +234,7 @@ bool statusStage(World*, void* raw) {  // NRT
   }
   const kf::ThreadScheduling usbThread = usbThreadOf(*data->device);
   fillStatusValues(*data->device, usbThread, data->replyValues);
+  if (data->args.numbers[0] == 0.0) return true;  // the figures only: a poller's post window stays readable
   const kf::TelemetrySnapshot t = data->device->telemetry();
   Print(
       "kfStatus %d: %s, reports %llu (interval %.3f ms, jitter %.3f ms), frames %llu, "
@@ -283,7 +284,7 @@ void replyStatus(World* world, CommandData* data) {
 }
 
 void statusCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
-  CommandData* data = newCommand(world, "kfStatus", CommandShape::kIndex, args);
+  CommandData* data = newCommand(world, "kfStatus", CommandShape::kStatus, args);
   if (data == nullptr) return;
   std::fill_n(data->replyValues, static_cast<int>(kStatusFields), 0.0f);
   data->onEnd = replyStatus;

@@ -153,10 +153,12 @@ FrictionDevice {
 
 	// Posts the device thread's telemetry in the server's output.
 	status { this.prSendAnswered(\kfStatus, this.statusMsg) }
-	statusMsg { ^['/cmd', \kfStatus, index] }
+	// post: false asks for the /kfStatus reply only, nothing posted.
+	statusMsg { |post = true| ^['/cmd', \kfStatus, index] ++ (if(post) { [] } { [0] }) }
 
 	// The same figures as numbers: an Event (FrictionDevice.statusOf) passed to action, from the
 	// server's /kfStatus reply to the clients registered with /notify (sclang by default).
+	// Nothing is posted: polling it leaves the post window readable (status posts them).
 	statusValues { |action|
 		var reply;
 		if(server.isNil) { ^this };
@@ -164,7 +166,7 @@ FrictionDevice {
 		reply = OSCFunc({ |msg| action.value(this.class.statusOf(msg[3..])) }, '/kfStatus', server.addr,
 			argTemplate: [nil, index]).oneShot;
 		// A refused or unanswered kfStatus sends no reply: its responder would wait for the next one.
-		this.prSendAnswered(\kfStatus, this.statusMsg, onFail: { reply.free })
+		this.prSendAnswered(\kfStatus, this.statusMsg(false), onFail: { reply.free })
 	}
 	// Thread priorities: -1 no such thread, 0 normal scheduling (realtime refused or not asked
 	// for), > 0 SCHED_FIFO. Durations in s, the force in N.

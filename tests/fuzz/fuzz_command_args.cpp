@@ -18,8 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // A copy of exactly `size` bytes on the heap: any read past it is reported.
   std::vector<char> message(data, data + size);
   using kf::sc::CommandShape;
-  for (CommandShape shape :
-       {CommandShape::kIndex, CommandShape::kOpenSim, CommandShape::kOpenReplay, CommandShape::kRecord}) {
+  for (CommandShape shape : {CommandShape::kIndex, CommandShape::kStatus, CommandShape::kOpenSim,
+                             CommandShape::kOpenReplay, CommandShape::kRecord}) {
     kf::sc::OscArgReader reader = kf::sc::OscArgReader::fromMessage(message.data(), message.size());
     kf::sc::CommandArgs args;
     char error[200];

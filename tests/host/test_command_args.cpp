@@ -135,6 +135,18 @@ TEST_CASE("device indices: non-finite, fractional, out of range or not numbers",
   CHECK(contains(parse(CommandShape::kIndex, Message().i(1).i(2).bytes()).error, "unexpected argument 2"));
 }
 
+TEST_CASE("kfStatus posts by default; post 0 asks for the figures only", "[commands]") {
+  Parsed plain = parse(CommandShape::kStatus, Message().i(2).bytes());
+  REQUIRE(plain.ok);
+  CHECK(plain.args.numbers[0] == 1.0);
+  Parsed quiet = parse(CommandShape::kStatus, Message().i(2).i(0).bytes());
+  REQUIRE(quiet.ok);
+  CHECK(quiet.args.numbers[0] == 0.0);
+  CHECK_FALSE(parse(CommandShape::kStatus, Message().i(2).f(0.5f).bytes()).ok);
+  CHECK_FALSE(parse(CommandShape::kStatus, Message().i(2).i(2).bytes()).ok);
+  CHECK(contains(parse(CommandShape::kStatus, Message().i(2).i(0).i(0).bytes()).error, "unexpected argument 3"));
+}
+
 TEST_CASE("hand script counts must match the values sent", "[commands]") {
   // Count 4, two values, then a key: the key used to be eaten as a value.
   Parsed short_ = parse(CommandShape::kOpenSim, Message().i(0).i(0).i(4).f(0.f).f(0.f).s("maxForceN").f(1.f).bytes());

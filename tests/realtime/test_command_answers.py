@@ -17,7 +17,7 @@ VALID = {
     "kfOpenSim": [0, -1, 0, "replace", 1],
     "kfOpenReplay": [0, HID, "replace", 1],
     "kfRecord": [0, "/nonexistent-dir/session.txt"],
-    "kfStatus": [0],
+    "kfStatus": [0, 0],
     "kfClose": [0],
     "kfZero": [0, 1.0, 2.0],
     "kfListMice": ["hidapi", ""],
@@ -44,8 +44,8 @@ def variants(cmd):
         return [value if i in strings else a for i, a in enumerate(args)] if strings else [value] + args[1:]
 
     yield "wrong type", (["one"] + args[1:] if cmd in HAS_DEVICE else [3] + args[1:]), True, ""
-    # kfZero's coordinates are optional: without y it is still a command.
-    yield "missing", args[:-1], cmd != "kfZero", ""
+    # kfZero's coordinates and kfStatus's post flag are optional: without them it is still a command.
+    yield "missing", args[:-1], cmd not in {"kfZero", "kfStatus"}, ""
     yield "extra", args + [7], True, "argument" if cmd not in TAKES_SETTINGS else "setting name"
     if cmd in HAS_DEVICE:
         for device in (16, -1, 2.5, NAN, INF):

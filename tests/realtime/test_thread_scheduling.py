@@ -33,6 +33,9 @@ def test_threads_are_named_and_realtime_above_the_audio_thread(jack):
     assert {"kf-device-3", "kf-usb-3", "kf-device-4"} <= set(threads), threads
     assert figures[4]["deviceThreadPriority"] == 0
     assert threads["kf-device-4"] == ("TS", None)
+    # Device 4 was only polled (statusValues): its figures came, nothing was posted.
+    assert not [line for line in run.output.splitlines() if line.startswith("kfStatus 4:")], run.output[-2000:]
+    assert [line for line in run.output.splitlines() if line.startswith("kfStatus 3:")], "status posts"
     if realtime_allowed():
         # jackd -R -P 70: scsynth's audio thread (a JACK client's) at SCHED_FIFO 65, ours at 66.
         audio = max(p for name, cls, p in listed if name == "scsynth" and cls == "FF")
