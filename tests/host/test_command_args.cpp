@@ -135,7 +135,7 @@ TEST_CASE("device indices: non-finite, fractional, out of range or not numbers",
   CHECK(contains(parse(CommandShape::kIndex, Message().i(1).i(2).bytes()).error, "unexpected argument 2"));
 }
 
-TEST_CASE("kfStatus posts by default; post 0 asks for the figures only", "[commands]") {
+TEST_CASE("kfStatus posts by default, post 0 asks for the figures only", "[commands]") {
   Parsed plain = parse(CommandShape::kStatus, Message().i(2).bytes());
   REQUIRE(plain.ok);
   CHECK(plain.args.numbers[0] == 1.0);
