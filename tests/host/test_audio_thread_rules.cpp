@@ -61,12 +61,21 @@ class Scenario {
     kf_rules_set_phase(name);
     std::printf("== %s\n", name);
   }
-  // Runs the audio for that long, the NRT side served.
-  void runFor(int ms) {
+  // Runs `ms` of audio, the NRT side served meanwhile: the blocks of that much time at 48 kHz,
+  // however long the wall clock takes. What the scenario needs is that the UGens ran that much
+  // audio; an audio thread at normal priority beside other load runs slower than the clock (the
+  // UGens here need about 0.9 ms of CPU per 1.33 ms block, measured, so beside two CPU hogs
+  // on two cores it got under 10 blocks in some 50 ms of wall time). The limit only catches
+  // an audio thread that stopped.
+  void runAudio(int ms) {
+    const int64_t blocks =
+        (ms * static_cast<int64_t>(FakeServer::kSampleRate) / FakeServer::kBlockSamples + 999) / 1000;
     const int64_t before = server_.blocks();
-    server_.serveFor(Ms(ms));
-    check(server_.blocks() - before >= 10, "blocks ran for " + std::to_string(ms) + " ms");
+    const bool ran = server_.serveBlocks(blocks, kAudioLimit);
+    check(ran, std::to_string(ms) + " ms of audio (" + std::to_string(blocks) + " blocks) ran within " +
+                   std::to_string(kAudioLimit.count()) + " ms: only " + std::to_string(server_.blocks() - before));
   }
+  static constexpr Ms kAudioLimit{10000};
   void expectDone(const OscMessage& message);
   void expectFailure(const OscMessage& message);
   void expectAnswer(const OscMessage& message);  // /done or /kfFail: what the machine has decides
@@ -103,7 +112,10 @@ void Scenario::expectFailure(const OscMessage& message) {
   const int failures = server_.repliesNamed("/kfFail");
   server_.command(message);
   server_.serveUntil([&] { return server_.repliesNamed("/kfFail") > failures; }, Ms(10000));
-  server_.serveFor(Ms(20));  // a /done would have come by now
+  // A /kfFail comes from the command itself (refused: no stages follow), from its stage 3 (RT),
+  // which sends stage 4 on in the same block, or from its stage 4 (NRT). So a /done could only
+  // come from a stage 4 sent by the end of the block that sent the /kfFail: one round runs it.
+  check(server_.settle(1, kAudioLimit), "the audio ran on after " + message.describe());
   check(server_.repliesNamed("/kfFail") == failures + 1 && server_.doneCount(message.command()) == dones,
         "/kfFail (and no /done) for " + message.describe());
 }
@@ -135,48 +147,48 @@ void Scenario::run() {
   Synth* writers = server_.play(writersSynth(server_));
   Synth* drives = server_.play(drivesSynth(server_, chain_));
   Synth* patterns = server_.play(patternsSynth(server_));
-  runFor(200);
+  runAudio(200);
 
   phase("2 simulated device opened on slot 0 while the UGens run");
   expectDone(openSim(false));
-  runFor(400);
+  runAudio(400);
   check(chain_.largestXMm.load() > 1.f, "FrictionMouseIn followed the simulated puck");
 
   phase("3 recording on, then off");
   expectDone(OscMessage("kfRecord").i(0).s(recording));
-  runFor(200);
+  runAudio(200);
   expectDone(OscMessage("kfRecord").i(0).s(""));
-  runFor(100);
+  runAudio(100);
 
   phase("4 status and zero");
   const int statusReplies = server_.repliesNamed("/kfStatus");
   expectDone(OscMessage("kfStatus").i(0));
   server_.serveUntil([&] { return server_.repliesNamed("/kfStatus") > statusReplies; }, Ms(2000));
   expectDone(OscMessage("kfZero").i(0).f(10.f).f(0.f));
-  runFor(100);
+  runAudio(100);
 
   phase("5 replay device opened on slot 1");
   expectDone(OscMessage("kfOpenReplay").i(1).s(options_.replay).s("loop").i(1));
   Synth* slot1 = server_.play(slot1Synth(server_));
-  runFor(300);
+  runAudio(300);
 
   phase("6 an emulated board on slot 0");
   expectDone(OscMessage("kfBoardOpen").i(0).s("").i(1).i(2));
   expectDone(OscMessage("kfBoardCalibrate").i(0).s(""));
   expectDone(OscMessage("kfBoardStatus").i(0));
-  runFor(200);
+  runAudio(200);
   expectDone(OscMessage("kfBoardClose").i(0));
 
   phase("6b the audio drive loaded on slot 0, a bad file refused, removed");
   expectDone(OscMessage("kfDriveCalibrate").i(0).s(writeDriveFiles(options_.scratch)));
-  runFor(200);
+  runAudio(200);
   expectFailure(OscMessage("kfDriveCalibrate").i(0).s(options_.scratch + "/no-such-drive.txt"));
   expectFailure(OscMessage("kfDriveCalibrate").i(3).s(""));  // no device there: fails in stage 2 (NRT)
-  runFor(50);
+  runAudio(50);
 
   phase("7 slot 0 handed over to a new device while the UGens run");
   expectDone(openSim(true));
-  runFor(200);
+  runAudio(200);
 
   phase("8 refused and failing commands, and the mouse commands (no mouse needed)");
   expectFailure(openSim(false));                                      // slot taken: refused in stage 3
@@ -186,27 +198,27 @@ void Scenario::run() {
   expectFailure(OscMessage("kfReopenMouse").i(0));                    // the simulated device is no mouse
   expectFailure(OscMessage("kfOpenMouse").i(2).s("/nonexistent/hidraw9").s("hidapi").s(""));
   expectAnswer(OscMessage("kfListMice").s("").s(""));  // whatever mice this machine has
-  runFor(100);
+  runAudio(100);
 
   phase("9 units started and freed while the device is open");
   Synth* lateJoiners = server_.play(lateJoinersSynth(server_));
-  runFor(100);
+  runAudio(100);
   server_.free(writers);
   server_.free(lateJoiners);
-  runFor(100);
+  runAudio(100);
 
   phase("10 devices closed while the UGens run");
   expectDone(OscMessage("kfClose").i(0));
-  runFor(150);
+  runAudio(150);
   expectDone(OscMessage("kfClose").i(1));
-  runFor(100);
+  runAudio(100);
 
   phase("11 reopened, then freed with the device open and closed");
   expectDone(openSim(false));
-  runFor(150);
+  runAudio(150);
   server_.free(chain);
   server_.free(mouseModes);
-  runFor(50);
+  runAudio(50);
   expectDone(OscMessage("kfClose").i(0));
   server_.free(readers);
   server_.free(surfaces);
@@ -216,7 +228,7 @@ void Scenario::run() {
   server_.free(slot1);
   server_.free(drives);
   server_.serveUntil([&] { return server_.numSynths() == 0; }, Ms(5000));
-  runFor(50);
+  runAudio(50);
   server_.stop();
 
   // What must have happened for the run to mean anything.
@@ -240,6 +252,10 @@ void Scenario::run() {
   check(status != nullptr && status->values.size() >= 22, "/kfStatus replied");
   if (status != nullptr && status->values.size() >= 22) {
     const std::vector<float>& v = status->values;  // FrictionDevice.statusFields order
+    std::printf(
+        "/kfStatus: %g reports, %g frames, %g watchdog trips, %g missed deadlines, %g skipped; p50 loop period "
+        "%.2f ms, force latency %.2f ms, report latency %.2f ms\n",
+        v[6], v[7], v[8], v[9], v[10], v[14] * 1e3, v[17] * 1e3, v[21] * 1e3);
     check(v[0] == 1.f && v[1] == 1.f, "/kfStatus: open, realtime");
     check(v[6] > 20.f, "/kfStatus: reports delivered (" + std::to_string(v[6]) + ")");
     check(v[7] > 100.f, "/kfStatus: frames delivered (" + std::to_string(v[7]) + ")");

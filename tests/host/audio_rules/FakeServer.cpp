@@ -184,10 +184,6 @@ void FakeServer::serveOnce() {
         Reply{record.name, record.id, std::vector<float>(record.values, record.values + record.numValues)});
 }
 
-void FakeServer::serveFor(std::chrono::milliseconds duration) {
-  serveUntil([] { return false; }, duration);
-}
-
 bool FakeServer::serveUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (true) {
@@ -196,6 +192,21 @@ bool FakeServer::serveUntil(const std::function<bool()>& done, std::chrono::mill
     if (std::chrono::steady_clock::now() >= end) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
+}
+
+bool FakeServer::serveBlocks(int64_t count, std::chrono::milliseconds timeout) {
+  const int64_t end = blocks() + count;
+  return serveUntil([&] { return blocks() >= end; }, timeout);
+}
+
+bool FakeServer::settle(int rounds, std::chrono::milliseconds timeout) {
+  for (int i = 0; i < rounds; ++i) {
+    serveOnce();
+    // The block running now may have begun before that serve; the one after it has not.
+    if (!serveBlocks(2, timeout)) return false;
+  }
+  serveOnce();
+  return true;
 }
 
 void FakeServer::problem(const char* what) {

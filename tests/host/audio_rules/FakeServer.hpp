@@ -6,7 +6,7 @@
 //     asynchronous commands and their cleanup; synths started and freed: the units'
 //     constructors and destructors), then every playing unit's calculation function;
 //   - the NRT thread, which is the caller's (the test's main thread): stages 2 and 4 and every
-//     message sent from the RT side, whenever it serves (serveFor, serveUntil).
+//     message sent from the RT side, whenever it serves (serveUntil, serveBlocks, settle).
 // What the harness does on the audio thread is fixed rings and a preallocated pool (RTAlloc),
 // so whatever the counters (Counting.h) see there is the plugin's. Misuse of the interface (RT
 // functions called off the audio thread, and the like) is collected as problems.
@@ -70,9 +70,15 @@ class FakeServer {
   // Ends a synth at the next block (its destructors run there); deleted afterwards.
   void free(Synth* synth);
   int numSynths() const { return static_cast<int>(synths_.size()); }
-  // Serves the NRT side for that long, or until `done` (false if it never was).
-  void serveFor(std::chrono::milliseconds duration);
+  // Serves the NRT side until `done`, for at most `timeout` (false if it never was).
   bool serveUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout);
+  // Serves the NRT side until the audio thread has run `count` more blocks (false if it has not
+  // within `timeout`): audio time, which a loaded machine stretches, not the wall clock's.
+  bool serveBlocks(int64_t count, std::chrono::milliseconds timeout);
+  // Lets what is in flight between the two sides go round `rounds` times: each round the NRT
+  // side serves, then the audio thread runs a whole block begun after that; then it serves once
+  // more. An asynchronous command moves on one stage a round (false if a block took `timeout`).
+  bool settle(int rounds, std::chrono::milliseconds timeout);
 
   int64_t blocks() const { return blocks_.load(); }
   int doneCount(const std::string& command) const;  // `/done command` replies so far
