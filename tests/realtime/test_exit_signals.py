@@ -16,6 +16,11 @@ from kfharness import paths, procs, sclang
 from kfstudy import readers
 
 FORCE_N = 1.4
+# Frames the device applies before the signal (the script waits for them), and the fewest the
+# recording must hold: the frames the recording's writer had not written yet are lost with the
+# process (it writes every 10 ms at normal priority: the off record came at most 0.019 s after
+# the last frame written, measured under load), so half of them is a margin of 0.3 s.
+FRAMES = 600
 
 
 def signal_each_in_turn(jack, signal_numbers, records):
@@ -31,7 +36,7 @@ def signal_each_in_turn(jack, signal_numbers, records):
     return sclang.run_with_server(f"""
         var period = s.aliveThreadPeriod;
         [{turns}].do {{ |turn, i|
-            var signal = turn[0], record = turn[1], dev, pid, waited = 0, seen = 0;
+            var signal = turn[0], record = turn[1], dev, pid, waited = 0, seen = 0, applied = 0, polls = 0;
             try {{
                 if(i > 0) {{
                     // As the harness boots (sclang.py): polled every 0.05 s while booting.
@@ -46,7 +51,15 @@ def signal_each_in_turn(jack, signal_numbers, records):
                 s.sync;
                 Synth(\\kfPush);
                 s.sync;
-                0.6.wait;
+                // Until the device has applied {FRAMES} frames of 1.4 N ({FRAMES} ms of the server's
+                // audio), not for a time of sclang's clock: without realtime scheduling the server
+                // lost audio cycles, and 0.6 s of the clock held as little as 0.15 s of audio.
+                while {{ applied < {FRAMES} and: {{ polls < 200 }} }} {{
+                    var answered = Condition.new;
+                    dev.statusValues {{ |values| applied = values[\\frames]; answered.test = true; answered.signal }};
+                    answered.wait;
+                    0.05.wait; polls = polls + 1;
+                }};
                 pid = s.pid;
                 ("kill -" ++ signal ++ " " ++ pid).unixCmd;
                 // Until the process is gone (kill -0 fails), at most 10 s.
@@ -114,7 +127,7 @@ def test_a_signal_drives_the_magnet_off(signalled, signal_number):
 
     header, records = readers.read_session(record)
     frames = [fields for tag, fields in records if tag == "F"]
-    assert len(frames) >= 300, f"only {len(frames)} frames recorded before the signal"
+    assert len(frames) >= FRAMES // 2, f"only {len(frames)} frames recorded before the signal"
     # The magnet was at the maximum until the signal...
     assert frames[-1][3] == pytest.approx(FORCE_N, abs=1e-6), frames[-1]
     # ... and the last record is the handler's: magnet off, after the last frame.
