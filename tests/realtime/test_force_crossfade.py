@@ -39,6 +39,7 @@ def tolerance_n(excess_n, fade_s=FADE_S):
 
 TOLERANCE_N = tolerance_n(0.5 - MIN_N)  # 3.87e-4 N
 MARGIN_S = 0.1  # a fade's start is the bundle's time, a few blocks from where the frames show it
+STEP_S = 3.0  # of audio between the script's steps: a fade of FADE_S and a second to spare
 
 
 def figure(name, value):
@@ -46,10 +47,13 @@ def figure(name, value):
 
 
 def commanded_frames(path):
-    """(audio time s, commanded force N) of every frame of a session record."""
+    """(device thread's time s, audio time s, commanded force N) of every frame of a session
+    record. The device thread's clock is the wall clock (seconds since the open); audio time
+    is the server's blocks, which fall behind the wall clock whenever JACK drops a cycle
+    (without realtime scheduling, beside two CPU hogs: 8.0 s of audio in 11.6 s)."""
     header, records = readers.read_session(path)
     frames = np.array([f for tag, f in records if tag == "F"]).reshape(-1, 4)
-    return frames[:, 1], frames[:, 3]
+    return frames[:, 0], frames[:, 1], frames[:, 3]
 
 
 def fade_start(t_seen, excess_n):
@@ -69,26 +73,38 @@ def test_an_ndef_crossfade_moves_the_force_from_old_to_new_never_above_the_large
     assert jack.sample_rate == 48000, "BLOCK_S assumes 48 kHz"
     record = paths.work_dir() / "ndef-crossfade.kfs"
     record.unlink(missing_ok=True)
-    sclang.require_ok(sclang.run_with_server(f"""
-        var dev = FrictionDevice.sim(s, 0);
+    run = sclang.require_ok(sclang.run_with_server(f"""
+        var dev = FrictionDevice.sim(s, 0), step;
+        SynthDef(\\kfAudioWait, {{ |dur = 1| Line.kr(0, 1, dur, doneAction: 2) }}).add;
         s.sync;
         dev.record({sclang.sc_string(record)});
+        // Each step posts its logical time (its bundles' time less the latency) and waits for
+        // {STEP_S} s of the server's audio, not of sclang's clock: without realtime scheduling
+        // the server loses cycles (JACK's xruns) and 3 s of the clock held 2.1 s of audio, so
+        // a fade of 2 s was not over when the next step came.
+        step = {{ |name|
+            var done = Condition.new, node;
+            "KF-STEP % %".format(name, thisThread.seconds).postln;
+            s.bind {{ node = Synth(\\kfAudioWait, [\\dur, {STEP_S}]) }};
+            node.onFree {{ done.test = true; done.signal }};
+            done.wait;
+        }};
         Ndef(\\kf).fadeTime = {FADE_S};
         Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.5)); Silent.ar }});
-        3.wait;
+        step.(\\first);
         // Another 0.5 N version: the crossfade must keep 0.5 N.
         Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.25) + DC.ar(0.25)); Silent.ar }});
-        3.wait;
+        step.(\\same);
         // A 0.8 N version: from 0.5 to 0.8 N within the fade, never above 0.8 N.
         Ndef(\\kf, {{ FrictionOut.ar(0, DC.ar(0.8)); Silent.ar }});
-        3.wait;
+        step.(\\up);
         // Released with the proxy's fadeTime: down to the minimum.
         Ndef(\\kf).release;
-        3.wait;
+        step.(\\release);
         dev.close;
         Ndef(\\kf).clear;
     """, jack, name="ndef-crossfade", timeout=90))
-    t, f = commanded_frames(record)
+    host, t, f = commanded_frames(record)
     failed = []  # every claim is checked, and all that fail are told
 
     def check(ok, claim):
@@ -96,11 +112,23 @@ def test_an_ndef_crossfade_moves_the_force_from_old_to_new_never_above_the_large
             failed.append(claim)
 
     # The script's steps on audio time, whatever the rule: the last frame is the released synth's
-    # last block, fadeTime after the release; the evaluations before it are 3 s apart (sclang's
-    # logical time; NodeProxy's bundles share one latency). (The first version's first frame is
-    # later than its step by the time its SynthDef takes to reach the server.)
+    # last block, fadeTime of audio after the release. The steps before it are sclang's logical
+    # times (KF-STEP), on the wall clock: NodeProxy's bundles share one latency and the server
+    # runs each at its time on the wall clock, whatever audio it lost. So each step is the
+    # release's wall clock time (the device thread's, at the frame of t_release) less the
+    # step's distance from the release on sclang's clock, read back on audio time through the
+    # frames. (Measured under load: the 0.5 -> 0.8 N fade started within 0.02 s of this, and
+    # 0.26 to 1.07 s after the audio time 3 s before the release that counted on audio and
+    # wall clock keeping pace.) (The first version's first frame is later than its step by the
+    # time its SynthDef takes to reach the server.)
+    steps = {name: float(seconds) for name, seconds in run.lines("KF-STEP ")}
     t_release = t[-1] - FADE_S
-    t_up_eval, t_same_eval = t_release - 3, t_release - 6
+    host_release = np.interp(t_release, t, host)
+
+    def audio_time(name):
+        return float(np.interp(host_release - (steps["release"] - steps[name]), host, t))
+
+    t_up_eval, t_same_eval = audio_time("up"), audio_time("same")
     same = (t >= t_same_eval - 0.5) & (t < t_up_eval - MARGIN_S)  # the 0.5 -> 0.5 N crossfade
     figure("first_version_reached_0.5N_after_s", round(float(t[first(f >= 0.5 - TOLERANCE_N)] - t[0]), 4))
     figure("first_version_settled_before_the_second_s", round(float(t_same_eval - t[0] - FADE_S), 4))
@@ -146,7 +174,7 @@ def test_a_pbind_notes_adsr_shapes_its_force(jack):
     record = paths.work_dir() / "pbind-adsr.kfs"
     record.unlink(missing_ok=True)
     sclang.require_ok(sclang.run_with_server(f"""
-        var dev = FrictionDevice.sim(s, 0), player;
+        var dev = FrictionDevice.sim(s, 0), notes;
         SynthDef(\\kfNote, {{ |gate = 1, force = 0.8, freq = 440, amp = 0.1|
             var env = EnvGen.kr(Env.adsr(0.02, 0.05, 1, 0.3, curve: \\lin), gate, doneAction: 2);
             FrictionOut.ar(0, DC.ar(force));
@@ -154,31 +182,56 @@ def test_a_pbind_notes_adsr_shapes_its_force(jack):
         }}).add;
         s.sync;
         dev.record({sclang.sc_string(record)});
-        // Notes of 0.5 s every second: attack 20 ms, sustain, a linear release of 0.3 s.
-        player = Pbind(\\instrument, \\kfNote, \\force, 0.8, \\dur, 1, \\legato, 0.5).play;
-        3.5.wait;
-        player.stop;
-        1.wait;
+        // Notes of 0.5 s: attack 20 ms, sustain, a linear release of 0.3 s. The Pbind's events
+        // are played as its player plays them, each once the one before has ended (its node's
+        // /n_end), not every second of the clock: without realtime scheduling the server's
+        // audio lost up to 0.7 s of a second, and one note's release overlapped the next's
+        // attack (1.05 N, the two notes' forces added as their sounds do).
+        notes = Pbind(\\instrument, \\kfNote, \\force, 0.8, \\dur, 1, \\legato, 0.5).asStream;
+        4.do {{
+            var note = notes.next(Event.default), ended = Condition.new;
+            note.play;
+            OSCFunc({{ ended.test = true; ended.signal }}, '/n_end', s.addr,
+                argTemplate: [note[\\id].asArray[0]]).oneShot;
+            ended.wait;
+            0.2.wait;
+        }};
         dev.close;
     """, jack, name="pbind-adsr", timeout=90))
-    t, f = commanded_frames(record)
-    # Each note starts a synth: its first frame follows a gap (the synth before was freed).
-    starts = t[np.r_[0, np.flatnonzero(np.diff(t) > 0.1) + 1]]
-    # The gate goes off 0.5 s in (dur 1, legato 0.5): the linear release halves the force above
-    # the minimum 0.15 s later and ends 0.3 s later (then the synth is freed).
-    midway = [float(np.interp(s + 0.5 + 0.15, t, f)) for s in starts]
-    sustain = [float(np.interp(s + 0.3, t, f)) for s in starts]
+    host, t, f = commanded_frames(record)
+    # Each note starts with its attack: frames rising by more than 0.01 N (the attack rises
+    # (0.8 - 0.14) N in 20 ms, 0.033 N a frame; sustain is flat and the release falls), the
+    # first of a rise that follows none for 0.1 s. Not by the gap before it: 0.2 s of the wall
+    # clock, which shrank to 0.03 s of audio under load.
+    rising = np.flatnonzero(np.diff(f) > 0.01) + 1
+    starts = [i for k, i in enumerate(rising) if k == 0 or t[i] - t[rising[k - 1]] > 0.1]
+    ends = starts[1:] + [len(t)]
+    # The gate goes off 0.5 s of the wall clock in (dur 1, legato 0.5): that is 0.5 s of audio
+    # only where no cycle was lost (0.15 to 0.40 s measured under load), so the gate-off is read
+    # from the force: its last frame at the sustain level. The linear release then halves the
+    # force above the minimum 0.15 s of audio later and ends 0.3 s later, when the synth is
+    # freed: its last frame (measured 0.296 to 0.300 s after, 0.004 s being the frames of the
+    # last blocks the device skipped under load; 0.01 s allowed). A force that ignored the
+    # envelope would stay at 0.8 N to that last frame.
+    off = [int(np.flatnonzero(f[s:e] >= 0.8 - 1e-3)[-1]) + s for s, e in zip(starts, ends)]
+    midway = [float(np.interp(t[o] + 0.15, t[s:e], f[s:e])) for s, e, o in zip(starts, ends, off)]
+    release_s = [float(t[e - 1] - t[o]) for e, o in zip(ends, off)]
     figure("pbind_notes", len(starts))
     figure("pbind_max_N", float(f.max()))
-    figure("pbind_sustain_N", [round(v, 4) for v in sustain])
+    figure("pbind_gate_off_after_audio_s_wall_s", [(round(float(t[o] - t[s]), 4), round(float(host[o] - host[s]), 4))
+                                                   for s, o in zip(starts, off)])
     figure("pbind_release_midway_N", [round(m, 4) for m in midway])
-    figure("pbind_last_frame_after_gate_off_s", [round(float(t[t < s + 0.95][-1] - s - 0.5), 4) for s in starts])
+    figure("pbind_last_frame_after_gate_off_s", [round(r, 4) for r in release_s])
     assert len(starts) >= 3
     assert f.max() <= 0.8 + TOLERANCE_N
-    for v in sustain:
-        assert abs(v - 0.8) < 1e-3
+    for s, e, o in zip(starts, ends, off):
+        # Attack (20 ms) and decay (50 ms) are over 0.1 s in (ahead of the gate-off, at least
+        # 0.15 s of audio in under load); the sustain holds to the gate-off.
+        sustain = f[s:o + 1][t[s:o + 1] >= t[s] + 0.1]
+        assert sustain.size and np.all(np.abs(sustain - 0.8) < 1e-3), "the sustain holds the force"
+        tail = f[s:e][t[s:e] > t[o] + 0.3 + 0.01]
+        assert tail.size == 0 or tail.max() <= MIN_N + 1e-3, "the minimum once the release is over"
     for m in midway:
         assert abs(m - (MIN_N + 0.8) / 2) < 0.03, "the force fades with the note's release"
-    for s in starts:
-        tail = f[(t > s + 0.5 + 0.3 + 0.01) & (t < s + 0.95)]
-        assert tail.size == 0 or tail.max() <= MIN_N + 1e-3, "the minimum once the release is over"
+    for r in release_s:
+        assert abs(r - 0.3) < 0.01, "the release lasts its 0.3 s"
