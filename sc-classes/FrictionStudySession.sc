@@ -13,6 +13,8 @@
 // folder, the server, the channels, the device): a refusal is an Error with the reason.
 FrictionStudySession {
 	classvar <answersHeader, <eventsHeader, <trialsHeader;
+	// A server that has not answered a /sync for this long (s) is lost: the session fails.
+	classvar <>lostAfterS = 3;
 	var <study, <participant, <folder, <server, <participantIndex, <seed, <device, <simulated, <windows;
 	var <participantOut, <experimenterOut, <deviceIndex;
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
@@ -20,7 +22,7 @@ FrictionStudySession {
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
 	var buttonsSynth, buttonsResponder;
-	var routine;
+	var routine, lastAnswerT, watchId;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -132,6 +134,7 @@ FrictionStudySession {
 					SendReply.kr(FrictionButtons.kr(\device.kr(0)).sum > 0, '/kfStudyButton', 1)
 				}).add;
 				server.sync;
+				this.prWatch;
 				if(windows) {
 					participantWindow = FrictionStudyParticipantWindow(this);
 					experimenterWindow = FrictionStudyExperimenterWindow(this);
@@ -283,6 +286,11 @@ FrictionStudySession {
 		state = \running;
 		this.log(\start, condition.name);
 		estimate = experiment.run(conditionDevice, how, { |trial|
+			var endT = Main.elapsedTime;
+			// Stored once the server has answered since the trial ended (a round trip: a few ms): a
+			// trial that ended on a lost server is never stored (prLost ends the session meanwhile).
+			server.sendMsg('/sync', watchId);
+			while { lastAnswerT <= endT } { 0.005.wait };
 			FrictionStudyFiles.appendCsv(folder +/+ "trials.csv", [participant, position + 1, condition.name, attempt]
 				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
 					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
@@ -302,6 +310,46 @@ FrictionStudySession {
 		if(simulated.notNil) { conditionDevice.close };
 		server.sync;
 		^this.prQuestions
+	}
+
+	// ---- the instrument ----
+
+	// Every 0.25 s the server is sent a /sync; its /synced comes after its audio thread ran a
+	// block, so a server that died, quit, hangs or lost its audio (jackd gone) sends none. With
+	// no answer for lostAfterS the session fails at once (prLost). 3 s: the server's async queue
+	// (a file opened for recording, a SynthDef) holds a /sync back beside it; a false alarm would
+	// end a participant's session, so the bound is far above the round trip (a few ms).
+	prWatch {
+		var answered;
+		watchId = UniqueID.next;
+		lastAnswerT = Main.elapsedTime;
+		answered = OSCFunc({ lastAnswerT = Main.elapsedTime }, '/synced', server.addr, argTemplate: [watchId]);
+		Routine {
+			while { this.isOver.not } {
+				server.sendMsg('/sync', watchId);
+				0.25.wait;
+				if(Main.elapsedTime - lastAnswerT > lostAfterS) {
+					this.prLost("the server % stopped answering (no /synced for % s)".format(server.name,
+						(Main.elapsedTime - lastAnswerT).round(0.01)))
+				}
+			};
+			answered.free;
+		}.play(AppClock);
+	}
+
+	// The instrument is gone: the session's routine, which may be waiting on that server, stops;
+	// the session fails with the reason in session.csv, the condition's events and the post
+	// window. What was stored stays; the trial in flight is not stored.
+	prLost { |reason|
+		if(this.isOver) { ^this };
+		routine.stop;
+		state = \failed;
+		this.log(\lost, reason);
+		this.prSessionLog(\error, reason);
+		"FrictionStudySession %: %; the session failed (what it stored is kept)".format(participant, reason).error;
+		participantWindow !? { participantWindow.showEnd };
+		experimenterWindow !? { experimenterWindow.refresh };
+		onEnd.value(this);
 	}
 
 	// The participant's output pair into the condition's audio.wav; the report places its first

@@ -1,0 +1,60 @@
+"""A study session whose server dies (kill -9 of scsynth mid-threshold-condition) fails at once:
+the session's state, its reason in session.csv and the condition's events, and no trial stored
+after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS)."""
+import csv
+import shutil
+
+from kfharness import paths, sclang
+
+SCRIPT = r"""
+var study, session, path = @ROOT@ +/+ "L1/trials.csv", killT, overT, atKill, atOver, later;
+var rows = { if(File.exists(path)) { File.readAllString(path).split($\n).reject(_.isEmpty).size - 1 } { 0 } };
+study = FrictionStudy("lost", [
+	FrictionStudyCondition.threshold(\forceStep, {
+		FrictionThreshold.force(FrictionConstantStimuli([0.05, 0.1, 0.2], 10, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
+session = study.run("L1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
+session.onEnd = { overT = Main.elapsedTime; atOver = rows.value };
+while { rows.value < 3 } { 0.01.wait };
+("kill -9 " ++ s.pid).systemCmd;
+killT = Main.elapsedTime;
+atKill = rows.value;
+while { session.isOver.not and: { Main.elapsedTime - killT < 30 } } { 0.05.wait };
+3.wait;  // what a session that went on would store meanwhile: a trial every 0.4 s
+later = rows.value;
+"KF-STATE %".format(session.state).postln;
+"KF-LOST-AFTER %".format(FrictionStudySession.lostAfterS).postln;
+"KF-DEATH-TO-FAILURE %".format(overT !? { overT - killT }).postln;
+"KF-ROWS % % %".format(atKill, atOver, later).postln;
+"""
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack):
+    root = paths.work_dir() / "study-server-lost"
+    shutil.rmtree(root, ignore_errors=True)
+    run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root))), jack, timeout=90,
+                                 name="study-server-lost", server_options={"numOutputBusChannels": 4})
+    assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]
+    lost_after_s = float(run.lines("KF-LOST-AFTER")[0][0])
+    death_to_failure_s = float(run.lines("KF-DEATH-TO-FAILURE")[0][0])
+    print(f"KF-FIGURE study_server_death_to_session_failure_s {death_to_failure_s:.3f}")
+    # The last /synced came before the kill; the watch checks every 0.25 s, on AppClock: lost
+    # after at most lostAfterS + 0.25 s, plus the time its routine waits for the CPU (beside two
+    # CPU hogs at normal priority, tens of ms); 1 s of room covers that with margin.
+    assert lost_after_s <= death_to_failure_s <= lost_after_s + 1.0
+    at_kill, at_over, later = (int(n) for n in run.lines("KF-ROWS")[0])
+    # At most the trial whose store (after its /synced) crossed the kill; nothing after the failure
+    # (the old session stored a trial every 0.4 s until the end).
+    assert at_kill <= at_over <= at_kill + 1 and later == at_over, (at_kill, at_over, later)
+    folder = root / "L1"
+    assert len(rows(folder / "trials.csv")) == later
+    session = rows(folder / "session.csv")
+    assert session[-1]["event"] == "error" and "stopped answering" in session[-1]["detail"], session
+    events = [e["event"] for e in rows(folder / "01-forceStep" / "events.csv")]
+    assert events[-1] == "lost" and "done" not in events and "estimate" not in events, events
+    assert "the session failed" in run.output
