@@ -77,12 +77,16 @@ void TrajectoryReconstructor::addReport(double reportTimeS, double dxMm, double 
   // The update rate is measured on the device's own clock where there is one.
   const double rateTimeS = std::isfinite(sourceTimeS) ? sourceTimeS : reportTimeS;
   if (std::isfinite(rateTimeS)) rate_.addReport(rateTimeS);
-  enqueue(reportTimeS, dxMm, dyMm, false);
+  enqueue(reportTimeS, dxMm, dyMm);
 }
 
-void TrajectoryReconstructor::addShift(double timeS, double dxMm, double dyMm) { enqueue(timeS, dxMm, dyMm, true); }
+void TrajectoryReconstructor::addShift(double /*timeS*/, double dxMm, double dyMm) {
+  // Anchor and everything relative to it move together: the output steps by the shift.
+  if (std::isfinite(dxMm)) axes_[0].anchorMm += dxMm;
+  if (std::isfinite(dyMm)) axes_[1].anchorMm += dyMm;
+}
 
-void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm, bool isShift) {
+void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm) {
   if (!std::isfinite(dxMm)) dxMm = 0.0;  // one bad report must not poison the position
   if (!std::isfinite(dyMm)) dyMm = 0.0;
   if (!std::isfinite(timeS)) timeS = pendingCount_ > 0 ? lastQueuedTimeS_ : lastRenderTimeS_;
@@ -95,7 +99,7 @@ void TrajectoryReconstructor::enqueue(double timeS, double dxMm, double dyMm, bo
     ++reportsMerged_;
     return;
   }
-  queue_[(pendingHead_ + pendingCount_) % kQueueCapacity] = Pending{timeS, {dxMm, dyMm}, isShift};
+  queue_[(pendingHead_ + pendingCount_) % kQueueCapacity] = Pending{timeS, {dxMm, dyMm}};
   ++pendingCount_;
   lastQueuedTimeS_ = timeS;
 }
@@ -123,11 +127,6 @@ double TrajectoryReconstructor::speedAt(const Axis& axis, double s) const {
 }
 
 void TrajectoryReconstructor::take(const Pending& report, double nowS) {
-  if (report.isShift) {
-    // Anchor and everything relative to it move together: the output steps by the shift.
-    for (int a = 0; a < 2; ++a) axes_[a].anchorMm += report.dMm[a];
-    return;
-  }
   // Taken at its own time, or at the last rendered sample if that is already past it, so the
   // position just before it is what was (or would have been) output.
   double takeS = std::min(report.timeS, nowS);
