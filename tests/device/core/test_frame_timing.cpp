@@ -1,7 +1,10 @@
 // Realtime: force frames leave the device thread at their own time (the jitter buffer), one
 // per millisecond, whatever the audio block size; the watchdog does not chatter when the audio
 // period is longer than its timeout, and turns the magnet off when the frames stop. Timing
-// bounds are loose (a loaded 2-core machine); the measured figures are printed.
+// bounds are loose (a loaded 2-core machine); the measured figures are printed. These claims
+// need the threads to get the CPU on time, which realtime scheduling gives: where it is refused
+// they are not checked (the test says so), only what holds at any priority; the exact tests
+// below show the mechanism on a clock of their own.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -23,6 +26,10 @@ struct StreamResult {
   std::vector<TimelineSink::Event> events;
   double lastPushS = 0.0;
   int framesPushed = 0;
+  // Both the audio stand-in and the device thread got SCHED_FIFO.
+  bool realtime = false;
+  // The audio stand-in's wake-ups whose first block went out more than 5 ms after its end.
+  int lateWakeups = 0;
 };
 
 // The body of streamFrames, on the calling thread.
@@ -37,7 +44,9 @@ StreamResult streamFramesHere(int blockSamples, double seconds, double stopWaitS
   int frame = 0;
   for (int block = 1; block * blockS < seconds; ++block) {
     const double blockEndS = block * blockS;
-    while (device.nowS() < blockEndS) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    bool slept = false;
+    for (; device.nowS() < blockEndS; slept = true) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    if (slept && device.nowS() - blockEndS > 0.005) ++result.lateWakeups;
     for (; (frame + 1) * 0.001 <= blockEndS + 1e-12; ++frame)
       device.pushForceFrame({frame * 0.001, 0.2f + 0.001f * static_cast<float>(frame % 1000), (frame + 1) * 0.001});
     result.lastPushS = device.nowS();
@@ -46,6 +55,7 @@ StreamResult streamFramesHere(int blockSamples, double seconds, double stopWaitS
   std::this_thread::sleep_for(std::chrono::duration<double>(stopWaitS));
   result.telemetry = device.telemetry();
   result.events = sink->events();
+  result.realtime = result.telemetry.deviceThread.priority > 0;
   device.close();
   return result;
 }
@@ -58,8 +68,9 @@ StreamResult streamFramesHere(int blockSamples, double seconds, double stopWaitS
 StreamResult streamFrames(int blockSamples, double seconds, double stopWaitS) {
   StreamResult result;
   std::thread audio([&] {
-    scheduleThisThread("audio", {0, kFallbackPriority - 1});
+    const bool realtime = scheduleThisThread("audio", {0, kFallbackPriority - 1}).priority > 0;
     result = streamFramesHere(blockSamples, seconds, stopWaitS);
+    result.realtime = result.realtime && realtime;
   });
   audio.join();
   return result;
@@ -76,12 +87,32 @@ void print(const char* name, const StreamResult& r) {
       static_cast<double>(t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3]);
   std::printf(
       "%s: %d frames; pumps releasing 0/1/2/3+ frames: %.3f/%.3f/%.3f/%.3f; offset from due p50 %.3f ms p99 %.3f ms "
-      "max %.3f ms; release latency %.2f ms; late %llu; watchdog trips %llu; missed deadlines %llu, skipped %llu\n",
+      "max %.3f ms; release latency %.2f ms; late %llu; watchdog trips %llu; missed deadlines %llu, skipped %llu; %s, "
+      "audio wake-ups over 5 ms late %d\n",
       name, r.framesPushed, t.framesPerPump[0] / pumps, t.framesPerPump[1] / pumps, t.framesPerPump[2] / pumps,
       t.framesPerPump[3] / pumps, t.frameOffset.p50S * 1e3, t.frameOffset.p99S * 1e3, t.frameOffset.maxS * 1e3,
       t.releaseLatencyS * 1e3, static_cast<unsigned long long>(t.lateFrames),
       static_cast<unsigned long long>(t.watchdogTrips), static_cast<unsigned long long>(t.missedDeadlines),
-      static_cast<unsigned long long>(t.skippedFrames));
+      static_cast<unsigned long long>(t.skippedFrames), r.realtime ? "realtime" : "normal priority", r.lateWakeups);
+}
+
+// What the stream's timing claims stand on: both threads getting the CPU on time. Without
+// realtime scheduling, measured beside two CPU hogs on 2 cores (27 runs of each test), the
+// device thread missed up to 336 of 1500 deadlines and the stand-in was held up to 23 ms: the
+// watchdog then rightly trips, and the one-frame-per-ms spacing holds only as far as the
+// threads happened to get the CPU. So there the test says so and checks what holds at any
+// priority: each watchdog trip needs the frames to have run out, that is a late wake-up of
+// the audio stand-in (lateWakeups): the frame after the last one sent was not pushed 10 ms
+// after that one went out at its due time (its start plus the release latency, >= 1 ms, and at
+// 1024 samples about the block period, as each burst's first frames are that late), so its
+// block went out more than 10 ms + latency - 2.5 ms - block period, over 5 ms, after its end.
+bool timingChecked(const StreamResult& r) {
+  if (!r.realtime)
+    WARN(
+        "realtime scheduling refused (audio stand-in and device thread at normal priority): the timing claims "
+        "(one frame per pump, 1 ms spacing, watchdog quiet) are not checked, only what holds at any priority; "
+        << r.lateWakeups << " wake-ups of the audio stand-in more than 5 ms late");
+  return r.realtime;
 }
 
 }  // namespace
@@ -105,6 +136,10 @@ TEST_CASE("realtime frames leave one per ms at their own time with 64-sample blo
     while (frame < j + skipped && commands[j].forceN != 0.2f + 0.001f * static_cast<float>(frame % 1000)) ++frame;
     CHECK(commands[j].forceN == 0.2f + 0.001f * static_cast<float>(frame % 1000));
   }
+  CHECK(r.telemetry.frameOffset.count + skipped == static_cast<uint64_t>(r.framesPushed));
+  // At most the trip after the stream ended, and one for each time the audio stalled.
+  CHECK(r.telemetry.watchdogTrips <= 1 + static_cast<uint64_t>(r.lateWakeups));
+  if (!timingChecked(r)) return;
   // Spaced by the frame period: the median gap is 1 ms, and most pumps release exactly one.
   std::vector<double> gaps;
   for (size_t j = 1; j < commands.size(); ++j) gaps.push_back(commands[j].timeS - commands[j - 1].timeS);
@@ -119,7 +154,6 @@ TEST_CASE("realtime frames leave one per ms at their own time with 64-sample blo
   CHECK(pumps > 0);
   // Each left within a pump period of its due time (start + latency), mostly.
   CHECK(t.frameOffset.p50S < 0.001);
-  CHECK(t.frameOffset.count + skipped == static_cast<uint64_t>(r.framesPushed));
   CHECK(t.watchdogTrips <= 1);  // at most the one after the stream ended
   // Without the buffer a 1.33 ms block carries 1 or 2 frames: a quarter of them would share a
   // pump with the next and be overwritten before reaching the magnet.
@@ -130,8 +164,10 @@ TEST_CASE("a long audio period raises the release latency and the watchdog does 
   // watchdog.
   const StreamResult r = streamFrames(1024, 1.5, 0.0);
   print("1024 samples at 48 kHz", r);
+  CHECK(r.telemetry.releaseLatencyS > 0.8 * 1024 / 48000.0);                 // about one period (bursts are that late)
+  CHECK(r.telemetry.watchdogTrips <= static_cast<uint64_t>(r.lateWakeups));  // only where the audio stalled
+  if (!timingChecked(r)) return;
   CHECK(r.telemetry.watchdogTrips == 0);
-  CHECK(r.telemetry.releaseLatencyS > 0.8 * 1024 / 48000.0);  // about one period (bursts are that late)
   std::vector<double> gaps;
   std::vector<TimelineSink::Event> commands;
   for (const auto& e : r.events)
