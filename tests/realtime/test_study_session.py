@@ -146,7 +146,7 @@ while { ~session.isOver.not } { 0.1.wait };
 # device opens (bit 2 of the reports' buttons, 0.2 s long); then a simulated participant's session
 # that the experimenter aborts 0.5 s into its second condition.
 DONE_AND_ABORT = r"""
-var root = @ROOT@, device, session, sim, aborted;
+var root = @ROOT@, device, session, sim, aborted, served = Condition(), counted = Condition(), synths;
 ~study = FrictionStudy("button and abort", [
 	FrictionStudyCondition(\first, (mapping: \mapping1), "Explore; press a button when done.",
 		[FrictionStudyQuestion.text(\say, "Describe it.")], 20),
@@ -163,12 +163,21 @@ while { session.isOver.not } { 0.05.wait };
 device.close;
 aborted = ~study.run("A1", root, s, simulated: FrictionStudySimParticipant(2, 1.5), windows: false,
 	experimenterOut: 2);
-while { aborted.position < 1 or: { aborted.state != \running } or: { aborted.elapsedS < 0.5 } } { 0.05.wait };
+while { aborted.position < 1 or: { aborted.state != \running } } { 0.05.wait };
+// 0.5 s into the condition on the server's clock (its audio.wav's) as well as sclang's: without
+// realtime scheduling the server's falls behind (a JACK cycle that comes late is an xrun, and
+// the dummy driver starts its clock again from then: 0.38 s of audio in 0.5 s seen here).
+{ Line.kr(0, 0, 0.5, doneAction: 2); DC.ar(0) }.play.onFree { served.test = true; served.signal };
+served.wait;
+while { aborted.elapsedS < 0.5 } { 0.05.wait };
 aborted.abort;
 while { aborted.isOver.not } { 0.05.wait };
-// The server's count of synths comes with its status, polled every 0.7 s.
-1.0.wait;
-"KF-ABORTED % % synths".format(aborted.state, s.numSynths).postln;
+// The server's count of synths, asked after the session's frees (the sync), not its 0.7 s poll's.
+s.sync;
+OSCFunc({ |msg| synths = msg[3]; counted.test = true; counted.signal }, '/status.reply', s.addr).oneShot;
+s.sendMsg('/status');
+counted.wait;
+"KF-ABORTED % % synths".format(aborted.state, synths).postln;
 """
 
 
@@ -207,7 +216,8 @@ def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
     assert second[second.index("start"):] == ["start", "abort", "coverage"], second
     assert [(r["condition"], r["question"]) for r in read_rows(session / "answers.csv")] == [("first", "say")]
     # The aborted condition's recordings are kept: the device's (0.5 s and more of reports at
-    # 125 Hz: 62, less a margin), the audio as long as the condition ran.
+    # 125 Hz: 62, less a margin), the audio as long as the condition ran (0.5 s and more of the
+    # server's clock: the script waited for it).
     recording = readers.Session(session / "02-second" / "device.kfsession")
     assert len(recording.reports) > 40
     data, rate = readers.read_wav(session / "02-second" / "audio.wav")
