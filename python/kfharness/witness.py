@@ -11,22 +11,55 @@ in the same window is ours.
 stalls: how many times the machine kept the witness from running for longer than `stall_us` (the
 most over its threads, one a core: a stall of the machine holds them all). After a late wake-up
 cyclictest sleeps to its next deadline still ahead, so one stall counts once however long it was.
+
+Witness(normal_priority=True), for a user without realtime scheduling (cyclictest refuses to run
+there: it always asks for SCHED_FIFO): one thread at normal priority (SCHED_OTHER, as our threads
+then run), waking every 1 ms to absolute deadlines, measures how long a normal thread waited for
+the CPU beside whatever else runs (the scheduler's share, not only the machine's stalls). Same
+result; a Python thread, so its figures include some 50 us of its own.
 """
 import re
 import shutil
 import signal
 import subprocess
+import sys
+
+# The normal-priority witness: sleeps to 1 ms deadlines until SIGINT, then prints the lateness
+# in cyclictest's summary lines (us), so that one parser reads both.
+NORMAL_SAMPLER = r"""
+import signal, sys, time
+stall_us, period = int(sys.argv[1]), 0.001
+stop, total, count, worst, stalls = [], 0.0, 0, 0.0, 0
+signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+deadline = time.monotonic()
+while not stop:
+    deadline += period
+    ahead = deadline - time.monotonic()
+    if ahead > 0:
+        time.sleep(ahead)
+    late = time.monotonic() - deadline
+    total, count, worst, stalls = total + late, count + 1, max(worst, late), stalls + (late * 1e6 > stall_us)
+    if late >= period:  # as cyclictest: on to the next deadline still ahead, no catching up
+        deadline += late // period * period
+print("# Avg Latencies: %d" % (total / max(count, 1) * 1e6))
+print("# Max Latencies: %d" % (worst * 1e6))
+print("# Histogram Overflows: %d" % stalls)
+"""
 
 
 class Witness:
-    def __init__(self, stall_us=100000):
+    def __init__(self, stall_us=100000, normal_priority=False):
         self.stall_us = stall_us
+        self.normal_priority = normal_priority
         self.proc = None
         self.result = None
         self.output = ""
 
     def start(self):
-        if shutil.which("cyclictest"):
+        if self.normal_priority:
+            self.proc = subprocess.Popen([sys.executable, "-c", NORMAL_SAMPLER, str(self.stall_us)],
+                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        elif shutil.which("cyclictest"):
             self.proc = subprocess.Popen(["cyclictest", "-m", "-p", "90", "-t", "-a", "-i", "1000", "-q",
                                           "-h", str(self.stall_us)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         return self
