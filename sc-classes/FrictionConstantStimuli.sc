@@ -37,6 +37,8 @@ FrictionConstantStimuli {
 	}
 
 	isFinished { ^trials.size >= order.size }
+	// The lowest and highest level it asks for.
+	levelRange { ^[levels.minItem, levels.maxItem] }
 
 	next { ^order[trials.size] }
 

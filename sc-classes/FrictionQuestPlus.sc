@@ -39,6 +39,8 @@ FrictionQuestPlus {
 	}
 
 	isFinished { ^trials.size >= maxTrials }
+	// The lowest and highest level it can ask for.
+	levelRange { ^[levels.minItem, levels.maxItem] }
 
 	// The expected entropy after a trial at levels[i] is, up to a constant of all levels,
 	// -H(p) + sum posterior * (-H(p per grid point)), where p = sum posterior * p(correct): the

@@ -61,6 +61,8 @@ FrictionStaircase {
 	targetProbability { ^0.5 ** down.reciprocal }
 
 	isFinished { ^reversalLevels.size >= reversals or: { trials.size >= maxTrials } }
+	// The lowest and highest level it can ask for (inf when unbounded).
+	levelRange { ^[minLevel, maxLevel] }
 
 	// The level of the next trial (also after the last one).
 	level { ^nextLevel }

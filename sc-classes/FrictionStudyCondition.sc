@@ -97,7 +97,7 @@ FrictionStudyCondition {
 		if(questions.collect(_.key).asSet.size != questions.size) {
 			Error("%: two questions have one key: %".format(where, questions.collect(_.key))).throw
 		};
-		if(maxTimeS.isNumber.not or: { maxTimeS <= 0 } or: { maxTimeS == inf }) {
+		if(maxTimeS.isNumber.not or: { maxTimeS.isNaN } or: { maxTimeS <= 0 } or: { maxTimeS == inf }) {
 			Error("%: maxTimeS must be a finite number > 0 (s), got %".format(where, maxTimeS)).throw
 		};
 	}

@@ -83,6 +83,7 @@ FrictionThreshold {
 			Error("%: answers must be \\keys, \\buttons or a FrictionObserver, got %".format(where, answers)).throw
 		};
 		server = FrictionCheck.serverRunning(device.server, where);
+		this.prCheckForces(device, procedure.tryPerform(\levelRange) ? []);
 		def = FrictionThresholdStimuli.synthDef(kind, device, settings).add;
 		if(kind == \asynchrony) {
 			// The signal is sent in parts: the run starts once all of it is on the server.
@@ -98,6 +99,7 @@ FrictionThreshold {
 		while { (level = procedure.next).notNil } {
 			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
 				target: target, startS: thisThread.seconds - startS);
+			this.prCheckForces(device, [level], synth);
 			[1, 2].do { |interval|
 				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
 				server.bind { synth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
@@ -119,6 +121,27 @@ FrictionThreshold {
 		estimate = procedure.estimate;
 		onEnd.value(estimate);
 		^estimate
+	}
+
+	// The force experiment's reference and targets must be forces the device renders: one outside
+	// its minForceN..maxForceN would be clamped, and both intervals could hold the same force.
+	// Checked before the first trial for every level the procedure can name (its levelRange;
+	// infinite ends are left to the trials), and before each trial for its level. An Error with
+	// the reason; synth (the run's) is freed first.
+	prCheckForces { |device, levels, synth|
+		var lo, hi, base = settings[\baseForceN];
+		if(kind != \force) { ^this };
+		lo = device.specs[\minForceN];
+		hi = device.specs[\maxForceN];
+		([0] ++ levels.reject { |l| l.abs == inf }).do { |level|
+			var force = base + level;
+			if(force.isNaN or: { force < (lo - 1e-9) } or: { force > (hi + 1e-9) }) {
+				synth !? { device.server.bind { synth.free } };
+				Error(("FrictionThreshold.force: % N (the reference % N + the level %) is outside the % N to % N "
+					"that % renders: it would be clamped, and both intervals could hold the same force").format(
+					force, base, level, lo, hi, device)).throw
+			}
+		};
 	}
 
 	// The answer of the trial waiting for one: which interval (1 or 2) held the target. The keys'

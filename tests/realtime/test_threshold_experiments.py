@@ -173,3 +173,39 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
     # The first press comes at 2.4 s of the replay, after the first trial's 1.3 s of intervals:
     # the trial waited for it (the replay opened shortly before the run started).
     assert buttons[0]["answerS"] > 2 * (INTERVAL_S + GAP_S)
+
+
+def test_forces_the_device_cannot_render_are_refused_not_clamped(jack):
+    """A reference or a target outside the device's 0.14..1.4 N is refused with the reason: before
+    the first trial for the levels a procedure names, before the trial for an unbounded staircase's
+    level; and nothing of it reached the device (the run's synth freed, no trial). A condition's
+    NaN maxTimeS is refused too."""
+    run = sclang.require_ok(sclang.run_with_server(on_tempo_clock(rf"""
+        var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80));
+        var refused = {{ |tag, f|
+            try {{ f.value; "KF-ACCEPTED %".format(tag).postln }} {{ |e| "KF-REFUSED % %".format(tag, e.errorString).postln }}
+        }};
+        var ran = {{ |procedure, base|
+            FrictionThreshold.force(procedure, base, {INTERVAL_S}, {GAP_S}, seed: 1).run(dev, FrictionObserver(0.1),
+                {{ |t| "KF-TRIAL-RAN %".format(t[\level]).postln }})
+        }};
+        refused.(\negativeBase, {{ ran.(FrictionStaircase(0.1), -0.3) }});
+        refused.(\baseAboveMax, {{ ran.(FrictionConstantStimuli([0.1], 1), 5) }});
+        refused.(\levelsAboveMax, {{ ran.(FrictionConstantStimuli([0.1, 2], 1), 0.3) }});
+        refused.(\questAboveMax, {{ ran.(FrictionQuestPlus([0.1, 1.5], maxTrials: 2), 0.3) }});
+        refused.(\unboundedStaircase, {{ ran.(FrictionStaircase(1.5, 2, [0.2], \log, 10, 2), 0.3) }});
+        refused.(\nanTime, {{ FrictionStudyCondition(\a, (mapping: \mapping1), "", [], 0/0) }});
+        s.sync;
+        "KF-NODES %".format(s.numSynths).postln;
+        refused.(\inRange, {{ ran.(FrictionConstantStimuli([0.1, 1.1], 1, seed: 2), 0.3) }});
+        dev.close;
+    """), jack, name="threshold-refused", timeout=120))
+    refused = {fields[0]: " ".join(fields[1:]) for fields in run.lines("KF-REFUSED")}
+    for tag, force in [("negativeBase", "-0.3 N"), ("baseAboveMax", "5 N"), ("levelsAboveMax", "2.3 N"),
+                       ("questAboveMax", "1.8 N"), ("unboundedStaircase", "1.8 N")]:
+        assert tag in refused and force in refused[tag] and "0.14 N to 1.4 N" in refused[tag], (tag, refused)
+    assert "nanTime" in refused and "maxTimeS" in refused["nanTime"], refused
+    # Only the run in range played trials: the refused ones, none; their synths are gone.
+    assert sorted(float(f[0]) for f in run.lines("KF-TRIAL-RAN ")) == [0.1, 1.1], run.output[-3000:]
+    assert run.lines("KF-NODES ") == [["0"]]
+    assert run.lines("KF-ACCEPTED") == [["inRange"]]
