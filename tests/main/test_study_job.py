@@ -5,7 +5,6 @@ and writes the sessions and the report (FrictionStudy.report, from sclang) into 
 The test checks the sessions, the report's figures (PNG) and tables (CSV) against the sessions,
 the binds statistic (where it measures, and its test), and the threshold fits against the model
 observers' known thresholds."""
-import csv
 import os
 import shutil
 import subprocess
@@ -21,11 +20,6 @@ PILOT = ["mapping1-off", "mapping1-on", "mapping2-off", "mapping2-on", "mapping3
 THRESHOLDS = {"forceStep": "force", "asynchrony": "asynchrony", "gratingStep": "grating"}
 CONDITIONS = PILOT + list(THRESHOLDS)
 EXPLORE_S, TRIALS, INTERVAL_S, GAP_S = 3, 24, 0.2, 0.05
-
-
-def rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def png_size(path):
@@ -63,7 +57,7 @@ def test_the_study_job_writes_five_sessions_and_their_report():
             observer = c.event_json("observer")
             assert observer["threshold"] == s.manifest["simulatedParticipant"]["thresholds"][THRESHOLDS[c.name]]
             assert c.event_json("experiment")["kind"] == THRESHOLDS[c.name]
-        trials = rows(s.folder / "trials.csv")
+        trials = session_folder.read_csv(s.folder / "trials.csv")
         assert [t["condition"] for t in trials] == [name for name in THRESHOLDS for _ in range(TRIALS)]
         assert {(a["condition"], a["question"]) for a in s.answers} == {
             (c, q) for c in PILOT for q in (["audio"] if c.endswith("off") else ["touch", "relation"])} | {
@@ -71,7 +65,7 @@ def test_the_study_job_writes_five_sessions_and_their_report():
 
     # The report: a row per condition run, its figures there and drawn.
     report = (OUT / "report.md").read_text()
-    table = rows(OUT / "conditions.csv")
+    table = session_folder.read_csv(OUT / "conditions.csv")
     assert len(table) == 45
     for r in table:
         assert f"![{r['condition']}]({r['figure3']})" in report
@@ -105,7 +99,7 @@ def check_binds():
     from a crossing (|sine| >= 0.71, -3 dB: 0.45 N when crossed slowly) is raised whatever the
     speed it was crossed at (measured: all 50 of them in a run of this job); some parts, at the
     crossings, are not."""
-    parts = rows(OUT / "binds-parts.csv")
+    parts = session_folder.read_csv(OUT / "binds-parts.csv")
     judged = {m: [p for p in parts if p["mapping"] == m and p["mean_force_n"] not in ("", "nan")]
               for m in ("mapping1", "mapping2", "mapping3")}
     for mapping in ("mapping1", "mapping2"):
@@ -121,8 +115,8 @@ def check_binds():
     assert 0 < raised.sum() < len(raised), raised
 
     # The test is the paired t test of the per-participant differences, per mapping.
-    pairs = rows(OUT / "binds.csv")
-    tests = {r["mapping"]: r for r in rows(OUT / "binds-test.csv")}
+    pairs = session_folder.read_csv(OUT / "binds.csv")
+    tests = {r["mapping"]: r for r in session_folder.read_csv(OUT / "binds-test.csv")}
     assert len(pairs) == 15 and sorted(tests) == ["mapping1", "mapping2", "mapping3"]
     for mapping, test in tests.items():
         d = np.array([float(p["speed_off"]) - float(p["speed_on"]) for p in pairs if p["mapping"] == mapping])
@@ -149,12 +143,12 @@ def check_threshold_fits(sessions, report):
     fits were within 1.05), and the mean over the five participants of an experiment within 3
     bounds / sqrt(5) (the mean's sd); the procedure's own estimate (QUEST+'s posterior mean) the
     same."""
-    fits = rows(OUT / "thresholds.csv")
+    fits = session_folder.read_csv(OUT / "thresholds.csv")
     assert len(fits) == 15
     by_experiment = {}
     for fit in fits:
         session = next(s for s in sessions if s.participant == fit["participant"])
-        trials = [t for t in rows(session.folder / "trials.csv") if t["condition"] == fit["condition"]]
+        trials = [t for t in session_folder.read_csv(session.folder / "trials.csv") if t["condition"] == fit["condition"]]
         known = session.manifest["simulatedParticipant"]["thresholds"][THRESHOLDS[fit["condition"]]]
         assert int(fit["trials"]) == TRIALS and float(fit["observer_threshold"]) == known
         bound = psychometric.cramer_rao_sd_log10([float(t["level"]) for t in trials], known, 3.5, 0.5, 0.02)

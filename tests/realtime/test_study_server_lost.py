@@ -1,10 +1,10 @@
 """A study session whose server dies (kill -9 of scsynth mid-threshold-condition) fails at once:
 the session's state, its reason in session.csv and the condition's events, and no trial stored
 after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS)."""
-import csv
 import shutil
 
 from kfharness import paths, sclang
+from kfstudy.session_folder import read_csv
 
 SCRIPT = r"""
 var study, session, path = @ROOT@ +/+ "L1/trials.csv", killT, overT, atKill, atOver, later;
@@ -29,11 +29,6 @@ later = rows.value;
 """
 
 
-def rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack):
     root = paths.work_dir() / "study-server-lost"
     shutil.rmtree(root, ignore_errors=True)
@@ -52,9 +47,9 @@ def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jac
     # (the old session stored a trial every 0.4 s until the end).
     assert at_kill <= at_over <= at_kill + 1 and later == at_over, (at_kill, at_over, later)
     folder = root / "L1"
-    assert len(rows(folder / "trials.csv")) == later
-    session = rows(folder / "session.csv")
+    assert len(read_csv(folder / "trials.csv")) == later
+    session = read_csv(folder / "session.csv")
     assert session[-1]["event"] == "error" and "stopped answering" in session[-1]["detail"], session
-    events = [e["event"] for e in rows(folder / "01-forceStep" / "events.csv")]
+    events = [e["event"] for e in read_csv(folder / "01-forceStep" / "events.csv")]
     assert events[-1] == "lost" and "done" not in events and "estimate" not in events, events
     assert "the session failed" in run.output

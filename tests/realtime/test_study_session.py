@@ -1,7 +1,6 @@
 """A FrictionStudy session on a realtime server: bad input refused before anything starts, and a
 session killed mid-condition (scsynth and sclang, by pid) that loses nothing and resumes from
 sclang at the condition it was in."""
-import csv
 import json
 import os
 import shutil
@@ -11,6 +10,7 @@ import time
 
 from kfharness import paths, sclang
 from kfstudy import readers
+from kfstudy.session_folder import read_csv
 
 # Two conditions of mapping 1 (its 6 mm), each explored for 2.5 s by a simulated participant
 # (explore-s: 6 speed steps of 0.42 s), and a free-text and a rating question after each.
@@ -62,13 +62,8 @@ refused.(\noDevice, { ~study.run("P3", root, s, windows: false) });
     assert not any((root / "P1").iterdir())
 
 
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def events_of(folder):
-    return [row["event"] for row in read_rows(folder / "events.csv")]
+    return [row["event"] for row in read_csv(folder / "events.csv")]
 
 
 def test_a_killed_session_resumes_with_nothing_lost(jack):
@@ -108,7 +103,7 @@ while { ~session.isOver.not } { 0.1.wait };
     assert manifest["sampleRateHz"] == jack.sample_rate and manifest["device"]["kind"] == "sim"
     assert manifest["device"]["specs"]["tactileLatencyS"] == 0.0024 and manifest["version"] != "unknown"
     answers_before = (session / "answers.csv").read_bytes()
-    rows = read_rows(session / "answers.csv")
+    rows = read_csv(session / "answers.csv")
     assert [(r["condition"], r["question"]) for r in rows] == [("first", "say"), ("first", "hold")]
     assert events_of(session / "01-first")[-1] == "end"
     killed = events_of(session / "02-second")
@@ -127,14 +122,14 @@ while { ~session.isOver.not } { 0.1.wait };
                                                    server_options={"numOutputBusChannels": 4}))
     assert run.lines("KF-RESUMED") == [["finished", "2"]], run.output[-3000:]
     assert (session / "answers.csv").read_bytes().startswith(answers_before)
-    rows = read_rows(session / "answers.csv")
+    rows = read_csv(session / "answers.csv")
     assert [(r["condition"], r["question"], r["attempt"]) for r in rows] == [
         ("first", "say", "1"), ("first", "hold", "1"), ("second", "say", "2"), ("second", "hold", "2")]
     # The killed attempt is kept whole; the second attempt ran beside it.
     assert events_of(session / "02-second") == killed
     assert (session / "02-second" / "device.kfsession").read_text() == killed_recording
     assert events_of(session / "02-second-attempt2")[-1] == "end"
-    log = [row["event"] for row in read_rows(session / "session.csv")]
+    log = [row["event"] for row in read_csv(session / "session.csv")]
     assert log == ["start", "resume", "finish"], log
     for folder in ("01-first", "02-second-attempt2"):
         data, rate = readers.read_wav(session / folder / "audio.wav")
@@ -199,7 +194,7 @@ def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
     # The button ended the first condition: its "done" says so, at the press (2.0 s after the
     # device opened, which the prepare line follows within a few ms; a block and a status poll
     # late at most: 0.03 s measured, 0.5 s allowed on a busy machine).
-    events = read_rows(root / "B1" / "01-first" / "events.csv")
+    events = read_csv(root / "B1" / "01-first" / "events.csv")
     done = [e for e in events if e["event"] == "done"]
     assert [e["detail"] for e in done] == ["button"], events
     assert 1.9 < float(done[0]["timeS"]) < 2.5, done
@@ -209,12 +204,12 @@ def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
     # condition's events and the session's log; nothing is left playing on the server.
     assert run.lines("KF-ABORTED") == [["aborted", "0", "synths"]], run.output[-3000:]
     session = root / "A1"
-    log = read_rows(session / "session.csv")
+    log = read_csv(session / "session.csv")
     assert [(r["event"], r["detail"]) for r in log] == [("start", ""), ("abort", "second")], log
     assert events_of(session / "01-first")[-1] == "end"
     second = events_of(session / "02-second")
     assert second[second.index("start"):] == ["start", "abort", "coverage"], second
-    assert [(r["condition"], r["question"]) for r in read_rows(session / "answers.csv")] == [("first", "say")]
+    assert [(r["condition"], r["question"]) for r in read_csv(session / "answers.csv")] == [("first", "say")]
     # The aborted condition's recordings are kept: the device's (0.5 s and more of reports at
     # 125 Hz: 62, less a margin), the audio as long as the condition ran (0.5 s and more of the
     # server's clock: the script waited for it).

@@ -3,7 +3,6 @@ answers, onTrial, onEnd, out) inside its Routine, a FrictionObserver answering f
 participant; each trial goes into trials.csv as it comes; start, the experiment, the observer,
 each trial, the end and the estimate are logged; its questions follow. The report fits the trials
 (kfstudy.psychometric) and draws them beside the observer's known function."""
-import csv
 import json
 import shutil
 
@@ -11,6 +10,7 @@ import numpy as np
 
 from kfharness import paths, sclang
 from kfstudy import psychometric, report
+from kfstudy.session_folder import read_csv
 
 LEVELS, REPEATS, THRESHOLD = [0.05, 0.1, 0.2], 4, 0.1
 
@@ -32,11 +32,6 @@ while { session.isOver.not } {
 """
 
 
-def rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     root = paths.work_dir() / "study-threshold"
     shutil.rmtree(root, ignore_errors=True)
@@ -49,12 +44,12 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     seen = [int(n) for n in run.lines("KF-ROWS")[0]]
     assert seen == list(range(0, count + 1)) or seen == list(range(1, count + 1)), seen
     folder = root / "T1"
-    trials = rows(folder / "trials.csv")
+    trials = read_csv(folder / "trials.csv")
     assert [t["trial"] for t in trials] == [str(n) for n in range(1, count + 1)]
     assert sorted(float(t["level"]) for t in trials) == sorted(LEVELS * REPEATS)
     assert all(t["condition"] == "forceStep" and t["participant"] == "T1" for t in trials)
     assert [t["correct"] == "true" for t in trials] == [t["answer"] == t["target"] for t in trials]
-    events = rows(folder / "01-forceStep" / "events.csv")
+    events = read_csv(folder / "01-forceStep" / "events.csv")
     names = [e["event"] for e in events]
     assert names == ["prepare", "recordDevice", "experiment", "observer", "recordAudio", "start"] + [
         "trial"] * count + ["done", "estimate", "answer", "end"], names
@@ -63,7 +58,7 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     assert json.loads(detail["observer"])["threshold"] == THRESHOLD
     estimate = json.loads(detail["estimate"])
     right = sum(t["correct"] == "true" for t in trials)
-    assert [(a["question"], a["source"], a["answer"]) for a in rows(folder / "answers.csv")] == [
+    assert [(a["question"], a["source"], a["answer"]) for a in read_csv(folder / "answers.csv")] == [
         ("how", "simulated", f"simulated: {right} of {count} trials answered right by its model observer")]
     manifest = json.loads((folder / "manifest.json").read_text())
     assert manifest["study"]["conditions"][0]["threshold"] is True
@@ -81,4 +76,4 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     from PIL import Image
     with Image.open(root / "report" / "T1-forceStep-psychometric.png") as image:
         assert np.asarray(image.convert("L")).std() > 10
-    assert [r["condition"] for r in rows(root / "report" / "thresholds.csv")] == ["forceStep"]
+    assert [r["condition"] for r in read_csv(root / "report" / "thresholds.csv")] == ["forceStep"]

@@ -6,7 +6,6 @@ nothing else (no coverage, no live view); the experimenter's shows the live view
 map, whose filled part is the fraction covered. The experimenter's output pair carries what the
 participant hears. Screenshots: $KF_TEST_ARTEFACTS_DIR/study_windows (default
 build/test-artefacts/study_windows)."""
-import csv
 import os
 import shutil
 from pathlib import Path
@@ -16,6 +15,7 @@ import pytest
 
 from kfharness import paths, sclang
 from kfstudy import readers
+from kfstudy.session_folder import read_csv
 
 ARTEFACTS = Path(os.environ.get("KF_TEST_ARTEFACTS_DIR") or paths.REPO_DIR / "build" / "test-artefacts") / "study_windows"
 
@@ -101,11 +101,6 @@ def count(image, color, tol=10):
     return int(np.all(np.abs(image - np.array(color)) <= tol, axis=-1).sum())
 
 
-def rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def test_the_windows_driven_as_people_would(jack, display):
     root = paths.work_dir() / "study-windows"
     shutil.rmtree(root, ignore_errors=True)
@@ -149,13 +144,13 @@ def test_the_windows_driven_as_people_would(jack, display):
 
     # What the session wrote: the answers as given, the events as they happened.
     folder = root / "W1"
-    answers = rows(folder / "answers.csv")
+    answers = read_csv(folder / "answers.csv")
     assert [(a["question"], a["answer"], a["source"]) for a in answers] == [
         ("say", 'sticky, like "syrup"', "participant"), ("hold", "4", "participant"),
         ("which", "touch", "participant")]
-    first = [e["event"] for e in rows(folder / "01-explore" / "events.csv")]
+    first = [e["event"] for e in read_csv(folder / "01-explore" / "events.csv")]
     assert first == ["prepare", "recordDevice", "recordAudio", "start", "pause", "resume", "repeat", "coverage"], first
-    events = [(e["event"], e["detail"]) for e in rows(folder / "01-explore-attempt2" / "events.csv")]
+    events = [(e["event"], e["detail"]) for e in read_csv(folder / "01-explore-attempt2" / "events.csv")]
     assert [e for e, _ in events] == ["prepare", "recordDevice", "recordAudio", "start", "done", "coverage", "answer",
                                       "answer", "answer", "end"], events
     assert ("done", "key") in events and all(a["attempt"] == "2" for a in answers)
