@@ -1,7 +1,10 @@
-"""A study session whose server dies (kill -9 of scsynth mid-threshold-condition) fails at once:
+"""A study session whose server dies (kill -9 of scsynth, or of jackd: the server's audio stops,
+mid-threshold-condition) fails at once:
 the session's state, its reason in session.csv and the condition's events, and no trial stored
 after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS)."""
 import shutil
+
+import pytest
 
 from kfharness import paths, sclang
 from kfstudy.session_folder import read_csv
@@ -16,7 +19,7 @@ study = FrictionStudy("lost", [
 session = study.run("L1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
 session.onEnd = { overT = Main.elapsedTime; atOver = rows.value };
 while { rows.value < 3 } { 0.01.wait };
-("kill -9 " ++ s.pid).systemCmd;
+("kill -9 " ++ @VICTIM@).systemCmd;
 killT = Main.elapsedTime;
 atKill = rows.value;
 while { session.isOver.not and: { Main.elapsedTime - killT < 30 } } { 0.05.wait };
@@ -29,15 +32,17 @@ later = rows.value;
 """
 
 
-def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack):
-    root = paths.work_dir() / "study-server-lost"
+@pytest.mark.parametrize("victim", ["scsynth", "jackd"])
+def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack, victim):
+    root = paths.work_dir() / f"study-server-lost-{victim}"
     shutil.rmtree(root, ignore_errors=True)
-    run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root))), jack, timeout=90,
+    pid = "s.pid" if victim == "scsynth" else str(jack.proc.pid)
+    run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root)), VICTIM=pid), jack, timeout=90,
                                  name="study-server-lost", server_options={"numOutputBusChannels": 4})
     assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]
     lost_after_s = float(run.lines("KF-LOST-AFTER")[0][0])
     death_to_failure_s = float(run.lines("KF-DEATH-TO-FAILURE")[0][0])
-    print(f"KF-FIGURE study_server_death_to_session_failure_s {death_to_failure_s:.3f}")
+    print(f"KF-FIGURE study_{victim}_death_to_session_failure_s {death_to_failure_s:.3f}")
     # The last /synced came before the kill; the watch checks every 0.25 s, on AppClock: lost
     # after at most lostAfterS + 0.25 s, plus the time its routine waits for the CPU (beside two
     # CPU hogs at normal priority, tens of ms); 1 s of room covers that with margin.
