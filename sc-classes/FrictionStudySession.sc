@@ -153,6 +153,7 @@ FrictionStudySession {
 				state = \failed;
 				this.prSessionLog(\error, error.errorString);
 				error.reportError;
+				this.prFreeAfterFailure;
 			};
 			participantWindow !? { participantWindow.showEnd };
 			experimenterWindow !? { experimenterWindow.refresh };
@@ -217,11 +218,13 @@ FrictionStudySession {
 		state = \stopping;
 		this.log(ending, endedBy ? "");
 		this.log(\coverage, coverage.fraction.round(0.001));
-		recorder.stopRecording;
+		this.prStopAudio;
 		monitor.free;
 		listenSynth.free;
+		listenSynth = nil;  // freed once (prFreeAfterFailure)
 		buttonsResponder.free;
 		buttonsSynth.free;
+		buttonsSynth = nil;
 		pilot.free;
 		server.sync;
 		conditionDevice.stopRecording;
@@ -303,8 +306,9 @@ FrictionStudySession {
 		this.log(\estimate, FrictionStudyFiles.json(estimate));
 		stats = (trials: count, correct: right);
 		state = \stopping;
-		recorder.stopRecording;
+		this.prStopAudio;
 		listenSynth.free;
+		listenSynth = nil;  // freed once (prFreeAfterFailure)
 		server.sync;
 		conditionDevice.stopRecording;
 		if(simulated.notNil) { conditionDevice.close };
@@ -350,6 +354,38 @@ FrictionStudySession {
 		participantWindow !? { participantWindow.showEnd };
 		experimenterWindow !? { experimenterWindow.refresh };
 		onEnd.value(this);
+	}
+
+	// A session that failed frees what its condition started: the synths, the audio recording, the
+	// device's recording, the simulated device (which the next session may then open).
+	prFreeAfterFailure {
+		if(server.serverRunning.not) { ^this };
+		[monitor, listenSynth, buttonsResponder, buttonsSynth, pilot].do { |x| x !? { x.free } };
+		recorder !? { if(recorder.isRecording) { recorder.stopRecording } };
+		conditionDevice !? {
+			if(FrictionDevice.at(server, conditionDevice.index) === conditionDevice) {
+				conditionDevice.stopRecording;
+				if(simulated.notNil) { conditionDevice.close }
+			}
+		};
+	}
+
+	// Ends the condition's audio.wav. Recorder.stopRecording frees its DiskOut and closes the file
+	// in one go, but DiskOut's last part (up to half its buffer, 0.68 s at 48 kHz) reaches the file
+	// from scsynth's disk thread after the free: a close that came first lost it (a 0.4 s condition
+	// left 0 frames). So the DiskOut goes first, without the Recorder's own close on its /n_end (its
+	// onFree, a dependant of the node); the file is closed once its size has stopped growing (the
+	// disk thread wrote), at most 2 s later. Recorder has no flush of its own to call instead.
+	prStopAudio {
+		var path = conditionDir +/+ "audio.wav", size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
+		recorder.instVarAt(\recordNode) !? { |node| node.releaseDependants; node.free };
+		server.sync;
+		while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
+			var now = File.fileSize(path);
+			if(now != size) { size = now; stableSince = Main.elapsedTime };
+			0.01.wait
+		};
+		recorder.stopRecording;
 	}
 
 	// The participant's output pair into the condition's audio.wav; the report places its first

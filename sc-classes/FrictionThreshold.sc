@@ -96,10 +96,11 @@ FrictionThreshold {
 		server.sync;
 		server.bind { synth = Synth(def.name, [\out, out, \bufnum, buffer !? _.bufnum ? 0]) };
 		startS = thisThread.seconds;
-		while { (level = procedure.next).notNil } {
+		// On any way out, a refused force or onTrial's Error included, nothing of the run stays.
+		protect { while { (level = procedure.next).notNil } {
 			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
 				target: target, startS: thisThread.seconds - startS);
-			this.prCheckForces(device, [level], synth);
+			this.prCheckForces(device, [level]);
 			[1, 2].do { |interval|
 				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
 				server.bind { synth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
@@ -112,11 +113,12 @@ FrictionThreshold {
 			trial[\correct] = trial[\answer] == target;
 			procedure.respond(level, trial[\correct]);
 			onTrial.value(trial)
+		} } {
+			server.bind { synth.free };
+			this.prStopAnswers;
 		};
-		server.bind { synth.free };
 		// The bundles play server.latency after they are sent: the synth is gone when run returns.
 		(server.latency ? 0).wait;
-		this.prStopAnswers;
 		buffer !? { buffer.free };
 		estimate = procedure.estimate;
 		onEnd.value(estimate);
@@ -127,8 +129,8 @@ FrictionThreshold {
 	// its minForceN..maxForceN would be clamped, and both intervals could hold the same force.
 	// Checked before the first trial for every level the procedure can name (its levelRange;
 	// infinite ends are left to the trials), and before each trial for its level. An Error with
-	// the reason; synth (the run's) is freed first.
-	prCheckForces { |device, levels, synth|
+	// the reason.
+	prCheckForces { |device, levels|
 		var lo, hi, base = settings[\baseForceN];
 		if(kind != \force) { ^this };
 		lo = device.specs[\minForceN];
@@ -136,7 +138,6 @@ FrictionThreshold {
 		([0] ++ levels.reject { |l| l.abs == inf }).do { |level|
 			var force = base + level;
 			if(force.isNaN or: { force < (lo - 1e-9) } or: { force > (hi + 1e-9) }) {
-				synth !? { device.server.bind { synth.free } };
 				Error(("FrictionThreshold.force: % N (the reference % N + the level %) is outside the % N to % N "
 					"that % renders: it would be clamped, and both intervals could hold the same force").format(
 					force, base, level, lo, hi, device)).throw

@@ -58,3 +58,34 @@ def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jac
     events = [e["event"] for e in read_csv(folder / "01-forceStep" / "events.csv")]
     assert events[-1] == "lost" and "done" not in events and "estimate" not in events, events
     assert "the session failed" in run.output
+
+
+FAILING = r"""
+var study, session, path = @ROOT@ +/+ "F1/trials.csv";
+study = FrictionStudy("failing", [
+	FrictionStudyCondition.threshold(\forceStep, {
+		FrictionThreshold.force(FrictionConstantStimuli([0.05, 0.1, 0.2], 10, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
+session = study.run("F1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
+while { File.exists(path).not } { 0.01.wait };
+// trials.csv cannot be written from now on (a folder in its place: root writes any file).
+("rm " ++ path.shellQuote ++ " && mkdir " ++ path.shellQuote).systemCmd;
+while { session.isOver.not } { 0.05.wait };
+1.wait;
+s.sync;
+"KF-STATE %".format(session.state).postln;
+"KF-LEFT synths % slot %".format(s.numSynths, FrictionDevice.at(s, 0)).postln;
+"""
+
+
+def test_a_failed_session_frees_what_it_started(jack):
+    """trials.csv made unwritable mid-condition: the session fails with the reason, and leaves no
+    synth (the experiment's stimulus, the listen synth, the audio recorder) and no device open."""
+    root = paths.work_dir() / "study-failing"
+    shutil.rmtree(root, ignore_errors=True)
+    run = sclang.run_with_server(sclang.fill(FAILING, ROOT=sclang.sc_string(str(root))), jack, timeout=90,
+                                 name="study-failing", server_options={"numOutputBusChannels": 4})
+    assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]
+    assert run.lines("KF-LEFT") == [["synths", "0", "slot", "nil"]], run.output[-3000:]
+    session = read_csv(root / "F1" / "session.csv")
+    assert session[-1]["event"] == "error" and "cannot write" in session[-1]["detail"], session
