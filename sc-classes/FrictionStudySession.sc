@@ -22,7 +22,7 @@ FrictionStudySession {
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
 	var buttonsSynth, buttonsResponder;
-	var routine, lastAnswerT, watchId;
+	var routine, lastAnswerT, watchId, experiment;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -264,7 +264,8 @@ FrictionStudySession {
 	// simulated participant answers through the condition's makeObserver, or its own observer for
 	// the experiment's kind; the experiment and the observer (its known threshold) are logged.
 	prRunThreshold {
-		var experiment = condition.makeExperiment.value, estimate, how, right = 0, count = 0;
+		var estimate, how, right = 0, count = 0;
+		experiment = condition.makeExperiment.value;
 		how = if(simulated.notNil) {
 			condition.makeObserver !? { |make| make.value(simulated.seed) } ?? {
 				if(experiment.respondsTo(\kind).not) {
@@ -293,7 +294,9 @@ FrictionStudySession {
 			// Stored once the server has answered since the trial ended (a round trip: a few ms): a
 			// trial that ended on a lost server is never stored (prLost ends the session meanwhile).
 			server.sendMsg('/sync', watchId);
-			while { lastAnswerT <= endT } { 0.005.wait };
+			while { lastAnswerT <= endT and: { Main.elapsedTime - endT < lostAfterS } } { 0.005.wait };
+			// No answer (the watch gone with Cmd-., say): the trial is not stored, the session fails.
+			if(lastAnswerT <= endT) { Error("the server did not answer after trial %".format(trial[\trial])).throw };
 			FrictionStudyFiles.appendCsv(folder +/+ "trials.csv", [participant, position + 1, condition.name, attempt]
 				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
 					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
@@ -354,20 +357,29 @@ FrictionStudySession {
 		participantWindow !? { participantWindow.showEnd };
 		experimenterWindow !? { experimenterWindow.refresh };
 		onEnd.value(this);
+		this.prFreeAfterFailure;  // a server that still runs (jackd gone, a hang) plays on otherwise
 	}
 
-	// A session that failed frees what its condition started: the synths, the audio recording, the
-	// device's recording, the simulated device (which the next session may then open).
+	// A session that failed frees what its condition started: the experiment's stimulus and
+	// answers, the synths, the audio recording, the device's recording, the simulated device
+	// (which the next session may then open). Without waiting for the server, which may be why it
+	// failed: from AppClock outside a Routine the device's commands do not wait for their answers
+	// (a refusal is posted), and the audio is closed in a Routine of its own.
 	prFreeAfterFailure {
-		if(server.serverRunning.not) { ^this };
-		[monitor, listenSynth, buttonsResponder, buttonsSynth, pilot].do { |x| x !? { x.free } };
-		recorder !? { if(recorder.isRecording) { recorder.stopRecording } };
-		conditionDevice !? {
-			if(FrictionDevice.at(server, conditionDevice.index) === conditionDevice) {
-				conditionDevice.stopRecording;
-				if(simulated.notNil) { conditionDevice.close }
+		{
+			if(server.serverRunning) {
+				experiment !? { if(experiment.respondsTo(\stop)) { experiment.stop } };
+				[monitor, listenSynth, buttonsResponder, buttonsSynth, pilot].do { |x| x !? { x.free } };
+				listenSynth = buttonsSynth = nil;
+				recorder !? { fork { this.prStopAudio } };
+				conditionDevice !? {
+					if(FrictionDevice.at(server, conditionDevice.index) === conditionDevice) {
+						conditionDevice.stopRecording;
+						if(simulated.notNil) { conditionDevice.close }
+					}
+				}
 			}
-		};
+		}.defer
 	}
 
 	// Ends the condition's audio.wav. Recorder.stopRecording frees its DiskOut and closes the file
@@ -377,7 +389,11 @@ FrictionStudySession {
 	// onFree, a dependant of the node); the file is closed once its size has stopped growing (the
 	// disk thread wrote), at most 2 s later. Recorder has no flush of its own to call instead.
 	prStopAudio {
-		var path = conditionDir +/+ "audio.wav", size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
+		var path = recorder.path, size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
+		if(path.isNil) { ^this };  // closed already
+		if(recorder.isRecording.not or: { Recorder.instVarNames.includes(\recordNode).not }) {
+			^recorder.stopRecording
+		};
 		recorder.instVarAt(\recordNode) !? { |node| node.releaseDependants; node.free };
 		server.sync;
 		while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {

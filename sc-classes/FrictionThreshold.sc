@@ -10,7 +10,7 @@ FrictionThreshold {
 	var <kind, <procedure, <settings, <intervalS, <gapS, <seed;
 	// false: with \keys, no window of its own; the answers come through `answer` (a study's window).
 	var <>showKeysWindow = true;
-	var rng, answered, givenAnswer, keysWindow, buttonsResponder, buttonsSynth;
+	var rng, answered, givenAnswer, keysWindow, buttonsResponder, buttonsSynth, runSynth, runBuffer;
 
 	// base: the reference's force (N) above which the target adds the level.
 	*force { |procedure, baseForceN = 0.3, intervalS = 1.5, gapS = 0.5, seed|
@@ -74,7 +74,7 @@ FrictionThreshold {
 	// s from the run's start). out: the first of two output channels (the asynchrony's sound).
 	// Returns the procedure's estimate (and passes it to onEnd).
 	run { |device, answers = \keys, onTrial, onEnd, out = 0|
-		var where = "FrictionThreshold.run", server, def, synth, buffer, loaded, startS, level, estimate;
+		var where = "FrictionThreshold.run", server, def, loaded, startS, level, estimate;
 		if(thisThread.isKindOf(Routine).not) { Error("%: call it inside a Routine (fork)".format(where)).throw };
 		if(device.isKindOf(FrictionDevice).not) {
 			Error("%: device must be a FrictionDevice, got %".format(where, device)).throw
@@ -88,13 +88,13 @@ FrictionThreshold {
 		if(kind == \asynchrony) {
 			// The signal is sent in parts: the run starts once all of it is on the server.
 			loaded = Condition(false);
-			buffer = FrictionPilot.loadSignal(server, { loaded.test = true; loaded.signal });
+			runBuffer = FrictionPilot.loadSignal(server, { loaded.test = true; loaded.signal });
 			loaded.wait
 		};
 		answered = Condition(false);
 		this.prStartAnswers(answers, device);
 		server.sync;
-		server.bind { synth = Synth(def.name, [\out, out, \bufnum, buffer !? _.bufnum ? 0]) };
+		server.bind { runSynth = Synth(def.name, [\out, out, \bufnum, runBuffer !? _.bufnum ? 0]) };
 		startS = thisThread.seconds;
 		// On any way out, a refused force or onTrial's Error included, nothing of the run stays.
 		protect { while { (level = procedure.next).notNil } {
@@ -103,9 +103,9 @@ FrictionThreshold {
 			this.prCheckForces(device, [level]);
 			[1, 2].do { |interval|
 				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
-				server.bind { synth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
+				server.bind { runSynth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
 				intervalS.wait;
-				server.bind { synth.set(\active, 0) };
+				server.bind { runSynth.set(\active, 0) };
 				gapS.wait
 			};
 			trial[\answer] = this.prAwaitAnswer(answers, level, target);
@@ -113,13 +113,9 @@ FrictionThreshold {
 			trial[\correct] = trial[\answer] == target;
 			procedure.respond(level, trial[\correct]);
 			onTrial.value(trial)
-		} } {
-			server.bind { synth.free };
-			this.prStopAnswers;
-		};
+		} } { this.stop };
 		// The bundles play server.latency after they are sent: the synth is gone when run returns.
 		(server.latency ? 0).wait;
-		buffer !? { buffer.free };
 		estimate = procedure.estimate;
 		onEnd.value(estimate);
 		^estimate
@@ -184,6 +180,16 @@ FrictionThreshold {
 				buttonsSynth = { FrictionThresholdStimuli.buttonsReply(device) }.play(device.server)
 			}
 		)
+	}
+
+	// Ends what a run started (its stimulus, the signal's buffer, the answers' window and
+	// responders), each once: run does it on any way out; call it when run's Routine was stopped.
+	stop {
+		var synth = runSynth, buffer = runBuffer;
+		// One bundle: the buffer goes with the synth that reads it (server.latency from now).
+		(synth ? buffer) !? { |any| any.server.bind { synth !? _.free; buffer !? _.free } };
+		runSynth = runBuffer = nil;
+		this.prStopAnswers;
 	}
 
 	prStopAnswers {

@@ -156,7 +156,10 @@ session.abort;  // the experimenter: the second condition has no use here
 while { session.isOver.not } { 0.05.wait };
 "KF-BUTTON %".format(session.state).postln;
 device.close;
-aborted = ~study.run("A1", root, s, simulated: FrictionStudySimParticipant(2, 1.5), windows: false,
+// Its participant explores each condition 4 s: the abort below, after 0.5 s of the server's audio,
+// must come first (a 1.5 s participant finished first once beside a busy machine: the audio ran
+// at 45 % of the wall clock there, so 0.5 s of it takes about 1.1 s; 4 s leaves room).
+aborted = ~study.run("A1", root, s, simulated: FrictionStudySimParticipant(2, 4), windows: false,
 	experimenterOut: 2);
 while { aborted.position < 1 or: { aborted.state != \running } } { 0.05.wait };
 // 0.5 s into the condition on the server's clock (its audio.wav's) as well as sclang's: without
