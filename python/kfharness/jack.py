@@ -5,6 +5,7 @@ import subprocess
 import time
 
 from . import paths
+from .jack_registry import reclaim, reclaim_dead_servers
 
 
 class JackServer:
@@ -32,6 +33,8 @@ class JackServer:
                 "-p", str(self.period), "-C", "2", "-P", "2"]
 
     def start(self, timeout_s=20.0):
+        # A killed jackd's slot in JACK's 8-slot registry stays taken (jack_registry.py).
+        reclaim_dead_servers()
         with open(self.log_path, "w") as log:
             self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
                                          stderr=subprocess.STDOUT, env=self.env)
@@ -60,6 +63,8 @@ class JackServer:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait(5)
+        if self.proc.returncode == -9:  # killed here or by a test: its registry slot stays taken
+            reclaim(self.name)
         self.proc = None
 
     def log(self):

@@ -1,0 +1,50 @@
+"""Killed jackds do not use up JACK's server registry.
+
+JACK keeps 8 server slots and frees one only when its jackd exits normally or a server of the
+same name starts. Every test server has a name of its own, so CI at 60f8359 (a test kills jackd
+on purpose, a stop that times out kills one) filled the table, and every jackd after it failed
+with "Too many servers already active": 22 realtime tests and the main job."""
+import os
+import signal
+import subprocess
+import time
+
+from kfharness import jack_registry
+from kfharness.jack import JackServer
+
+
+def killed_jackd(name):
+    """A jackd that took a registry slot and was killed with SIGKILL (its slot left taken)."""
+    proc = subprocess.Popen(["jackd", "-n", name, "-r", "-d", "dummy", "-r", "48000", "-p", "1024"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env=dict(os.environ, JACK_NO_AUDIO_RESERVATION="1"))
+    deadline = time.monotonic() + 10
+    while not any(pid == proc.pid for pid, _, _ in jack_registry.registered_servers()):
+        assert proc.poll() is None and time.monotonic() < deadline, f"{name} did not register"
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+
+
+def test_a_full_table_of_killed_servers_does_not_stop_the_next_one():
+    free_slots = jack_registry.MAX_SERVERS - len(jack_registry.registered_servers())
+    names = [f"kfdead{os.getpid()}x{i}" for i in range(free_slots)]
+    for name in names:
+        killed_jackd(name)
+    assert set(names) <= set(jack_registry.dead_servers())
+    assert len(jack_registry.registered_servers()) == jack_registry.MAX_SERVERS
+
+    with JackServer() as server:
+        assert server.alive()
+        taken = [name for _, _, name in jack_registry.registered_servers()]
+        assert server.name in taken and not set(names) & set(taken), taken
+    assert server.name not in [name for _, _, name in jack_registry.registered_servers()]
+
+
+def test_a_server_killed_in_a_test_leaves_no_slot_behind():
+    server = JackServer().start()
+    os.kill(server.proc.pid, signal.SIGKILL)  # as test_study_server_lost does
+    server.proc.wait()
+    assert server.name in jack_registry.dead_servers()
+    server.stop()
+    assert server.name not in [name for _, _, name in jack_registry.registered_servers()]
