@@ -2,10 +2,11 @@
 import os
 import random
 import subprocess
+import sys
 import time
 
 from . import paths
-from .jack_registry import reclaim, reclaim_dead_servers
+from .jack_registry import reclaim, reclaim_dead_servers, registered_servers
 
 
 class JackServer:
@@ -41,7 +42,8 @@ class JackServer:
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
-                raise RuntimeError(f"jackd exited ({self.proc.returncode}):\n{self.log()}")
+                raise RuntimeError(f"jackd exited ({self.proc.returncode}):\n{self.log()}\n"
+                                   f"JACK's server registry (pid, uid, name): {registered_servers()}")
             probe = subprocess.run(["jack_lsp"], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                    stderr=subprocess.STDOUT, env=self.env, timeout=10, text=True)
             if probe.returncode == 0 and "system:playback_1" in probe.stdout:
@@ -61,6 +63,7 @@ class JackServer:
             try:
                 self.proc.wait(5)
             except subprocess.TimeoutExpired:
+                print(f"jackd {self.name} did not stop within 5 s of SIGTERM: killed", file=sys.stderr)
                 self.proc.kill()
                 self.proc.wait(5)
         if self.proc.returncode == -9:  # killed here or by a test: its registry slot stays taken
