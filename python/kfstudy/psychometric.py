@@ -11,10 +11,11 @@ lapse in [0, max_lapse] (0.05 by default, as Debian's psignifit bounds it) with 
 started from the best point of a coarse grid so that a flat or sparse data set still finds the
 global maximum. The bench (scripts/bench.sh --only thresholds) checks it against psignifit.
 """
-import csv
 from pathlib import Path
 
 import numpy as np
+
+from . import checked_csv
 
 GUESS_2AFC = 0.5
 MAX_LAPSE = 0.05
@@ -122,18 +123,17 @@ def plot(levels, correct, fitted, path, title="", xlabel="level", observer=None)
     plt.close(fig)
 
 
-def read_trials(path):
-    """The rows of a trials CSV as dicts, with level a float and correct a bool (true/false, 1/0)."""
-    rows = []
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            row["level"] = float(row["level"])
-            row["correct"] = str(row["correct"]).strip().lower() in ("true", "1", "yes")
-            rows.append(row)
+def read_trials(path, damaged=None):
+    """The rows of a trials CSV as dicts, with level a float and correct a bool (true/false, 1/0);
+    damaged rows are skipped and listed in `damaged` (checked_csv)."""
+    rows = checked_csv.read_rows(path, damaged)
+    for row in rows:
+        row["level"] = float(row["level"])
+        row["correct"] = str(row["correct"]).strip().lower() in ("true", "1", "yes")
     return rows
 
 
-def report_section(trials_csv, out_dir, name=None, conditions=None):
+def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None):
     """The threshold section of a report from one session's trials CSV: a PNG per condition
     (<name>-<condition>-psychometric.png in out_dir) and the Markdown that shows them, with the
     figures' names relative to out_dir. conditions: per condition name, what else is known of it
@@ -145,7 +145,7 @@ def report_section(trials_csv, out_dir, name=None, conditions=None):
     out_dir.mkdir(parents=True, exist_ok=True)
     name = name or trials_csv.stem
     conditions = conditions or {}
-    rows = read_trials(trials_csv)
+    rows = read_trials(trials_csv, damaged)
     lines = [f"### Thresholds: {name}", "",
              "Maximum-likelihood Weibull, guess rate 1/2, lapse rate free in [0, 0.05] (kfstudy.psychometric); "
              "the procedure's own estimate beside it, and a simulated participant's known threshold (its model "

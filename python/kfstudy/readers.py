@@ -6,6 +6,14 @@ import numpy as np
 import soundfile
 
 
+def read_text(path):
+    """A text file's text; a file that is not UTF-8 (damaged) raises ValueError naming it."""
+    try:
+        return Path(path).read_text()
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not UTF-8 text at byte {error.start} (damaged?)") from error
+
+
 def read_wav(path):
     """(frames x channels float32, sample rate)."""
     data, rate = soundfile.read(str(path), dtype="float32", always_2d=True)
@@ -16,7 +24,7 @@ def read_session(path):
     """(header dict, [(tag, fields)...]) of a kf-session file, records in file order. Fields are
     floats, but for an off record's cause (O: [hostTimeS, cause]; cause "" in files written
     before it was recorded)."""
-    lines = Path(path).read_text().splitlines()
+    lines = read_text(path).splitlines()
     assert lines and lines[0].startswith("kf-session 1 "), f"not a kf-session file: {path}"
     header = dict(field.split("=", 1) for field in lines[0].split()[2:])
     records = []

@@ -7,6 +7,7 @@ participant and mapping, and a paired t test over participants per mapping), and
 fits of any threshold conditions (psychometric). Markdown with PNG figures and CSV files beside it.
 """
 import csv
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -251,87 +252,112 @@ def _threshold_conditions(session):
     return known
 
 
+def _session_section(session, out_dir, rows, answers, fits):
+    """One participant's part of the report: its Markdown lines; its rows, answers and fits
+    appended to the lists given."""
+    from . import psychometric
+
+    md = []
+    measured = []
+    md += [f"## Participant {session.participant}", "",
+           f"Order: {', '.join(session.manifest['order'])}; seed {session.manifest['seed']}; "
+           f"{'finished' if session.finished else 'not finished'}; device {session.manifest['device']['kind']}, "
+           f"{session.manifest['sampleRateHz']} Hz.", "",
+           "| # | condition | friction | audio | duration (s) | ended by | coverage (live) | coverage (recording) "
+           "| median speed in the fragment (mm/s) | time in the fragment (s) | attempts before |",
+           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for c in session.conditions:
+        if not c.complete:
+            md.append(f"| {c.position} | {c.name} | | | not run to its end | | | | | | {c.attempts} |")
+            continue
+        m = _measure(session, c)
+        measured.append((c, m))
+        png = f"figure3-{session.participant}-{c.position:02d}-{c.name}.png"
+        figure3 = png if _figure3(c, m, out_dir / png, f"{session.participant} {c.name}") is not None else ""
+        if c.is_threshold:
+            # Trials, not exploration: its fit is below; its speeds are no exploring's.
+            duration = c.duration_s
+            md.append(f"| {c.position} | {c.name} | threshold experiment | | {duration:.1f} | "
+                      f"{c.ended_by} | | | | | {c.attempts} |")
+            rows.append(dict(participant=session.participant, position=c.position, condition=c.name,
+                             threshold=True, duration_s=duration, ended_by=c.ended_by, attempts=c.attempts,
+                             figure3=figure3))
+            continue
+        live = c.event_detail("coverage")
+        row = dict(participant=session.participant, position=c.position, condition=c.name, threshold=False,
+                   mapping=str(c.settings["mapping"]), friction=bool(c.settings["friction"]),
+                   audio=bool(c.settings["audio"]), duration_s=c.duration_s, ended_by=c.ended_by,
+                   coverage_live=float(live) if live else float("nan"), coverage_recording=m["coverage"],
+                   median_speed_inside=float(np.median(m["speeds_inside"])) if len(m["speeds_inside"]) else float("nan"),
+                   mean_speed_inside=float(np.mean(m["speeds_inside"])) if len(m["speeds_inside"]) else float("nan"),
+                   time_inside_s=m["time_inside_s"], attempts=c.attempts, speeds=m["speeds_inside"],
+                   x=m["x"], v=m["v"], force=m["force"], area_mm=c.area_mm, figure3=figure3)
+        rows.append(row)
+        md.append(f"| {c.position} | {c.name} | {'on' if row['friction'] else 'off'} | "
+                  f"{'on' if row['audio'] else 'off'} | {row['duration_s']:.1f} | {row['ended_by']} | "
+                  f"{100 * row['coverage_live']:.0f} % | {100 * row['coverage_recording']:.0f} % | "
+                  f"{row['median_speed_inside']:.1f} | {row['time_inside_s']:.1f} | {c.attempts} |")
+    mine = [r for r in rows if r["participant"] == session.participant]
+    exploring = [r for r in mine if not r["threshold"]]
+    if exploring:
+        speeds_png = f"speeds-{session.participant}.png"
+        by = {}
+        for r in exploring:
+            by.setdefault(r["mapping"], []).append(r)
+        _speed_figure(by, out_dir / speeds_png)
+        md += ["", "Speeds in the fragment, friction off against on:", "", f"![speeds]({speeds_png})"]
+        cov_png = f"coverage-{session.participant}.png"
+        _coverage_figure(session, [(c, m) for c, m in measured if not c.is_threshold], out_dir / cov_png)
+        md += ["", f"![coverage]({cov_png})", ""]
+    if mine:
+        md += ["Figure 3 of each condition (4 s of speed, audio and force):", ""]
+        md += [f"![{r['condition']}]({r['figure3']})" for r in mine if r["figure3"]]
+    session_answers = session.last_answers()
+    answers += session_answers
+    md += ["", "Answers:", "", "| condition | question | answer | source |", "| --- | --- | --- | --- |"]
+    md += [f"| {a['condition']} | {a['question']} | {a['answer'].replace('|', '/')} | {a['source']} |"
+           for a in session_answers]
+    trials = session.folder / "trials.csv"
+    if trials.exists():
+        section, session_fits = psychometric.report_section(trials, out_dir, session.participant,
+                                                            _threshold_conditions(session), session.damaged)
+        md += ["", section]
+        fits += [dict(participant=session.participant, **f) for f in session_fits]
+    if session.damaged:
+        md += ["", f"Damaged rows, skipped ({len(session.damaged)}; the rows after each were read):", ""]
+        md += [f"- `{row}`" for row in session.damaged]
+        for row in session.damaged:
+            print(f"kfstudy report: {session.folder}: skipped {row}", file=sys.stderr)
+    md.append("")
+    return md
+
+
 def write_report(root, out_dir):
     """Reads every session under root and writes report.md, its PNGs and CSVs into out_dir.
     Returns a summary dict (the sessions, the rows, the binds table, the threshold fits)."""
-    from . import psychometric
-
     root, out_dir = Path(root), Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    all_sessions = session_folder.sessions(root)
+    unreadable = []
+    all_sessions = session_folder.sessions(root, unreadable)
     rows, md, answers, fits = [], [], [], []
     study_name = all_sessions[0].manifest["study"]["name"] if all_sessions else "-"
     md += [f"# Study report: {study_name}", "",
            f"{len(all_sessions)} sessions in `{root}`. Speeds come from the device recordings (differences "
            f"over {session_folder.SPEED_REPORTS} reports); coverage is the map the experimenter saw, computed "
            "again from the recording; \"in the fragment\" is the fragment's part on the surface.", ""]
+    for folder, why in unreadable:
+        md += [f"**Not reported: the session in `{folder.name}` cannot be read** ({why}).", ""]
+        print(f"kfstudy report: {folder}: not reported: {why}", file=sys.stderr)
     for session in all_sessions:
-        measured = []
-        md += [f"## Participant {session.participant}", "",
-               f"Order: {', '.join(session.manifest['order'])}; seed {session.manifest['seed']}; "
-               f"{'finished' if session.finished else 'not finished'}; device {session.manifest['device']['kind']}, "
-               f"{session.manifest['sampleRateHz']} Hz.", "",
-               "| # | condition | friction | audio | duration (s) | ended by | coverage (live) | coverage (recording) "
-               "| median speed in the fragment (mm/s) | time in the fragment (s) | attempts before |",
-               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-        for c in session.conditions:
-            if not c.complete:
-                md.append(f"| {c.position} | {c.name} | | | not run to its end | | | | | | {c.attempts} |")
-                continue
-            m = _measure(session, c)
-            measured.append((c, m))
-            png = f"figure3-{session.participant}-{c.position:02d}-{c.name}.png"
-            figure3 = png if _figure3(c, m, out_dir / png, f"{session.participant} {c.name}") is not None else ""
-            if c.is_threshold:
-                # Trials, not exploration: its fit is below; its speeds are no exploring's.
-                duration = c.duration_s
-                md.append(f"| {c.position} | {c.name} | threshold experiment | | {duration:.1f} | "
-                          f"{c.ended_by} | | | | | {c.attempts} |")
-                rows.append(dict(participant=session.participant, position=c.position, condition=c.name,
-                                 threshold=True, duration_s=duration, ended_by=c.ended_by, attempts=c.attempts,
-                                 figure3=figure3))
-                continue
-            live = c.event_detail("coverage")
-            row = dict(participant=session.participant, position=c.position, condition=c.name, threshold=False,
-                       mapping=str(c.settings["mapping"]), friction=bool(c.settings["friction"]),
-                       audio=bool(c.settings["audio"]), duration_s=c.duration_s, ended_by=c.ended_by,
-                       coverage_live=float(live) if live else float("nan"), coverage_recording=m["coverage"],
-                       median_speed_inside=float(np.median(m["speeds_inside"])) if len(m["speeds_inside"]) else float("nan"),
-                       mean_speed_inside=float(np.mean(m["speeds_inside"])) if len(m["speeds_inside"]) else float("nan"),
-                       time_inside_s=m["time_inside_s"], attempts=c.attempts, speeds=m["speeds_inside"],
-                       x=m["x"], v=m["v"], force=m["force"], area_mm=c.area_mm, figure3=figure3)
-            rows.append(row)
-            md.append(f"| {c.position} | {c.name} | {'on' if row['friction'] else 'off'} | "
-                      f"{'on' if row['audio'] else 'off'} | {row['duration_s']:.1f} | {row['ended_by']} | "
-                      f"{100 * row['coverage_live']:.0f} % | {100 * row['coverage_recording']:.0f} % | "
-                      f"{row['median_speed_inside']:.1f} | {row['time_inside_s']:.1f} | {c.attempts} |")
-        mine = [r for r in rows if r["participant"] == session.participant]
-        exploring = [r for r in mine if not r["threshold"]]
-        if exploring:
-            speeds_png = f"speeds-{session.participant}.png"
-            by = {}
-            for r in exploring:
-                by.setdefault(r["mapping"], []).append(r)
-            _speed_figure(by, out_dir / speeds_png)
-            md += ["", "Speeds in the fragment, friction off against on:", "", f"![speeds]({speeds_png})"]
-            cov_png = f"coverage-{session.participant}.png"
-            _coverage_figure(session, [(c, m) for c, m in measured if not c.is_threshold], out_dir / cov_png)
-            md += ["", f"![coverage]({cov_png})", ""]
-        if mine:
-            md += ["Figure 3 of each condition (4 s of speed, audio and force):", ""]
-            md += [f"![{r['condition']}]({r['figure3']})" for r in mine if r["figure3"]]
-        session_answers = session.last_answers()
-        answers += session_answers
-        md += ["", "Answers:", "", "| condition | question | answer | source |", "| --- | --- | --- | --- |"]
-        md += [f"| {a['condition']} | {a['question']} | {a['answer'].replace('|', '/')} | {a['source']} |"
-               for a in session_answers]
-        trials = session.folder / "trials.csv"
-        if trials.exists():
-            section, session_fits = psychometric.report_section(trials, out_dir, session.participant,
-                                                                _threshold_conditions(session))
-            md += ["", section]
-            fits += [dict(participant=session.participant, **f) for f in session_fits]
-        md.append("")
+        kept = len(rows), len(answers), len(fits)
+        try:
+            md += _session_section(session, out_dir, rows, answers, fits)
+        except (OSError, ValueError, KeyError, IndexError, AssertionError) as error:
+            # One participant's damaged files must not cost the others their report.
+            del rows[kept[0]:], answers[kept[1]:], fits[kept[2]:]
+            why = f"{type(error).__name__}: {error}"
+            md += [f"## Participant {session.participant}", "", f"**Not reported: its files cannot be read** ({why}).", ""]
+            print(f"kfstudy report: {session.folder}: not reported: {why}", file=sys.stderr)
 
     exploring = [r for r in rows if not r["threshold"]]
     by_mapping = {}

@@ -8,7 +8,6 @@ hostTimeS counts from when the device was opened (a simulated participant's devi
 each condition, just before its recording starts), so the recording's first line is placed at
 the event recordDevice. The audio's first sample is placed at the event recordAudio.
 """
-import csv
 import functools
 import json
 from dataclasses import dataclass, field
@@ -16,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import readers
+from . import checked_csv, readers
 
 # Speeds are differences of positions over this many reports (5 x 8 ms = 40 ms at 125 Hz): one
 # report moves at most by whole counts (0.021 mm, 2.6 mm/s at 125 Hz), so a single report's
@@ -24,9 +23,9 @@ from . import readers
 SPEED_REPORTS = 5
 
 
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+def read_csv(path, damaged=None):
+    """A study CSV's rows as dicts; damaged rows are skipped and listed in `damaged`."""
+    return checked_csv.read_rows(path, damaged)
 
 
 @dataclass
@@ -149,12 +148,13 @@ class StudySession:
 
     def __init__(self, folder):
         self.folder = Path(folder)
-        self.manifest = json.loads((self.folder / "manifest.json").read_text())
+        self.damaged = []  # checked_csv.DamagedRow of every row skipped in its CSVs
+        self.manifest = json.loads(readers.read_text(self.folder / "manifest.json"))
         self.participant = self.manifest["participant"]
         answers = self.folder / "answers.csv"
-        self.answers = read_csv(answers) if answers.exists() else []
+        self.answers = read_csv(answers, self.damaged) if answers.exists() else []
         session_log = self.folder / "session.csv"
-        self.log = read_csv(session_log) if session_log.exists() else []
+        self.log = read_csv(session_log, self.damaged) if session_log.exists() else []
         by_name = {c["name"]: c for c in self.manifest["study"]["conditions"]}
         self.conditions = []
         for position, name in enumerate(self.manifest["order"], start=1):
@@ -169,7 +169,7 @@ class StudySession:
             condition = Condition(position, name, folder, scene, area_mm, attempts=n - 1,
                                   is_threshold=bool(by_name[name].get("threshold")))
             if (folder / "events.csv").exists():
-                condition.events = read_csv(folder / "events.csv")
+                condition.events = read_csv(folder / "events.csv", self.damaged)
             self.conditions.append(condition)
 
     @property
@@ -188,6 +188,16 @@ class StudySession:
         return list(last.values())
 
 
-def sessions(root):
-    """Every session folder under root (a folder with manifest.json), by participant code."""
-    return [StudySession(p.parent) for p in sorted(Path(root).glob("*/manifest.json"))]
+def sessions(root, unreadable=None):
+    """Every session folder under root (a folder with manifest.json), by participant code. A
+    folder that cannot be read (its manifest damaged, say) is left out and, with `unreadable` (a
+    list), listed there as (folder, why): the others are still read."""
+    found = []
+    for manifest in sorted(Path(root).glob("*/manifest.json")):
+        try:
+            found.append(StudySession(manifest.parent))
+        except (OSError, ValueError, KeyError, TypeError) as error:
+            if unreadable is None:
+                raise
+            unreadable.append((manifest.parent, f"{type(error).__name__}: {error}"))
+    return found

@@ -9,7 +9,7 @@ import threading
 import time
 
 from kfharness import paths, sclang
-from kfstudy import readers
+from kfstudy import readers, report
 from kfstudy.session_folder import read_csv
 
 # Two conditions of mapping 1 (its 6 mm), each explored for 2.5 s by a simulated participant
@@ -112,6 +112,10 @@ while { ~session.isOver.not } { 0.1.wait };
     # Recorded from before the start line: at least 0.6 s of reports at 125 Hz (75), less a margin.
     assert killed_recording.count("\nR ") > 40, "the killed condition's recording lost its lines"
 
+    # The crash also cut answers.csv's last row inside its answer (a full disk, a power cut).
+    answers_cut = answers_before[:-20]
+    (session / "answers.csv").write_bytes(answers_cut)
+
     # Run 2: resume from sclang; the second condition runs again, the first is kept as it was.
     second = STUDY + sclang.fill(r"""
 ~session = ~study.resume(@SESSION@, s, simulated: FrictionStudySimParticipant(3, 2.5), windows: false);
@@ -121,10 +125,13 @@ while { ~session.isOver.not } { 0.1.wait };
     run = sclang.require_ok(sclang.run_with_server(second, jack, timeout=120, name="study-resume",
                                                    server_options={"numOutputBusChannels": 4}))
     assert run.lines("KF-RESUMED") == [["finished", "2"]], run.output[-3000:]
-    assert (session / "answers.csv").read_bytes().startswith(answers_before)
-    rows = read_csv(session / "answers.csv")
+    assert (session / "answers.csv").read_bytes().startswith(answers_cut + b"\n")
+    damaged = []
+    rows = read_csv(session / "answers.csv", damaged)
+    # The cut row is skipped and named; every other row, before and after it, is read whole.
     assert [(r["condition"], r["question"], r["attempt"]) for r in rows] == [
-        ("first", "say", "1"), ("first", "hold", "1"), ("second", "say", "2"), ("second", "hold", "2")]
+        ("first", "say", "1"), ("second", "say", "2"), ("second", "hold", "2")]
+    assert [d.line for d in damaged] == [3], damaged
     # The killed attempt is kept whole; the second attempt ran beside it.
     assert events_of(session / "02-second") == killed
     assert (session / "02-second" / "device.kfsession").read_text() == killed_recording
@@ -135,6 +142,22 @@ while { ~session.isOver.not } { 0.1.wait };
         data, rate = readers.read_wav(session / folder / "audio.wav")
         assert rate == jack.sample_rate and data.shape[1] == 2 and len(data) > rate, folder
         assert readers.Session(session / folder / "device.kfsession").frames.shape[0] > 1000, folder
+
+    # The report names the damaged row and is made for the other participants when one's files
+    # cannot be read: P8's manifest and P9's recording get garbage bytes.
+    for code, damage in (("P8", "manifest.json"), ("P9", "01-first/device.kfsession")):
+        shutil.copytree(session, root / code)
+        manifest = json.loads((root / code / "manifest.json").read_text())
+        (root / code / "manifest.json").write_text(json.dumps(dict(manifest, participant=code)))
+        target = root / code / damage
+        target.write_bytes(target.read_bytes()[:40] + b"\xff\xfe garbage" + target.read_bytes()[40:])
+    summary = report.write_report(root, root / "report")
+    text = (root / "report" / "report.md").read_text()
+    assert [s.participant for s in summary["sessions"]] == ["P7", "P9"]
+    assert "`P8` cannot be read" in text and "## Participant P9" in text and "answers.csv line 3" in text
+    p9 = text.split("## Participant P9")[1]
+    assert "Not reported: its files cannot be read" in p9 and "01-first/device.kfsession: not UTF-8" in p9 and "Not reported" not in text.split("## Participant P7")[1].split("## ")[0]
+    assert {r["participant"] for r in summary["rows"]} == {"P7"}
 
 
 # A person's session on a replayed recording whose puck's right button goes down 2.0 s after the
