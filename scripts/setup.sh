@@ -27,7 +27,7 @@ MAIN_PACKAGES=(
 PACKAGES=(
   "${MAIN_PACKAGES[@]}"
   clang-format supercollider-supernova catch2 libsndfile1-dev
-  python3-pytest python3-pyflakes python3-pil
+  python3-pytest python3-pyflakes python3-pil python3-pandas  # pandas: the tests read the study's BIDS tables
   python3-scipy python3-questplus psignifit  # the threshold fit and the study report's t test; their references
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross

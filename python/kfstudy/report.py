@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import session_folder
+from . import bids, session_folder
 
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
@@ -236,9 +236,6 @@ def _write_csv(path, rows, fields):
             w.writerow(r)
 
 
-# The unit of a threshold experiment's levels (FrictionThreshold's kinds).
-LEVEL_UNITS = {"force": "N", "asynchrony": "ms", "grating": "mm"}
-
 
 def _threshold_conditions(session):
     """Per threshold condition of a session: its unit, the procedure's estimate and the model
@@ -247,7 +244,7 @@ def _threshold_conditions(session):
     for c in session.conditions:
         if c.is_threshold:
             experiment = c.event_json("experiment") or {}
-            known[c.name] = dict(unit=LEVEL_UNITS.get(experiment.get("kind"), ""), estimate=c.event_json("estimate"),
+            known[c.name] = dict(unit=bids.LEVEL_UNITS.get(experiment.get("kind"), ""), estimate=c.event_json("estimate"),
                                  observer=c.event_json("observer"))
     return known
 
@@ -412,6 +409,10 @@ def write_report(root, out_dir):
                    ["participant", "condition", "unit", "trials", "threshold", "slope", "lapse", "level_707",
                     "level_794", "log_likelihood", "estimate", "observer_threshold"])
         files.append("`thresholds.csv` (the threshold fits)")
+    bids.write(all_sessions, out_dir / "bids")
+    files.append("`bids/` (the data as BIDS behavioural data: a trials and an answers table per participant, each "
+                 "column described in its JSON sidecar; `bids/derivatives/kfstudy/` holds the study's tidy trials "
+                 "table and the counts per level that psignifit reads)")
     md += ["Files: " + ", ".join(files) + ".", ""]
     (out_dir / "report.md").write_text("\n".join(md))
     return dict(sessions=all_sessions, rows=rows, binds=table, pairs=pairs, thresholds=fits)

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import paths
-from kfstudy import psychometric, session_folder
+from kfharness import bids_check, paths
+from kfstudy import bids, psychometric, session_folder
 
 OUT = Path(os.environ["KF_STUDY_JOB_OUT"])
 PILOT = ["mapping1-off", "mapping1-on", "mapping2-off", "mapping2-on", "mapping3-off", "mapping3-on"]
@@ -82,6 +82,28 @@ def test_the_study_job_writes_five_sessions_and_their_report():
         png_size(OUT / name)
     check_binds()
     check_threshold_fits(sessions, report)
+    check_bids(sessions)
+
+
+def check_bids(sessions):
+    """The study as BIDS behavioural data, read with pandas: each column against its sidecar, a
+    trials and an answers table per participant, every trial once in the tidy table, and the counts
+    per level psignifit reads adding up to the trials."""
+    tables = bids_check.read_checked(OUT / "bids")
+    assert list(tables["participants.tsv"]["participant_id"]) == [f"sub-{s.participant}" for s in sessions]
+    tidy = tables["derivatives/kfstudy/trials.tsv"]
+    assert len(tidy) == len(sessions) * len(THRESHOLDS) * TRIALS
+    assert dict(zip(tidy["condition"], tidy["unit"])) == {"forceStep": "N", "asynchrony": "ms", "gratingStep": "mm"}
+    for s in sessions:
+        task = bids.label(s.manifest["study"]["name"])  # letters and digits of the study's name
+        stem = f"sub-{s.participant}/beh/sub-{s.participant}_task-{task}"
+        assert len(tables[f"{stem}_acq-trials_beh.tsv"]) == len(THRESHOLDS) * TRIALS
+        assert len(tables[f"{stem}_acq-answers_beh.tsv"]) == len(s.answers)
+        for condition in THRESHOLDS:
+            counts = tables[f"derivatives/kfstudy/sub-{s.participant}_cond-{condition}_counts.tsv"].astype(float)
+            mine = tidy[(tidy["participant_id"] == f"sub-{s.participant}") & (tidy["condition"] == condition)]
+            assert counts["n_total"].sum() == len(mine) == TRIALS
+            assert counts["n_correct"].sum() == (mine["correct"] == "true").sum()
 
 
 def check_binds():

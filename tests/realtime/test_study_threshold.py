@@ -8,7 +8,7 @@ import shutil
 
 import numpy as np
 
-from kfharness import paths, sclang
+from kfharness import paths, sclang, bids_check
 from kfstudy import psychometric, report
 from kfstudy.session_folder import read_csv
 
@@ -77,3 +77,16 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     with Image.open(root / "report" / "T1-forceStep-psychometric.png") as image:
         assert np.asarray(image.convert("L")).std() > 10
     assert [r["condition"] for r in read_csv(root / "report" / "thresholds.csv")] == ["forceStep"]
+
+    # The same data as BIDS behavioural data, read with pandas, each column against its sidecar.
+    tables = bids_check.read_checked(root / "report" / "bids")
+    beh = tables["sub-T1/beh/sub-T1_task-threshold_acq-trials_beh.tsv"]
+    assert list(beh["trial"]) == [t["trial"] for t in trials] and set(beh["unit"]) == {"N"}
+    assert list(beh["level"].astype(float)) == [float(t["level"]) for t in trials]
+    assert set(beh["experiment"]) == {"force"} and set(beh["procedure"]) == {"constantStimuli"}
+    assert tables["derivatives/kfstudy/trials.tsv"].equals(beh)
+    counts = tables["derivatives/kfstudy/sub-T1_cond-forceStep_counts.tsv"].astype(float)
+    assert list(counts["level"]) == sorted(set(LEVELS)) and set(counts["n_total"]) == {REPEATS}
+    assert counts["n_correct"].sum() == right
+    assert list(tables["participants.tsv"]["participant_id"]) == ["sub-T1"]
+    assert json.loads((root / "report" / "bids" / "dataset_description.json").read_text())["BIDSVersion"] == "1.9.0"
