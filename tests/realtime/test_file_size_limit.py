@@ -24,6 +24,20 @@ AUDIO_FRAMES = 1000  # between the two status reads: at least one second of audi
 TRIP_STALL_US = 7600
 
 
+def trip_diagnosis(record):
+    """Where the recording saw trips and its longest gaps between frames (host time, s): for the
+    failure message of a trip the machine's stalls do not explain."""
+    _, records = readers.read_session(record)
+    trips = [round(f[0], 3) for tag, f in records if tag == "O" and f[1] == "watchdog"]
+    frames = np.array([f[0] for tag, f in records if tag == "F"])
+    if len(frames) < 2:
+        return f"trips recorded at {trips}; {len(frames)} frames recorded"
+    gaps = np.diff(frames)
+    worst = np.argsort(gaps)[-3:][::-1]
+    return (f"trips recorded at {trips}; frames recorded {frames[0]:.3f}..{frames[-1]:.3f} s, longest gaps "
+            + ", ".join(f"{gaps[i] * 1000:.1f} ms after {frames[i]:.3f}" for i in worst))
+
+
 def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     record = paths.work_dir() / "fsize-session.txt"
     record.unlink(missing_ok=True)
@@ -75,7 +89,9 @@ def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     assert b["lastForceN"] == pytest.approx(FORCE_N)
     if realtime_allowed():
         stalls = witness.result["stalls"] if witness.result else 0
-        assert b["watchdogTrips"] <= stalls, f"{b['watchdogTrips']} watchdog trips, the machine stalled {stalls} times"
+        assert b["watchdogTrips"] <= stalls, (
+            f"{b['watchdogTrips']} watchdog trips ({a['watchdogTrips']:.0f} by status A), the machine stalled "
+            f"{stalls} times; {trip_diagnosis(record)}; witness {witness.result}")
     else:
         # Without realtime scheduling the bound has no witness: cyclictest needs SCHED_FIFO, and
         # scsynth's audio thread, at normal priority beside busy processes, itself goes without
