@@ -49,25 +49,69 @@ def _negative_log_likelihood(params, x, right, total, guess):
     return -np.sum(right * np.log(p) + (total - right) * np.log1p(-p))
 
 
+# Fewer trials than this and a 2AFC threshold is poorly determined whatever the procedure: the
+# report says so beside the fit (its standard error says by how much).
+MIN_TRIALS = 20
+# The optimiser starts from this many of the best grid points: the likelihood of a few trials
+# has several maxima (a steep curve between two levels, a lapse against a shallow slope).
+STARTS = 8
+
+
+def _bounds(x, max_lapse):
+    lo, hi = np.log(x.min() / 2), np.log(x.max() * 2)
+    return [(lo - 2, hi + 2), (np.log(0.2), np.log(20)), (0.0, max_lapse)]
+
+
+def _se_log10_threshold(params, x, right, total, guess, bounds):
+    """The standard error of log10 threshold from the observed information (the likelihood's
+    curvature at its maximum), over the parameters not at a bound; inf where it is flat."""
+    free = [i for i, (a, b) in enumerate(bounds) if i == 0 or not (np.isclose(params[i], a) or np.isclose(params[i], b))]
+    steps = np.array([1e-4, 1e-4, 1e-5])
+    def f(p):
+        return _negative_log_likelihood(p, x, right, total, guess)
+    hessian = np.zeros((len(free), len(free)))
+    for m, i in enumerate(free):
+        for n, j in enumerate(free):
+            di, dj = np.eye(3)[i] * steps[i], np.eye(3)[j] * steps[j]
+            hessian[m, n] = (f(params + di + dj) - f(params + di - dj) - f(params - di + dj)
+                             + f(params - di - dj)) / (4 * steps[i] * steps[j])
+    try:
+        variance = np.linalg.inv(hessian)[0, 0]
+    except np.linalg.LinAlgError:
+        return float("inf")
+    return float(np.sqrt(variance) / np.log(10)) if variance > 0 else float("inf")
+
+
 def fit(levels, correct, guess=GUESS_2AFC, max_lapse=MAX_LAPSE):
     """The maximum-likelihood Weibull of trials (a level > 0 and a right/wrong answer each): a dict
-    of threshold, slope, lapse, guess, the log-likelihood, the number of trials and the levels
-    at 70.7 %, 75 % and 79.4 % correct (Levitt's staircases' and the midpoint's)."""
+    of threshold, slope, lapse, guess, the log-likelihood, the number of trials, the levels at
+    70.7 %, 75 % and 79.4 % correct (Levitt's staircases' and the midpoint's), threshold_se_log10
+    (the standard error of log10 threshold) and warning (why the fit says little, or "")."""
     from scipy.optimize import minimize
 
     x, right, total = grouped(levels, correct)
     if len(x) == 0 or np.any(x <= 0):
         raise ValueError("fit needs at least one trial, every level > 0")
-    # Thresholds over the levels' range and beyond it by a factor of 2 each way.
-    lo, hi = np.log(x.min() / 2), np.log(x.max() * 2)
-    starts = [(t, b, lapse) for t in np.linspace(lo, hi, 25) for b in np.log([1, 2, 3.5, 6])
-              for lapse in (0.0, max_lapse / 2)]
-    best = min(starts, key=lambda s: _negative_log_likelihood(s, x, right, total, guess))
-    result = minimize(_negative_log_likelihood, best, args=(x, right, total, guess), method="L-BFGS-B",
-                      bounds=[(lo - 2, hi + 2), (np.log(0.2), np.log(20)), (0.0, max_lapse)])
+    bounds = _bounds(x, max_lapse)
+    # Thresholds over the levels' range and beyond it by a factor of 2 each way, slopes and lapse
+    # rates over their whole bounds: a few trials' maximum often lies at a steep slope with the
+    # highest lapse rate (a wrong answer at a high level), which no start at slope 6 or below
+    # reached (2 of the study job's 15 fits, 0.12 and 0.41 log-likelihood below it).
+    starts = [(t, b, lapse) for t in np.linspace(bounds[0][0] + 2, bounds[0][1] - 2, 25)
+              for b in np.log([0.5, 1, 2, 3.5, 6, 10, 20]) for lapse in (0.0, max_lapse / 2, max_lapse)]
+    starts.sort(key=lambda s: _negative_log_likelihood(s, x, right, total, guess))
+    result = min((minimize(_negative_log_likelihood, start, args=(x, right, total, guess), method="L-BFGS-B",
+                           bounds=bounds) for start in starts[:STARTS]), key=lambda r: r.fun)
     threshold, slope, lapse = float(np.exp(result.x[0])), float(np.exp(result.x[1])), float(result.x[2])
+    trials = int(total.sum())
+    se = _se_log10_threshold(np.array(result.x, dtype=float), x, right, total, guess, bounds)
+    warning = ""
+    if trials < MIN_TRIALS:
+        warning = f"only {trials} trials (fewer than {MIN_TRIALS}): the threshold is poorly determined"
+    elif not np.isfinite(se):
+        warning = "the likelihood is flat along the threshold: the trials do not determine it"
     out = dict(threshold=threshold, slope=slope, lapse=lapse, guess=guess, log_likelihood=float(-result.fun),
-               trials=int(total.sum()))
+               trials=trials, threshold_se_log10=se, warning=warning)
     for name, p in (("level_707", 0.5 ** 0.5), ("level_750", 0.75), ("level_794", 0.5 ** (1 / 3))):
         out[name] = float(level_at(p, threshold, slope, guess, lapse)) if p < 1 - lapse else float("nan")
     return out
@@ -150,10 +194,10 @@ def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None
              "Maximum-likelihood Weibull, guess rate 1/2, lapse rate free in [0, 0.05] (kfstudy.psychometric); "
              "the procedure's own estimate beside it, and a simulated participant's known threshold (its model "
              "observer's).", "",
-             "| condition | trials | threshold | slope | lapse | level at 70.7 % | at 79.4 % | procedure's estimate "
-             "| model observer's threshold | figure |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    fits = []
+             "| condition | trials | threshold | its standard error (log10) | slope | lapse | level at 70.7 % "
+             "| at 79.4 % | procedure's estimate | model observer's threshold | figure |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    fits, warnings = [], []
     for condition in sorted({r.get("condition") or "" for r in rows}):
         chosen = [r for r in rows if (r.get("condition") or "") == condition]
         levels, correct = [r["level"] for r in chosen], [r["correct"] for r in chosen]
@@ -167,6 +211,10 @@ def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None
         observer = float((known.get("observer") or {}).get("threshold") or "nan")
         fits.append(dict(condition=condition, unit=unit, **fitted, estimate=estimate, observer_threshold=observer))
         lines.append(f"| {condition or '-'} | {fitted['trials']} | {fitted['threshold']:.4g} {unit} | "
-                     f"{fitted['slope']:.3g} | {fitted['lapse']:.3f} | {fitted['level_707']:.4g} | "
-                     f"{fitted['level_794']:.4g} | {estimate:.4g} | {observer:.4g} | ![]({png}) |")
+                     f"{fitted['threshold_se_log10']:.3f} | {fitted['slope']:.3g} | {fitted['lapse']:.3f} | "
+                     f"{fitted['level_707']:.4g} | {fitted['level_794']:.4g} | {estimate:.4g} | {observer:.4g} "
+                     f"| ![]({png}) |")
+        if fitted["warning"]:
+            warnings.append(f"**{condition or '-'}: {fitted['warning']}.**")
+    lines += [""] + warnings if warnings else []
     return "\n".join(lines) + "\n", fits

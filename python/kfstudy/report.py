@@ -406,8 +406,8 @@ def write_report(root, out_dir):
              "`binds-parts.csv` (the parts of each fragment and whether the friction is raised there)"]
     if fits:
         _write_csv(out_dir / "thresholds.csv", fits,
-                   ["participant", "condition", "unit", "trials", "threshold", "slope", "lapse", "level_707",
-                    "level_794", "log_likelihood", "estimate", "observer_threshold"])
+                   ["participant", "condition", "unit", "trials", "threshold", "threshold_se_log10", "slope", "lapse",
+                    "level_707", "level_794", "log_likelihood", "estimate", "observer_threshold", "warning"])
         files.append("`thresholds.csv` (the threshold fits)")
     bids.write(all_sessions, out_dir / "bids")
     files.append("`bids/` (the data as BIDS behavioural data: a trials and an answers table per participant, each "

@@ -145,6 +145,43 @@ def test_fit_agrees_with_psignifit(runs):
         assert ours["threshold"] == pytest.approx(ref["threshold"], rel=0.01), (r["procedure"], ours, ref)
 
 
+def dense_maximum(levels, correct, guess=0.5):
+    """The highest log-likelihood on a dense grid over fit's bounds (300 thresholds x 80 slopes x
+    11 lapse rates), found independently of fit's starts and optimiser: a lower bound of the
+    global maximum."""
+    x, right, total = psychometric.grouped(levels, correct)
+    log_t = np.linspace(np.log(x.min() / 2) - 2, np.log(x.max() * 2) + 2, 300)[:, None, None]
+    slope = np.exp(np.linspace(np.log(0.2), np.log(20), 80))[None, :, None]
+    best = -np.inf
+    for lapse in np.linspace(0, psychometric.MAX_LAPSE, 11):
+        p = np.clip(guess + (1 - guess - lapse) * (1 - np.exp(-(x / np.exp(log_t)) ** slope)), 1e-12, 1 - 1e-12)
+        best = max(best, float(np.max(np.sum(right * np.log(p) + (total - right) * np.log1p(-p), axis=-1))))
+    return best
+
+
+def test_fit_finds_the_global_maximum_and_its_standard_error(runs):
+    # Short runs have several maxima: each QUEST+ run cut to its first 8, 16 and 24 trials, and
+    # the extremes (every answer right, every answer wrong). One start at slope 6 or below missed
+    # the maximum at a steep slope and the highest lapse rate (0.12 and 0.41 below it in 2 of the
+    # study job's 15 fits); the grid's own resolution costs it at most a few thousandths.
+    cases = [(r["levels"][:n], r["correct"][:n]) for r in runs if r["procedure"] == "questplus" for n in (8, 16, 24)]
+    cases += [([0.1, 0.2, 0.4] * 3, [True] * 9), ([0.1, 0.2, 0.4] * 3, [False] * 9)]
+    for levels, correct in cases:
+        fitted = psychometric.fit(levels, correct)
+        assert fitted["log_likelihood"] >= dense_maximum(levels, correct) - 1e-6, (levels, correct, fitted)
+        assert bool(fitted["warning"]) == (len(levels) < psychometric.MIN_TRIALS), fitted
+    # The standard error of log10 threshold (the likelihood's curvature) against the spread of
+    # the fits of seeded runs of the same observer: 40 QUEST+ runs of 48 trials and 40 constant
+    # stimuli runs of 280. The sd of 40 values is itself uncertain by about 11 % (1 / sqrt(2 x 39)):
+    # the median standard error within 0.6 to 1.6 of it allows 4 of those either way.
+    for name in ("questplus", "constant"):
+        fits = [psychometric.fit(r["levels"], r["correct"]) for r in runs if r["procedure"] == name]
+        spread = np.std([np.log10(f["threshold"]) for f in fits], ddof=1)
+        se = np.median([f["threshold_se_log10"] for f in fits])
+        print(f"KF-FIGURE fit_se_over_spread_{name} {se / spread:.3f} (se {se:.4f}, spread {spread:.4f})")
+        assert 0.6 < se / spread < 1.6, (name, se, spread)
+
+
 def test_report_section_from_a_trials_csv(runs):
     out = paths.work_dir() / "threshold-report"
     path = out / "trials.csv"
