@@ -4,7 +4,7 @@
 #   ${KF_GENERATED_DIR}/PaperProfile.sc    sclang: KineticFriction.paperDevice, .paperMapping,
 #                                          .paperPilot (Events)
 # and sets KF_PAPER_<section>_<key> for configure_file() of sclang classes whose argument
-# defaults must be literals (sc-classes/*.sc.in).
+# defaults must be literals (the templates sc-classes/**/*.sc.in, configured in CMakeLists.txt).
 set(KF_PROFILE_FILE "${PROJECT_SOURCE_DIR}/profiles/paper.json")
 set(KF_GENERATED_DIR "${CMAKE_BINARY_DIR}/generated")
 set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${KF_PROFILE_FILE}")

@@ -1,7 +1,8 @@
 // Where the extension lives, so that a Score render or a server can load its plugin without the
 // extension being installed into Platform.userExtensionDir.
 KineticFriction {
-	// The extension folder: the one holding Classes/, plugins/ and HelpSource/.
+	// The extension folder: the one holding Classes/, plugins/ and HelpSource/ (this file sits at the
+	// top of Classes/, not in one of its role folders).
 	*extensionDir { ^PathName(this.filenameSymbol.asString).pathOnly.dirname }
 
 	*pluginDir { ^this.extensionDir +/+ "plugins" }

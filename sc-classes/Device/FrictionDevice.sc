@@ -1,6 +1,6 @@
 // One device slot of a server: a simulated friction device, a replay of a recorded session, or
-// hardware: a real mouse (hidapi or evdev, FrictionDeviceMouse.sc) as the puck's sensor, and the
-// friction board (libusb, FrictionDeviceBoard.sc) driving its magnet. Every command has a ...Msg
+// hardware: a real mouse (hidapi or evdev, extFrictionDeviceMouse.sc) as the puck's sensor, and the
+// friction board (libusb, extFrictionDeviceBoard.sc) driving its magnet. Every command has a ...Msg
 // twin that returns the OSC message, so the same device can be used in a Score: describeSim,
 // describeReplay and describeMouse make a device without opening it. A nil server is
 // Server.default, as everywhere in SC. The server's answers to the commands are FrictionAnswers'.
@@ -12,9 +12,9 @@ FrictionDevice {
 	// busSynths: the writer of forceBus and the reader of positionBus, by role (\writer, \reader).
 	var <state = \described, <replace = false, forceBus, positionBus, busSynths;
 	// The board the device carries, opened with it (and again at a reboot): nil, or an Event of
-	// addBoard's arguments and the calibration (FrictionDeviceBoard.sc).
+	// addBoard's arguments and the calibration (extFrictionDeviceBoard.sc).
 	var <boardSetup;
-	// The audio drive (FrictionDeviceDrive.sc): (path:, circuitLatencyS:) once loaded, else nil.
+	// The audio drive (extFrictionDeviceDrive.sc): (path:, circuitLatencyS:) once loaded, else nil.
 	var <driveSetup;
 
 	*initClass {
@@ -104,7 +104,7 @@ FrictionDevice {
 	isOpen { ^state == \open }
 
 	// Audio is delayed by this much so that sound and touch arrive together: the paper's 1 ms, or
-	// with an audio drive loaded (FrictionDeviceDrive.sc) the drive's own latency.
+	// with an audio drive loaded (extFrictionDeviceDrive.sc) the drive's own latency.
 	audioDelay { ^this.driveLatency ?? { specs[\tactileLatencyS] - specs[\audioLatencyS] } }
 
 	// The plugin command that opens this kind of device.
@@ -112,7 +112,7 @@ FrictionDevice {
 
 	openMsg {
 		^switch(kind,
-			\mouse, { this.mouseMsg },  // FrictionDeviceMouse.sc
+			\mouse, { this.mouseMsg },  // extFrictionDeviceMouse.sc
 			\sim, {
 				['/cmd', \kfOpenSim, index] ++ (source !? { source.asCommandArgs } ?? { [-1, 0] })
 				++ this.prOverrideArgs

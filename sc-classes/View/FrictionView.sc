@@ -1,7 +1,7 @@
 // A live view of one device slot: the buffer's signal laid out on the surface (mm), the puck on
 // it, and strip charts of the puck's speed and of the requested and commanded force. Usable as
 // its own window or embedded in a layout (like FreqScopeView). This file holds the view's state,
-// window and coordinates; FrictionViewDrawing.sc draws it. Its frames come from a
+// window and coordinates; extFrictionViewDrawing.sc draws it. Its frames come from a
 // FrictionViewMonitor (the server side) and its signal from a FrictionSignalPyramid.
 FrictionView {
 	classvar <markerColor, <requestedColor, <commandedColor, <speedColor, <signalColor;

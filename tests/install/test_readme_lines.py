@@ -77,12 +77,12 @@ def users():
 
 
 def check_found(found, classes_dir, what):
-    """The extension's classes from classes_dir, the bench's nowhere, the plugin loaded."""
+    """The extension's classes from classes_dir (or its role folders), the bench's nowhere, the plugin loaded."""
     assert found.classes, f"{what}: sclang ran no check (its class library did not compile?):\n{found.output[-4000:]}"
     assert "duplicate" not in found.output.lower(), f"{what}: classes compiled twice:\n{found.output[-4000:]}"
     assert found.classes.pop("KFBenchClock") == "none", f"{what}: the bench's class was installed"
     for name, path in found.classes.items():
-        assert Path(path).parent == Path(classes_dir), f"{what}: {name} from {path}, not {classes_dir}"
+        assert Path(path).is_relative_to(classes_dir), f"{what}: {name} from {path}, not {classes_dir}"
     assert found.lo_force == pytest.approx(profile.mapping()["loForceN"]), f"{what}: the profile's classes"
     assert found.level == pytest.approx(profile.mapping()["loForceN"]), \
         f"{what}: the plugin did not render:\n{found.render_output[-3000:]}"

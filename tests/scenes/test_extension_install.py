@@ -18,7 +18,7 @@ def test_user_extension_dir_is_sclangs_and_the_folder_is_a_quark():
         "USER-EXTENSIONS %".format(Platform.userExtensionDir).postln;
         "QUARK % % %".format(quark.name, quark.version, quark.data['schelp']).postln;
         "QUARK-HELP %".format(File.exists(quark.localPath +/+ "HelpSource" +/+ quark.data['schelp'] ++ ".schelp")).postln;
-        "QUARK-CLASSES %".format(File.exists(quark.localPath +/+ "Classes/FrictionDevice.sc")).postln;
+        "QUARK-CLASSES %".format(File.exists(quark.localPath +/+ "Classes/Device/FrictionDevice.sc")).postln;
     """)
     line = next(l for l in out.splitlines() if l.startswith("USER-EXTENSIONS "))
     assert configured == line.removeprefix("USER-EXTENSIONS ") + "/KineticFriction"
@@ -34,8 +34,22 @@ def test_generated_defaults_are_the_profiles_numbers_as_written():
     the defaults."""
     classes = paths.extension_dir() / "Classes"
     profile = (paths.REPO_DIR / "profiles" / "paper.json").read_text()
-    generated = ["LoudnessToFriction.sc", "FrictionPattern.sc", "PaperProfile.sc"]
+    generated = ["UGens/LoudnessToFriction.sc", "UGens/FrictionPattern.sc", "PaperProfile.sc"]
     noisy = [(name, number) for name in generated
              for number in re.findall(r"\d+\.\d{12,}", (classes / name).read_text())]
     assert not noisy, noisy
-    assert "loForce = 0.14," in (classes / "LoudnessToFriction.sc").read_text() and '"loForceN": 0.14,' in profile
+    assert "loForce = 0.14," in (classes / "UGens" / "LoudnessToFriction.sc").read_text() and '"loForceN": 0.14,' in profile
+
+
+def test_installed_classes_are_the_sources_each_once():
+    """The installed Classes folder holds sc-classes/ as laid out (a folder per role), the
+    templates' classes in their template's folder and PaperProfile.sc, and nothing else: a class
+    file an earlier install left elsewhere (before a move or a rename) would make sclang stop at a
+    duplicate class (cmake/RemoveStaleClasses.cmake removes it)."""
+    sources = paths.REPO_DIR / "sc-classes"
+    expected = {str(p.relative_to(sources)).removesuffix(".in") for p in [*sources.rglob("*.sc"), *sources.rglob("*.sc.in")]}
+    expected.add("PaperProfile.sc")
+    installed = [str(p.relative_to(paths.extension_dir() / "Classes")) for p in (paths.extension_dir() / "Classes").rglob("*.sc")]
+    assert sorted(installed) == sorted(expected)
+    names = [p.rsplit("/", 1)[-1] for p in installed]
+    assert len(names) == len(set(names)), sorted(names)
