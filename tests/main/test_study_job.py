@@ -125,10 +125,14 @@ def check_binds():
     judged = {m: [p for p in parts if p["mapping"] == m and p["mean_force_n"] not in ("", "nan")]
               for m in ("mapping1", "mapping2", "mapping3")}
     for mapping in ("mapping1", "mapping2"):
-        raised = [p["raised"] == "True" for p in judged[mapping]]
-        # At a fragment's ends the puck turns, slowly (the 1 ms window holds less than a cycle):
-        # two parts may be lower (measured: none in mapping 1, two in mapping 2).
-        assert len(raised) >= 10 and raised.count(False) <= 2, (mapping, raised)
+        # At a fragment's ends the puck turns, slowly (the 1 ms window holds less than a cycle),
+        # and the parts there may be lower: measured none in mapping 1, two and once three in
+        # mapping 2 (46.5 to 48 mm of its 48, all at the end the hands turn at after their fast
+        # strokes). Every part more than 2 mm from both ends is raised.
+        ends = (float(judged[mapping][0]["from_mm"]), float(judged[mapping][-1]["to_mm"]))
+        low = [(float(p["from_mm"]), float(p["to_mm"])) for p in judged[mapping] if p["raised"] != "True"]
+        assert len(judged[mapping]) >= 10, (mapping, judged[mapping])
+        assert all(a < ends[0] + 2 or b > ends[1] - 2 for a, b in low), (mapping, ends, low)
     middles = np.array([(float(p["from_mm"]) + float(p["to_mm"])) / 2 for p in judged["mapping3"]])
     raised = np.array([p["raised"] == "True" for p in judged["mapping3"]])
     from_crossing_mm = np.abs((middles + 3.125) % 6.25 - 3.125)
