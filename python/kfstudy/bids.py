@@ -165,9 +165,14 @@ def write(sessions, out_dir):
     study = sessions[0].manifest["study"]["name"] if sessions else "study"
     task = label(study)
     version = sessions[0].manifest.get("version", "unknown") if sessions else "unknown"
+    made_by = dict(Name="KineticFriction", Version=str(version))
+    provenance = sessions[0].manifest.get("provenance") if sessions else None
+    if provenance:  # the first session's; each manifest.json keeps its own
+        made_by["Description"] = (f"commit {provenance.get('commit')} (uncommitted changes: "
+                                  f"{provenance.get('uncommittedChanges')}), SuperCollider {provenance.get('supercollider')} "
+                                  f"on {provenance.get('platform')}, time zone {provenance.get('timeZone')}")
     _write_json(out_dir / "dataset_description.json", dict(
-        Name=study, BIDSVersion=BIDS_VERSION, DatasetType="raw",
-        GeneratedBy=[dict(Name="KineticFriction", Version=str(version))]))
+        Name=study, BIDSVersion=BIDS_VERSION, DatasetType="raw", GeneratedBy=[made_by]))
     participants = [dict(participant_id=f"sub-{label(s.participant)}", code=s.participant,
                          session_seed=s.manifest.get("seed"), order=" ".join(s.manifest.get("order", [])),
                          device=(s.manifest.get("device") or {}).get("kind"), finished=s.finished)

@@ -1,8 +1,8 @@
 // One participant's session of a FrictionStudy, run on a server: the session folder and the run.
 //
 // The folder (folder/participant): manifest.json (study, participant, order, seed, date, the
-// project's version, the device with its settings, board and calibration, sample rate and the
-// latencies in use), session.csv (start, resume, finish, abort), answers.csv (one line per answer,
+// project's version and provenance, the device with its settings, board and calibration, sample
+// rate and the latencies in use), session.csv (start, resume, finish, abort), answers.csv (one line per answer,
 // written and flushed as it is given), and per condition a folder NN-name (NN its place in the
 // order) with device.kfsession (the device recording), audio.wav (the participant's audio as
 // heard) and events.csv (prepare, start, pause, resume, done, end... with times in s from its
@@ -470,9 +470,24 @@ FrictionStudySession {
 					source: "FrictionHand.explore of the simulated participant, one device per condition",
 					audioDelayS: FrictionPilot.paperAudioDelayS)
 			},
-			simulatedParticipant: simulated !? { simulated.asEvent }
+			simulatedParticipant: simulated !? { simulated.asEvent }, provenance: this.class.provenance
 		);
 		FrictionStudyFiles.writeText(folder +/+ "manifest.json", FrictionStudyFiles.json(manifest) ++ "\n");
+	}
+
+	// What made the data, for a manifest: the project's commit (build-info.scd, written by cmake
+	// --install) and whether its tree had changes, SuperCollider's version, the platform, the
+	// python3 the report runs (its version) and the local time zone (UTC offset); "unknown" where
+	// one cannot be found.
+	*provenance {
+		var info = KineticFriction.extensionDir +/+ "build-info.scd", build, python, zone;
+		build = if(File.exists(info)) { File.readAllString(info).interpret } ? ();
+		python = (FrictionStudy.defaultPython.shellQuote ++ " --version 2>&1").unixCmdGetStdOut;
+		python = python.replace("Python", "").stripWhiteSpace;
+		zone = if(thisProcess.platform.name != \windows) { "date +%z".unixCmdGetStdOut.stripWhiteSpace } { "" };
+		^(project: this.projectVersion, commit: build[\commit] ? "unknown", uncommittedChanges: build[\dirty] ? "unknown",
+			supercollider: Main.version, platform: thisProcess.platform.name,
+			python: if(python.isEmpty) { "unknown" } { python }, timeZone: if(zone.isEmpty) { "unknown" } { zone })
 	}
 
 	// The project's version (the extension folder's quark file), or "unknown".

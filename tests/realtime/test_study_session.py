@@ -5,6 +5,7 @@ import json
 import os
 import shutil
 import signal
+import subprocess
 import threading
 import time
 
@@ -102,6 +103,15 @@ while { ~session.isOver.not } { 0.1.wait };
     assert manifest["participant"] == "P7" and manifest["seed"] == 11 and manifest["order"] == ["first", "second"]
     assert manifest["sampleRateHz"] == jack.sample_rate and manifest["device"]["kind"] == "sim"
     assert manifest["device"]["specs"]["tactileLatencyS"] == 0.0024 and manifest["version"] != "unknown"
+    # What made the data: the commit installed (the tests install from this tree), SuperCollider,
+    # the report's python3 and the time zone, as this machine has them.
+    head = subprocess.run(["git", "-C", str(paths.REPO_DIR), "rev-parse", "HEAD"], capture_output=True, text=True)
+    provenance = manifest["provenance"]
+    assert provenance["commit"] == (head.stdout.strip() if head.returncode == 0 else "unknown"), provenance
+    assert provenance["supercollider"].startswith("3.") and provenance["platform"] == "linux"
+    assert provenance["python"] == subprocess.run(["/usr/bin/python3", "--version"], capture_output=True,
+                                                  text=True).stdout.replace("Python", "").strip()
+    assert provenance["timeZone"] == time.strftime("%z")
     answers_before = (session / "answers.csv").read_bytes()
     rows = read_csv(session / "answers.csv")
     assert [(r["condition"], r["question"]) for r in rows] == [("first", "say"), ("first", "hold")]
