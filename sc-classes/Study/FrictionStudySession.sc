@@ -485,8 +485,8 @@ FrictionStudySession {
 		python = (FrictionStudy.defaultPython.shellQuote ++ " --version 2>&1").unixCmdGetStdOut;
 		python = python.replace("Python", "").stripWhiteSpace;
 		zone = if(thisProcess.platform.name != \windows) { "date +%z".unixCmdGetStdOut.stripWhiteSpace } { "" };
-		^(project: this.projectVersion, commit: build[\commit] ? "unknown", uncommittedChanges: build[\dirty] ? "unknown",
-			supercollider: Main.version, platform: thisProcess.platform.name,
+		^(project: this.projectVersion, commit: build[\commit] ? "unknown",
+			uncommittedChanges: build[\dirty] ? "unknown", supercollider: Main.version, platform: thisProcess.platform.name,
 			python: if(python.isEmpty) { "unknown" } { python }, timeZone: if(zone.isEmpty) { "unknown" } { zone })
 	}
 
