@@ -486,7 +486,8 @@ FrictionStudySession {
 		python = python.replace("Python", "").stripWhiteSpace;
 		zone = if(thisProcess.platform.name != \windows) { "date +%z".unixCmdGetStdOut.stripWhiteSpace } { "" };
 		^(project: this.projectVersion, commit: build[\commit] ? "unknown",
-			uncommittedChanges: build[\dirty] ? "unknown", supercollider: Main.version, platform: thisProcess.platform.name,
+			uncommittedChanges: build[\dirty] ? "unknown", supercollider: Main.version,
+			platform: thisProcess.platform.name,
 			python: if(python.isEmpty) { "unknown" } { python }, timeZone: if(zone.isEmpty) { "unknown" } { zone })
 	}
 
