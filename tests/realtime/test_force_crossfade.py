@@ -3,7 +3,8 @@ pattern classes on a realtime server (JACK dummy) with a simulated device: Frict
 its force above the minimum by its synth's gate envelope, so an Ndef re-evaluated with a
 fadeTime moves the force from the old version's to the new one's and never above the larger
 (the slot summed them before: 0.86 N for two 0.5 N versions), .release fades it to the minimum,
-and a Pbind note's ADSR shapes it.
+a Pbind note's ADSR shapes it, and the same holds for a ProxySpace's ~proxy reassigned with a
+fadeTime and for Synth.release.
 
 The device's commanded force is read from its session record: one frame per millisecond, each
 the force the device commanded (after its safety path), on audio time.
@@ -235,3 +236,63 @@ def test_a_pbind_notes_adsr_shapes_its_force(jack):
         assert abs(m - (MIN_N + 0.8) / 2) < 0.03, "the force fades with the note's release"
     for r in release_s:
         assert abs(r - 0.3) < 0.01, "the release lasts its 0.3 s"
+
+
+def test_a_proxyspace_crossfade_and_a_synth_release_move_the_force_as_their_sound(jack):
+    record = paths.work_dir() / "proxyspace-release.kfs"
+    record.unlink(missing_ok=True)
+    run = sclang.require_ok(sclang.run_with_server(f"""
+        var dev = FrictionDevice.sim(s, 0), p, wait, synth;
+        SynthDef(\\kfAudioWait, {{ |dur = 1| Line.kr(0, 1, dur, doneAction: 2) }}).add;
+        SynthDef(\\kfHeld, {{ |gate = 1|
+            var env = EnvGen.kr(Env.asr(0.01, 1, 1, \\lin), gate, doneAction: 2);
+            FrictionOut.ar(0, DC.ar(0.6)); Out.ar(0, SinOsc.ar(330) * env * 0.05) }}).add;
+        s.sync;
+        dev.record({sclang.sc_string(record)});
+        // {STEP_S} s of the server's audio between the steps (see the Ndef test).
+        wait = {{ |name| var done = Condition.new, node;
+            "KF-STEP % %".format(name, thisThread.seconds).postln;
+            s.bind {{ node = Synth(\\kfAudioWait, [\\dur, {STEP_S}]) }};
+            node.onFree {{ done.test = true; done.signal }}; done.wait }};
+        // A live coder's ProxySpace: ~kf reassigned with a fade, 0.3 N to 0.7 N, then ended.
+        p = ProxySpace.push(s);
+        p.fadeTime = {FADE_S};
+        ~kf = {{ FrictionOut.ar(0, DC.ar(0.3)); Silent.ar }};
+        wait.(\\first);
+        ~kf = {{ FrictionOut.ar(0, DC.ar(0.7)); Silent.ar }};
+        wait.(\\second);
+        ~kf.release;
+        wait.(\\released);
+        p.clear; p.pop;
+        // A Synth with a gate envelope, released over 1 s: its force falls as its sound does.
+        synth = Synth(\\kfHeld);
+        wait.(\\held);
+        synth.release(1);
+        wait.(\\synthReleased);
+        dev.close;
+    """, jack, name="proxyspace-release", timeout=90))
+    assert len(run.lines("KF-STEP ")) == 5
+    host, t, f = commanded_frames(record)
+    # The ProxySpace part: from 0.3 to 0.7 N and down to the minimum, never above 0.7 N (the old
+    # rule summed the two versions: 0.86 N in the middle of the fade).
+    # Its part ends where, after 0.7 N, the release brought the force back to the minimum.
+    back = first((t > t[first(f >= 0.7 - 1e-3)]) & (f <= MIN_N + 1e-3))
+    proxy = t <= t[back]
+    figure("proxyspace_max_N", float(f[proxy].max()))
+    assert f[proxy].max() <= 0.7 + tolerance_n(0.7 - MIN_N)
+    assert np.any(np.abs(f[proxy] - 0.3) < 1e-3) and np.any(np.abs(f[proxy] - 0.7) < 1e-3)
+    rise = np.flatnonzero((t <= t[first(f >= 0.7 - 1e-3)]) & (f > 0.3 + 1e-3))
+    figure("proxyspace_0.3_to_0.7N_s", round(float(t[rise[-1]] - t[rise[0]]), 4) if rise.size else None)
+    # From the old version's force to the new one's over about fadeTime of audio.
+    assert rise.size and FADE_S - 0.3 <= t[rise[-1]] - t[rise[0]] <= FADE_S + MARGIN_S
+    # The Synth: held at 0.6 N, then released over its envelope's 1 s, to the minimum.
+    held = np.flatnonzero(~proxy & (np.abs(f - 0.6) < 1e-3))
+    assert held.size, "the held synth's 0.6 N"
+    after = t > t[held[-1]]
+    falling = f[after]
+    figure("synth_release_frames_s", round(float(t[after][-1] - t[held[-1]]), 4) if after.any() else None)
+    assert falling.size and np.all(np.diff(falling) <= 1e-6) and falling[-1] <= MIN_N + 1e-3
+    # Linear release: halfway down half a second in.
+    halfway = float(np.interp(t[held[-1]] + 0.5, t[after], falling))
+    figure("synth_release_halfway_N", round(halfway, 4))
+    assert abs(halfway - (0.6 + MIN_N) / 2) < 0.03
