@@ -9,6 +9,7 @@ namespace {
 struct Slot {
   std::atomic<Device*> device{nullptr};
   std::atomic<uint32_t> generation{0};
+  std::atomic<uint32_t> closes{0};  // devices closed in this slot (kfClose), replaced ones not
   // Audio thread only: the reports popped in a block, and the slot's position.
   MouseReport reports[kMaxReportsPerBlock];
   SlotTrajectory trajectory;
@@ -58,6 +59,10 @@ uint32_t generationOfSlot(int index) {
   return isValidSlot(index) ? gSlots[index].generation.load(std::memory_order_acquire) : 0;
 }
 
+uint32_t closesOfSlot(int index) {
+  return isValidSlot(index) ? gSlots[index].closes.load(std::memory_order_acquire) : 0;
+}
+
 Device* deviceOfSlot(int index, double lockstepTimeS, uint32_t* generation) {
   if (!isValidSlot(index)) return nullptr;
   Slot& slot = gSlots[index];
@@ -105,6 +110,7 @@ Device* exchangeSlot(int index, Device* device) {
   // RT stage writes slots while the server runs).
   Device* previous = slot.device.load(std::memory_order_acquire);
   retire(previous);
+  if (device == nullptr && previous != nullptr) slot.closes.fetch_add(1, std::memory_order_acq_rel);
   slot.device.store(device, std::memory_order_release);
   return previous;
 }

@@ -60,6 +60,11 @@ bool isValidSlot(int index);
 // Any thread: the generation of the slot's device (0 for an invalid slot).
 uint32_t generationOfSlot(int index);
 
+// Any thread: how many devices were closed in the slot (a device replaced by another is not
+// closed; 0 for an invalid slot). A force writer that saw a device and then a close stops: the
+// next device opened there is not the one it was written for (FrictionOut).
+uint32_t closesOfSlot(int index);
+
 // Signal handlers (ExitSafety.cpp): Device::emergencyOff on every device in a slot and every
 // retired one (its close has not finished), taking the retired ones so that their NRT stage does
 // not delete them meanwhile. Atomic operations only, so async-signal-safe. A device whose NRT

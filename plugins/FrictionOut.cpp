@@ -59,8 +59,15 @@ class FrictionOut : public SCUnit {
 
  private:
   void next(int numSamples) {
+    if (mOrphaned) {
+      std::fill_n(out(0), numSamples, mMinForceN);
+      return;
+    }
     const int index = kf::sc::slotIndexOf(in0(kDevice));
-    if (index != mIndex) follow(index);
+    if (index != mIndex) {
+      follow(index);
+      mSawDevice = false;  // another slot: it follows that slot's device from now on
+    }
     const kf::sc::BlockClock clock = kf::sc::blockClockOf(mWorld);
     const double blockEndS = clock.startS + kf::sc::blockDurationS(mWorld);
     uint32_t generation = 0;
@@ -75,6 +82,22 @@ class FrictionOut : public SCUnit {
       return;
     }
     if (mSlot.isNew(generation)) mMinForceN = static_cast<float>(device->spec().minForceN);
+    // Written for the device it first saw in its slot: once that one is closed, this writer
+    // never acts on the next device opened there (a forgotten synth would hold its puck).
+    const uint32_t closes = kf::sc::closesOfSlot(index);
+    if (!mSawDevice) {
+      mSawDevice = true;
+      mClosesAtFirstDevice = closes;
+    } else if (closes != mClosesAtFirstDevice) {
+      kf::sc::postFromRt(mWorld,
+                         "FrictionOut: the device it wrote to in slot %d was closed; it sends no force to the next "
+                         "one there (free its synth)\n",
+                         index);
+      follow(-1);  // no longer one of the slot's writers, whose frames would wait for it
+      mOrphaned = true;
+      std::fill_n(out(0), numSamples, mMinForceN);
+      return;
+    }
 
     FrameSink sink{device, device->nowS(), blockEndS};
     // A control-rate force is held over the block.
@@ -102,6 +125,9 @@ class FrictionOut : public SCUnit {
   }
 
   int mIndex = -1;
+  bool mSawDevice = false;            // a device was open in its slot while it ran
+  uint32_t mClosesAtFirstDevice = 0;  // closesOfSlot when it first saw one
+  bool mOrphaned = false;             // that device was closed: it writes no more
   float mMinForceN = static_cast<float>(kf::DeviceSpec{}.minForceN);  // of the last device seen
   kf::sc::SlotFollower mSlot;
 };

@@ -390,3 +390,44 @@ def test_every_pbind_note_reads_the_puck_where_it_is(jack):
     figure("pbind_note_vs_running_reader_max_abs_difference_mm", diff)
     assert diff == 0.0
     assert rows[0, 0] > 5 and np.all(np.diff(rows[:, 0]) > 0), "every note reads the moving puck, none reads 0"
+
+
+def test_a_synth_left_playing_does_not_act_on_the_next_device_in_its_slot(jack):
+    # Issue 41: FrictionOut's first help example plays a synth it does not store; after
+    # ~device.close it played on, and the next device opened in slot 0 was held by its 1 N
+    # stripes (the puck stuck at 10.647 mm for 9 s). A writer follows the device it first saw:
+    # once that one is closed it sends nothing to the next one, and says so once.
+    record = paths.work_dir() / "next-device.kfs"
+    record.unlink(missing_ok=True)
+    run = sclang.require_ok(sclang.run_with_server("var first, second, forgotten, wait;\n" + status.SC_POST + f"""
+        wait = {{ |s_| var done = Condition.new;
+            {{ Line.kr(0, 1, s_, doneAction: 2); Silent.ar }}.play.onFree {{ done.test = true; done.signal }};
+            done.wait }};
+        first = FrictionDevice.sim(s, 0);
+        s.sync;
+        forgotten = {{ FrictionOut.ar(0, DC.ar(1.0)); Silent.ar }}.play;
+        wait.(0.3);
+        ~kfPostStatus.(first, "KF-FIRST");
+        first.close;
+        s.sync;
+        second = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 1]]));
+        second.record({sclang.sc_string(record)});
+        s.sync;
+        wait.(1.0);
+        ~kfPostStatus.(second, "KF-SECOND");
+        // A synth started for the new device drives it, beside the forgotten one.
+        {{ FrictionOut.ar(0, DC.ar(0.5)) * Line.ar(1, 1, 0.5, doneAction: 2); Silent.ar }}.play;
+        wait.(0.6);
+        second.close;
+        forgotten.free;
+    """, jack, name="next-device", timeout=60))
+    assert status.parse(run.output, "KF-FIRST")[0]["lastForceN"] == pytest.approx(1.0)
+    # The forgotten synth's 1 N never reached the second device: its frames are the new synth's
+    # 0.5 N and the minimum, and while only the forgotten synth played, no frame came at all.
+    _, records = readers.read_session(record)
+    commanded = np.array([f[3] for tag, f in records if tag == "F"])
+    figure = f"KF-FIGURE next_device_max_N {commanded.max() if commanded.size else None}"
+    print(figure)
+    assert commanded.size and commanded.max() <= 0.5 + 1e-4, figure
+    assert np.sum(np.isclose(commanded, 0.5, atol=1e-4)) > 200  # the new synth's half second
+    assert run.output.count("sends no force to the next one there") == 1, run.output[-3000:]
