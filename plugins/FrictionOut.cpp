@@ -125,9 +125,9 @@ class FrictionOut : public SCUnit {
   }
 
   int mIndex = -1;
-  bool mSawDevice = false;            // a device was open in its slot while it ran
-  uint32_t mClosesAtFirstDevice = 0;  // closesOfSlot when it first saw one
-  bool mOrphaned = false;             // that device was closed: it writes no more
+  bool mSawDevice = false;                                            // a device was open in its slot while it ran
+  uint32_t mClosesAtFirstDevice = 0;                                  // closesOfSlot when it first saw one
+  bool mOrphaned = false;                                             // that device was closed: it writes no more
   float mMinForceN = static_cast<float>(kf::DeviceSpec{}.minForceN);  // of the last device seen
   kf::sc::SlotFollower mSlot;
 };
