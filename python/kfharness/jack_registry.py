@@ -14,6 +14,8 @@ import subprocess
 import time
 from pathlib import Path
 
+from .procs import pid_alive
+
 REGISTRY_PATH = Path("/dev/shm/jack-shm-registry")
 MAX_SERVERS = 8  # JACK2 common/shm.h
 HEADER_BYTES = 24  # magic, protocol, type, size, hdr_len, entry_len
@@ -40,20 +42,10 @@ def registered_servers(path=REGISTRY_PATH):
     return servers
 
 
-def process_alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
 def dead_servers(path=REGISTRY_PATH):
     """Names of this user's registry entries whose jackd is gone."""
     return [name for pid, uid, name in registered_servers(path)
-            if uid == os.getuid() and not process_alive(pid)]
+            if uid == os.getuid() and not pid_alive(pid)]
 
 
 def reclaim(name, timeout_s=10.0):
