@@ -81,3 +81,13 @@ class JackServer:
 
     def __exit__(self, *exc):
         self.stop()
+
+
+PERFORMER_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the device threads at 66
+
+
+def performer_jack(**kwargs):
+    """A JACK server as a performer runs it: realtime scheduling where this user may (root or an
+    rtprio limit), else at normal priority."""
+    from .load import realtime_allowed
+    return JackServer(realtime_priority=PERFORMER_PRIORITY if realtime_allowed() else None, **kwargs)

@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from kfharness import paths, sclang
-from kfharness.jack import JackServer
+from kfharness.jack import performer_jack
 
 # The participants run at once, each on a device slot of its own (deviceIndex) and output pairs of
 # its own (participantOut, experimenterOut): a simulated participant needs no one's turn, and its
@@ -49,7 +49,10 @@ def run_study(out_dir, participants=5, explore_s=None, trials=40, interval_s=1.5
     # Each condition: at most 600 s of exploring (the pilot's maxTimeS), a few s to open and close;
     # each trial its two intervals and gaps and the procedure's choice; the report a few minutes.
     timeout_s = 6 * ((explore_s or 600) + 15) + 3 * (trials * (2 * (interval_s + gap_s) + 0.5) + 15) + 300
-    jack = JackServer()
+    # As a performer runs it: realtime scheduling where this user may. At normal priority the
+    # five participants' server fell to about 500 force frames a second in a fresh clone's run
+    # (the audio thread waiting for the CPU), and the binds statistic with it.
+    jack = performer_jack()
     jack.start()
     try:
         run = sclang.run_with_server(code, jack, timeout=timeout_s, name="study",

@@ -6,16 +6,8 @@ threads SCHED_FIFO, and the device's threads above them (ThreadScheduling), so t
 timing holds on a busy machine (scripts/realtime-under-load.sh)."""
 import pytest
 
-from kfharness.jack import JackServer
-from kfharness.load import realtime_allowed
+from kfharness.jack import performer_jack
 from kfharness.xvfb import Xvfb
-
-REALTIME_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the device threads at 66
-
-
-def performer_jack():
-    """A JACK server as a performer runs it: realtime scheduling where this user may."""
-    return JackServer(realtime_priority=REALTIME_PRIORITY if realtime_allowed() else None)
 
 
 @pytest.fixture
