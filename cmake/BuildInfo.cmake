@@ -1,6 +1,6 @@
 # Run by `cmake --install` (install(CODE)): writes build-info.scd into the extension folder, the
 # commit the installed classes and plugin came from, so that a study's manifest can name it
-# (FrictionStudySession.buildInfo). Needs KF_SOURCE_DIR and KF_BUILD_INFO_PATH. Outside a git
+# (FrictionStudySession.provenance). Needs KF_SOURCE_DIR and KF_BUILD_INFO_PATH. Outside a git
 # checkout (a release tarball) the commit is "unknown".
 set(commit "unknown")
 set(dirty "false")

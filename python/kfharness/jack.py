@@ -7,6 +7,7 @@ import time
 
 from . import paths
 from .jack_registry import reclaim, reclaim_dead_servers, registered_servers
+from .load import realtime_allowed
 
 
 class JackServer:
@@ -89,5 +90,4 @@ PERFORMER_PRIORITY = 70  # jackd -R -P 70: scsynth's audio thread at 65, the dev
 def performer_jack(**kwargs):
     """A JACK server as a performer runs it: realtime scheduling where this user may (root or an
     rtprio limit), else at normal priority."""
-    from .load import realtime_allowed
     return JackServer(realtime_priority=PERFORMER_PRIORITY if realtime_allowed() else None, **kwargs)

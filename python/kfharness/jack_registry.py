@@ -48,25 +48,29 @@ def dead_servers(path=REGISTRY_PATH):
             if uid == os.getuid() and not pid_alive(pid)]
 
 
+def start_registered(name, timeout_s=10.0):
+    """(proc, registered): a small jackd on the dummy driver named `name`, once it holds a slot
+    of the registry (registered False if it exited or took longer than timeout_s)."""
+    proc = subprocess.Popen(["jackd", "-n", name, "-r", "-d", "dummy", "-r", "48000", "-p", "1024"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env=dict(os.environ, JACK_NO_AUDIO_RESERVATION="1"))
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and proc.poll() is None:
+        if any(pid == proc.pid for pid, _, _ in registered_servers()):
+            return proc, True
+        time.sleep(0.05)
+    return proc, False
+
+
 def reclaim(name, timeout_s=10.0):
     """Start jackd as `name` until it holds the slot, then stop it normally (which frees it)."""
-    env = dict(os.environ, JACK_NO_AUDIO_RESERVATION="1")
-    proc = subprocess.Popen(["jackd", "-n", name, "-r", "-d", "dummy", "-r", "48000", "-p", "1024"],
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, env=env)
+    proc, _ = start_registered(name, timeout_s)
+    proc.terminate()
     try:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline and proc.poll() is None:
-            if any(pid == proc.pid for pid, _, _ in registered_servers()):
-                break
-            time.sleep(0.05)
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout_s)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        proc.wait(timeout_s)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
 
 
 def reclaim_dead_servers():

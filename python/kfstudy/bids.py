@@ -14,6 +14,8 @@ import csv
 import json
 import re
 
+from . import checked_csv
+
 BIDS_VERSION = "1.9.0"
 LEVEL_UNITS = {"force": "N", "asynchrony": "ms", "grating": "mm"}
 
@@ -114,8 +116,6 @@ def _experiments(session):
 
 def trial_rows(session, damaged=None):
     """The session's trials as tidy rows (TRIAL_COLUMNS); damaged rows skipped (checked_csv)."""
-    from . import checked_csv
-
     path = session.folder / "trials.csv"
     if not path.exists():
         return []

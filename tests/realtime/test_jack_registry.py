@@ -6,8 +6,6 @@ on purpose, a stop that times out kills one) filled the table, and every jackd a
 with "Too many servers already active": 22 realtime tests and the main job."""
 import os
 import signal
-import subprocess
-import time
 
 from kfharness import jack_registry
 from kfharness.jack import JackServer
@@ -15,15 +13,10 @@ from kfharness.jack import JackServer
 
 def killed_jackd(name):
     """A jackd that took a registry slot and was killed with SIGKILL (its slot left taken)."""
-    proc = subprocess.Popen(["jackd", "-n", name, "-r", "-d", "dummy", "-r", "48000", "-p", "1024"],
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, env=dict(os.environ, JACK_NO_AUDIO_RESERVATION="1"))
-    deadline = time.monotonic() + 10
-    while not any(pid == proc.pid for pid, _, _ in jack_registry.registered_servers()):
-        assert proc.poll() is None and time.monotonic() < deadline, f"{name} did not register"
-        time.sleep(0.05)
+    proc, registered = jack_registry.start_registered(name)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
+    assert registered, f"{name} did not register"
 
 
 def test_a_full_table_of_killed_servers_does_not_stop_the_next_one():
