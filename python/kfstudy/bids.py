@@ -15,6 +15,7 @@ import json
 import re
 
 from . import checked_csv
+from .psychometric import procedure_trials
 
 BIDS_VERSION = "1.9.0"
 LEVEL_UNITS = {"force": "N", "asynchrony": "ms", "grating": "mm"}
@@ -24,7 +25,8 @@ TRIAL_COLUMNS = {
     "condition": dict(Description="The threshold condition's name in the study."),
     "position": dict(Description="The condition's place in the participant's order, from 1."),
     "attempt": dict(Description="The condition's attempt (a crash or a repeat runs it again)."),
-    "trial": dict(Description="The trial's number in its attempt, from 1."),
+    "trial": dict(Description="The trial's number in the condition's procedure, from 1 (a resumed attempt "
+                              "numbers on)."),
     "level": dict(Description="The stimulus level the procedure chose (the difference the participant "
                               "was to detect); its unit is in the column unit."),
     "unit": dict(Description="The unit of level.", Levels=dict(N="newtons (a force step)",
@@ -39,6 +41,9 @@ TRIAL_COLUMNS = {
     "interval2_onset": dict(Description="The second interval's start, from the condition's prepare line.", Units="s"),
     "response_time": dict(Description="When the response was given, from the condition's prepare line.", Units="s"),
     "wall_time": dict(Description="Local date and time the trial was stored (ISO 8601)."),
+    "used": dict(Description="Whether the condition's procedure used the trial (a resumed attempt continues the "
+                             "procedure from the trials stored before it; a trial a later attempt ran again is "
+                             "not used).", Levels={"true": "used", "false": "run again by a later attempt"}),
     "experiment": dict(Description="What the threshold is of.", Levels=dict(
         force="a force step on a base force", asynchrony="the delay between the audio and the touch",
         grating="a grating's period")),
@@ -120,8 +125,11 @@ def trial_rows(session, damaged=None):
     if not path.exists():
         return []
     experiments = _experiments(session)
+    stored = checked_csv.read_rows(path, damaged)
+    used = {id(t) for name in {t["condition"] for t in stored}
+            for t in procedure_trials([t for t in stored if t["condition"] == name])[0]}
     rows = []
-    for t in checked_csv.read_rows(path, damaged):
+    for t in stored:
         experiment = experiments.get(t["condition"], {})
         procedure = experiment.get("procedure") or {}
         rows.append(dict(
@@ -133,7 +141,8 @@ def trial_rows(session, damaged=None):
             experiment=experiment.get("kind"), procedure=procedure.get("kind"),
             base_force=(experiment.get("settings") or {}).get("baseForceN"),
             interval_duration=experiment.get("intervalS"), gap_duration=experiment.get("gapS"),
-            experiment_seed=experiment.get("seed"), session_seed=session.manifest.get("seed")))
+            experiment_seed=experiment.get("seed"), session_seed=session.manifest.get("seed"),
+            used="true" if id(t) in used else "false"))
     return rows
 
 
@@ -145,9 +154,10 @@ def answer_rows(session):
 
 
 def level_counts(rows):
-    """{(participant_id, condition): [(level, n_correct, n_total)]}, levels ascending."""
+    """{(participant_id, condition): [(level, n_correct, n_total)]} of the trials the procedures
+    used, levels ascending."""
     counts = {}
-    for r in rows:
+    for r in (r for r in rows if r["used"] == "true"):
         key = (r["participant_id"], r["condition"])
         cell = counts.setdefault(key, {}).setdefault(float(r["level"]), [0, 0])
         cell[0] += str(r["correct"]).lower() == "true"

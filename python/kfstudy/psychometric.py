@@ -177,6 +177,29 @@ def read_trials(path, damaged=None):
     return rows
 
 
+def procedure_trials(rows):
+    """The trials a condition's procedure used, and how its attempts were joined. A resumed
+    attempt continues the procedure from the trials stored before it (FrictionStudySession), so
+    they are, per trial number, the row of the latest attempt that has it, up to the last
+    attempt's last trial. Returns (rows in trial order, text such as "trials 1-8 of attempt 1,
+    9-20 of attempt 2"). Rows without attempt and trial columns are all used, in their order."""
+    if not rows or any(r.get("attempt") in (None, "") or r.get("trial") in (None, "") for r in rows):
+        return rows, ""
+    last_attempt = max(int(r["attempt"]) for r in rows)
+    last_trial = max(int(r["trial"]) for r in rows if int(r["attempt"]) == last_attempt)
+    by_trial = {}
+    for row in sorted(rows, key=lambda r: int(r["attempt"])):
+        by_trial[int(row["trial"])] = row
+    used = [by_trial[n] for n in sorted(by_trial) if n <= last_trial]
+    parts = []
+    for row in used:
+        if parts and parts[-1][2] == row["attempt"]:
+            parts[-1][1] = row["trial"]
+        else:
+            parts.append([row["trial"], row["trial"], row["attempt"]])
+    return used, ", ".join(f"trials {a}-{b} of attempt {k}" for a, b, k in parts)
+
+
 def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None):
     """The threshold section of a report from one session's trials CSV: a PNG per condition
     (<name>-<condition>-psychometric.png in out_dir) and the Markdown that shows them, with the
@@ -197,9 +220,12 @@ def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None
              "| condition | trials | threshold | its standard error (log10) | slope | lapse | level at 70.7 % "
              "| at 79.4 % | procedure's estimate | model observer's threshold | figure |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    fits, warnings = [], []
+    fits, warnings, notes = [], [], []
     for condition in sorted({r.get("condition") or "" for r in rows}):
-        chosen = [r for r in rows if (r.get("condition") or "") == condition]
+        chosen, joined = procedure_trials([r for r in rows if (r.get("condition") or "") == condition])
+        if len({r.get("attempt") for r in chosen}) > 1:
+            notes.append(f"{condition}: {joined} (a resumed attempt continues the procedure; the fit takes "
+                         "exactly the trials it used).")
         levels, correct = [r["level"] for r in chosen], [r["correct"] for r in chosen]
         known = conditions.get(condition, {})
         unit = known.get("unit") or ""
@@ -217,4 +243,5 @@ def report_section(trials_csv, out_dir, name=None, conditions=None, damaged=None
         if fitted["warning"]:
             warnings.append(f"**{condition or '-'}: {fitted['warning']}.**")
     lines += [""] + warnings if warnings else []
+    lines += [""] + notes if notes else []
     return "\n".join(lines) + "\n", fits

@@ -42,6 +42,31 @@ FrictionStudy {
 			experimenterOut, deviceIndex)
 	}
 
+	// What differs between this study and stored, the study as a session's manifest holds it
+	// (parsed JSON): an Array of "where: stored, now" Strings, empty when they agree. Seeds are
+	// left out (a procedure's seed may be drawn anew each time it is made; one that changed the
+	// levels is found when the stored trials are continued).
+	differencesFrom { |stored|
+		var compare, found = [];
+		compare = { |was, now, where|
+			case
+				{ was.isKindOf(Dictionary) and: { now.isKindOf(Dictionary) } } {
+					(was.keys.asArray ++ now.keys.asArray).asSet.asArray.sort.do { |key|
+						if(key != "seed") { compare.(was[key], now[key], where ++ "." ++ key) }
+					}
+				}
+				{ was.isArray and: { now.isArray } and: { was.isString.not } and: { now.isString.not } } {
+					max(was.size, now.size).do { |i| compare.(was[i], now[i], where ++ "[" ++ i ++ "]") }
+				}
+				{ was != now } {
+					found = found.add("%: % in the session, % now".format(where.drop(1), was ? "absent",
+						now ? "absent"))
+				}
+		};
+		compare.(stored, FrictionStudyFiles.json(this.asEvent).parseJSON, "");
+		^found
+	}
+
 	asEvent {
 		^(name: name, order: order, introduction: introduction, coverage: coverage,
 			conditions: conditions.collect(_.asEvent))

@@ -60,10 +60,12 @@ FrictionStudyCondition {
 	}
 
 	// The condition as an Event (a session's manifest): with its area on the surface, so that the
-	// report needs nothing but the session folder.
+	// report needs nothing but the session folder, and a threshold condition's experiment (one made
+	// for it: its procedure's settings), so that a resume can tell a changed one.
 	asEvent {
 		^(name: name, scene: this.settings, areaMm: this.areaMm, instruction: instruction, maxTimeS: maxTimeS,
-			questions: questions.collect(_.asEvent), threshold: this.isThreshold, answers: answers)
+			questions: questions.collect(_.asEvent), threshold: this.isThreshold, answers: answers,
+			experiment: makeExperiment !? { |make| make.value.tryPerform(\asEvent) })
 	}
 
 	printOn { |stream| stream << this.class.name << "(" << name.cs << ")" }

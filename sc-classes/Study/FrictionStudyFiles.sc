@@ -40,6 +40,62 @@ FrictionStudyFiles {
 		file.close;
 	}
 
+	// The rows of a CSV that appendCsv wrote, each an Event of the header's names (Symbols) to
+	// its fields (Strings, the check left out), in the file's order. As kfstudy's checked_csv
+	// reads them: a record is the shortest run of lines from a row's start whose quotes balance
+	// (free text keeps its line breaks); one whose check fails (cut, changed) is left out, its
+	// first line's number (the header is line 1) added to damaged (a List, or nil), and the
+	// next line is tried as a row's start. No file: no rows.
+	*readCsv { |path, damaged|
+		var lines, header, rows = [], start = 1;
+		if(File.exists(path).not) { ^[] };
+		lines = File.readAllString(path).split($\n);
+		if(lines.last == "") { lines.pop };
+		if(lines.isEmpty) { ^[] };
+		header = this.prFields(lines[0]).drop(-1).collect(_.asSymbol);
+		while { start < lines.size } {
+			var end = start, record = lines[start], fields;
+			while { record.occurrencesOf($").odd and: { end + 1 < lines.size } and: { end - start < 64 } } {
+				end = end + 1;
+				record = record ++ "\n" ++ lines[end]
+			};
+			fields = this.prCheckedFields(record, header.size);
+			if(fields.notNil) {
+				rows = rows.add(Event.newFrom([header, fields].flop.flatten));
+				start = end + 1
+			} {
+				damaged !? { damaged.add(start + 1) };
+				start = start + 1
+			}
+		};
+		^rows
+	}
+
+	// A record's fields if its check holds and it has width of them (the check left out), else nil.
+	*prCheckedFields { |record, width|
+		var tail = 11, body, fields;  // ,"XXXXXXXX"
+		if(record.size <= tail or: { record.occurrencesOf($").odd }) { ^nil };
+		body = record.copyRange(0, record.size - tail - 1);
+		if(this.check(body) != record.copyRange(record.size - 9, record.size - 2)) { ^nil };
+		fields = this.prFields(body);
+		^if(fields.size == width) { fields } { nil }
+	}
+
+	// One record's fields: quoted ("" a quote inside) or bare, split at commas outside quotes.
+	*prFields { |record|
+		var fields = [], field = String.new, quoted = false, i = 0;
+		while { i < record.size } {
+			var c = record[i];
+			case
+				{ quoted and: { c == $" } and: { record[i + 1] == $" } } { field = field.add(c); i = i + 1 }
+				{ c == $" } { quoted = quoted.not }
+				{ quoted.not and: { c == $, } } { fields = fields.add(field); field = String.new }
+				{ field = field.add(c) };
+			i = i + 1
+		};
+		^fields.add(field)
+	}
+
 	// A row's check: the Adler-32 (RFC 1950, as Python's zlib.adler32) of its bytes, 8 hex digits.
 	*check { |text|
 		var a = 1, b = 0;

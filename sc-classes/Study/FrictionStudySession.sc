@@ -22,7 +22,7 @@ FrictionStudySession {
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
 	var buttonsSynth, buttonsResponder;
-	var routine, lastAnswerT, watchId, experiment;
+	var routine, lastAnswerT, watchId, experiment, sessionTimeOffsetS = 0;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -56,6 +56,13 @@ FrictionStudySession {
 		if(study.isKindOf(FrictionStudy).not or: { manifest["study"]["name"] != study.name }) {
 			Error("FrictionStudySession.resume: the session in % is of the study %, not %".format(
 				sessionFolder, manifest["study"]["name"].cs, study !? { study.name.cs })).throw
+		};
+		// Its data would mix two studies: refused, with what differs.
+		study.differencesFrom(manifest["study"]) !? { |found|
+			if(found.notEmpty) {
+				Error("FrictionStudySession.resume: the study % is not the one the session in % was started with:\n%"
+					.format(study.name.cs, sessionFolder, found.collect("\t" ++ _).join("\n"))).throw
+			}
 		};
 		^super.new.prInit(study, manifest["participant"], sessionFolder.asString.standardizePath.dirname, server,
 			manifest["participantIndex"].asInteger, manifest["seed"].asInteger, device, simulated, windows,
@@ -264,7 +271,7 @@ FrictionStudySession {
 	// simulated participant answers through the condition's makeObserver, or its own observer for
 	// the experiment's kind; the experiment and the observer (its known threshold) are logged.
 	prRunThreshold {
-		var estimate, how, right = 0, count = 0;
+		var estimate, how, stored, right = 0, count = 0;
 		experiment = condition.makeExperiment.value;
 		how = if(simulated.notNil) {
 			condition.makeObserver !? { |make| make.value(simulated.seed) } ?? {
@@ -277,6 +284,15 @@ FrictionStudySession {
 		} { condition.answers };
 		if(experiment.respondsTo(\asEvent)) { this.log(\experiment, FrictionStudyFiles.json(experiment.asEvent)) };
 		if(how.respondsTo(\asEvent)) { this.log(\observer, FrictionStudyFiles.json(how.asEvent)) };
+		// A resumed attempt goes on from the trials stored before: the procedure (and a simulated
+		// participant's observer) as it was when the session stopped.
+		stored = this.prStoredTrials;
+		if(stored.notEmpty) {
+			experiment.continueFrom(stored, if(how.isKindOf(FrictionObserver)) { how });
+			count = stored.size;
+			right = stored.count { |t| t[\correct] == "true" };
+			this.log(\continue, this.prJoined(stored))
+		};
 		listenSynth = Synth.tail(server, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
 		this.prRecordAudio;
 		participantWindow !? {
@@ -317,6 +333,26 @@ FrictionStudySession {
 		if(simulated.notNil) { conditionDevice.close };
 		server.sync;
 		^this.prQuestions
+	}
+
+	// The trials an earlier attempt at this threshold condition stored, which this attempt goes on
+	// from: per trial number the row of the latest attempt that has it, from trial 1 to the first
+	// number none has (a damaged row: the procedure goes on from there). The report joins them so.
+	prStoredTrials {
+		var mine, byTrial = (), n = 1, stored = [];
+		if(attempt < 2) { ^[] };
+		mine = FrictionStudyFiles.readCsv(folder +/+ "trials.csv").select { |t|
+			t[\position] == (position + 1).asString and: { t[\condition] == condition.name.asString }
+		};
+		mine.sort { |a, b| a[\attempt].asInteger <= b[\attempt].asInteger }.do { |t| byTrial[t[\trial].asInteger] = t };
+		while { byTrial[n].notNil } { stored = stored.add(byTrial[n]); n = n + 1 };
+		^stored
+	}
+
+	// How stored trials join: "1-8 of attempt 1, 9-12 of attempt 2".
+	prJoined { |stored|
+		var parts = stored.separate { |a, b| a[\attempt] != b[\attempt] };
+		^parts.collect { |p| "%-% of attempt %".format(p.first[\trial], p.last[\trial], p.first[\attempt]) }.join(", ")
 	}
 
 	// ---- the instrument ----
@@ -447,9 +483,12 @@ FrictionStudySession {
 		^n
 	}
 
+	// session.csv's times count on across a resume (a new sclang's clock starts again): they go on
+	// from the last one stored (the wallTime column says how long the session stood).
 	prSessionLog { |event, detail|
 		FrictionStudyFiles.appendCsv(folder +/+ "session.csv",
-			[Main.elapsedTime.round(0.001), event, detail, FrictionStudyFiles.now], eventsHeader);
+			[(Main.elapsedTime + sessionTimeOffsetS).round(0.001), event, detail, FrictionStudyFiles.now],
+			eventsHeader);
 	}
 
 	prWriteManifest {
@@ -511,6 +550,9 @@ FrictionStudySession {
 			if(position == order.size and: {
 				File.exists(events).not or: { File.readAllString(events).contains("\"end\"").not }
 			}) { position = k }
+		};
+		FrictionStudyFiles.readCsv(folder +/+ "session.csv").last !? { |last|
+			sessionTimeOffsetS = max(0, last[\timeS].asFloat - Main.elapsedTime)
 		};
 		this.prSessionLog(\resume, "at % of %".format(position + 1, order.size));
 		this.prPlay;

@@ -45,6 +45,10 @@ FrictionObserver {
 		^rng.next({ 1.0.rand }) < this.probability(level)
 	}
 
+	// Draws what n trials' answers would (their answers unused): an observer that answered n trials
+	// before a crash goes on, once skipped, as it would have without the crash.
+	skip { |n| n.do { rng.next({ 1.0.rand }) } }
+
 	// Runs procedure to its end, this observer answering every trial; onTrial.(procedure, n) after
 	// the n-th (e.g. to take its estimate as the trials go). Returns procedure.estimate. With no
 	// device: what a procedure does with a known observer (how many trials it needs, its bias).

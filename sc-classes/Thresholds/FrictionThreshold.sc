@@ -121,6 +121,30 @@ FrictionThreshold {
 		^estimate
 	}
 
+	// Continues from trials stored by an earlier run (a session that crashed and is resumed): an
+	// Array of Events with level and correct (Booleans, or "true"/"false" as trials.csv holds
+	// them), in their order. Each is given to the procedure as the answer to the level it asks,
+	// the interval order drawn as the run would, and observer (a FrictionObserver, or nil) skips
+	// its answer; run then goes on from the next trial, numbered on. The procedure must ask each
+	// stored level in turn (same procedure, same seed): else an Error says at which trial they part.
+	continueFrom { |trials, observer|
+		var where = "FrictionThreshold.continueFrom";
+		if(procedure.trials.notEmpty) { Error("%: the procedure has run trials already".format(where)).throw };
+		trials.do { |stored, i|
+			var asked = procedure.next, level = stored[\level], correct = stored[\correct];
+			if(level.isString) { level = level.asFloat };
+			if(correct.isString) { correct = correct == "true" };
+			FrictionCheck.boolean(correct, "correct", where);
+			if(asked.isNil or: { level.isNumber.not } or: { (asked - level).abs > (1e-9 * max(1, asked.abs)) }) {
+				Error(("%: trial % was stored at level %, where the procedure asks % (not the procedure, or not "
+					"the seed, that stored it)").format(where, i + 1, level, asked)).throw
+			};
+			rng.next({ [1, 2].choose });
+			procedure.respond(asked, correct);
+			observer !? { observer.skip(1) }
+		}
+	}
+
 	// The force experiment's reference and targets must be forces the device renders: one outside
 	// its minForceN..maxForceN would be clamped, and both intervals could hold the same force.
 	// Checked before the first trial for every level the procedure can name (its levelRange;

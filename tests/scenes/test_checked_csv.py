@@ -62,3 +62,35 @@ def test_a_file_without_checks_is_read_as_plain_csv(tmp_path):
     path.write_bytes(b'participant,answer\n"P1","a\nb"\n"P2","\xff"\n')
     assert checked_csv.read_rows(path) == [{"participant": "P1", "answer": "a\nb"},
                                            {"participant": "P2", "answer": "\ufffd"}]
+
+
+def sclang_reads(path):
+    """FrictionStudyFiles.readCsv's rows (the answer field's bytes as hex) and damaged lines."""
+    out = sclang.run_script(f"""
+var damaged = List.new, rows = FrictionStudyFiles.readCsv({sclang.sc_string(str(path))}, damaged);
+rows.do {{ |r| "KF-ROW % % % %".format(r[\\participant], r[\\answer].collectAs({{ |c| (c.ascii % 256).asHexString(2) }},
+    Array).join, r[\\level], r.size).postln }};
+"KF-DAMAGED %".format(damaged.join(" ")).postln;
+""", name="checked-csv-read")
+    rows = [line.split()[1:] for line in out.splitlines() if line.startswith("KF-ROW ")]
+    damaged = [line.split()[1:] for line in out.splitlines() if line.startswith("KF-DAMAGED")]
+    return [dict(participant=p, answer=bytes.fromhex(h).decode("utf-8"), level=level, size=int(n))
+            for p, h, level, n in rows], [int(n) for n in damaged[0]]
+
+
+def test_sclang_reads_what_python_reads_and_skips_the_same_lines(tmp_path):
+    # A resume reads trials.csv and session.csv in sclang: the same rows and the same damaged
+    # lines as kfstudy's report, on the cut and the changed rows above.
+    path = tmp_path / "answers.csv"
+    append(path, ROWS[:2])
+    path.write_bytes(path.read_bytes()[:-20])
+    append(path, ROWS[2:])
+    rows, damaged = sclang_reads(path)
+    assert [dict(r, size=None) for r in rows] == [dict(d, size=None) for d in as_dicts([ROWS[0], ROWS[2]])]
+    assert {r["size"] for r in rows} == {len(HEADER)}  # the check column is left out
+    assert damaged == [3, 4]
+    path.write_bytes(path.read_bytes().replace(b"then", b"th\xffn", 1))
+    rows, damaged = sclang_reads(path)
+    assert [r["answer"] for r in rows] == [ROWS[2][1]] and damaged == [2, 3, 4]
+    rows, damaged = sclang_reads(tmp_path / "none.csv")
+    assert rows == [] and damaged == []

@@ -219,3 +219,40 @@ def test_bad_arguments_are_refused():
     assert "levels must be a non-empty Array" in errors[8] and "level must be > 0" in errors[9]
     assert "maxTrials" in errors[10] and "level must be > 0" in errors[11] and "lapses" in errors[12]
     assert "p must lie between" in errors[13]
+
+
+def test_each_procedure_continues_from_stored_trials():
+    # A session resumed after k trials (FrictionThreshold.continueFrom): the stored trials, their
+    # levels as trials.csv holds them (asString), given to a new experiment and a new observer of
+    # the same seeds; what follows must be the straight run's trials, level for level, and its
+    # estimate. k = 7 puts QUEST+ past its first choices and the staircase past reversals.
+    out = sclang.run_script(r"""
+        var makers = [
+            \staircase -> { FrictionStaircase(0.4, 2, [0.2, 0.1, 0.05], \log, 10, 40) },
+            \questplus -> { FrictionQuestPlus(Array.geom(12, 0.02, 1.4), maxTrials: 24) },
+            \constant -> { FrictionConstantStimuli([0.05, 0.1, 0.2], 6, seed: 5) }
+        ];
+        var experiment = { |make| FrictionThreshold.force(make.value, 0.3, seed: 2) };
+        var observer = { FrictionObserver(0.1, 3.5, 0.02, seed: 9) };
+        makers.do { |pair|
+            var straight = experiment.(pair.value), first = experiment.(pair.value), resumed, o = observer.value,
+                stored = [], estimate;
+            estimate = observer.value.runProcedure(straight.procedure);
+            7.do { var l = first.procedure.next, c = o.answer(l);
+                first.procedure.respond(l, c); stored = stored.add((level: l.asString, correct: c.asString)) };
+            resumed = experiment.(pair.value);
+            o = observer.value;
+            resumed.continueFrom(stored, o);
+            "KF-CONT % % % %".format(pair.key, resumed.procedure.trials.size, o.runProcedure(resumed.procedure)
+                .threshold == estimate.threshold, resumed.procedure.trials.collect(_.level)
+                == straight.procedure.trials.collect(_.level)).postln;
+            stored[3] = (level: "0.123", correct: "true");
+            try { experiment.(pair.value).continueFrom(stored) } { |e| "KF-PART % %".format(pair.key, e.errorString)
+                .postln };
+        };
+    """, name="threshold-continue")
+    lines = [line.split() for line in out.splitlines() if line.startswith("KF-CONT ")]
+    assert lines == [["KF-CONT", name, "7", "true", "true"] for name in ("staircase", "questplus", "constant")], \
+        out[-3000:]
+    parted = [line for line in out.splitlines() if line.startswith("KF-PART ")]
+    assert len(parted) == 3 and all("trial 4 was stored at level 0.123" in p for p in parted), parted
