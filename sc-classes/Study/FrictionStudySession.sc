@@ -22,7 +22,7 @@ FrictionStudySession {
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
 	var buttonsSynth, buttonsResponder;
-	var routine, lastAnswerT, watchId, experiment, sessionTimeOffsetS = 0;
+	var routine, lastAnswerT, watchTickT, watchId, experiment, sessionTimeOffsetS = 0;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -112,6 +112,7 @@ FrictionStudySession {
 	// Starts the session (a new one; resume starts itself).
 	start {
 		if(state != \ready) { ^this };
+		this.prCheckStimuli;
 		this.prWriteManifest;
 		this.prSessionLog(\start, "");
 		this.prPlay;
@@ -313,6 +314,9 @@ FrictionStudySession {
 			while { lastAnswerT <= endT and: { Main.elapsedTime - endT < lostAfterS } } { 0.005.wait };
 			// No answer (the watch gone with Cmd-., say): the trial is not stored, the session fails.
 			if(lastAnswerT <= endT) { Error("the server did not answer after trial %".format(trial[\trial])).throw };
+			// sclang stood still during the trial (the watch did not tick): its times are not the
+			// participant's; it is not stored, whichever of the two routines runs first after it.
+			this.prStoodStill !? { |reason| this.prLost(reason) };
 			FrictionStudyFiles.appendCsv(folder +/+ "trials.csv", [participant, position + 1, condition.name, attempt]
 				++ #[trial, level, target, answer, correct, startS, interval1S, interval2S, answerS].collect { |k|
 					trial[k] } ++ [FrictionStudyFiles.now], trialsHeader);
@@ -361,31 +365,64 @@ FrictionStudySession {
 	// block, so a server that died, quit, hangs or lost its audio (jackd gone) sends none. With
 	// no answer for lostAfterS the session fails at once (prLost). 3 s: the server's async queue
 	// (a file opened for recording, a SynthDef) holds a /sync back beside it; a false alarm would
-	// end a participant's session, so the bound is far above the round trip (a few ms).
+	// end a participant's session, so the bound is far above the round trip (a few ms). The same
+	// tick finds sclang itself standing still (prStoodStill) and, while a condition runs, a
+	// device whose slot closed (prWatchDevice).
 	prWatch {
-		var answered;
+		var answered, deviceStatus;
 		watchId = UniqueID.next;
-		lastAnswerT = Main.elapsedTime;
+		lastAnswerT = watchTickT = Main.elapsedTime;
 		answered = OSCFunc({ lastAnswerT = Main.elapsedTime }, '/synced', server.addr, argTemplate: [watchId]);
+		// A /kfStatus reply (index, then FrictionDevice.statusFields: open first) for the device the
+		// condition runs on, saying it is closed. Not in force between conditions (state is not
+		// running: a simulated participant's device is closed on purpose then).
+		deviceStatus = OSCFunc({ |msg|
+			var polled = conditionDevice;
+			if(state == \running and: { polled.notNil } and: { msg[2] == polled.index } and: { msg[3] == 0 }) {
+				this.prLost("the device % closed under the session".format(polled))
+			}
+		}, '/kfStatus', server.addr);
 		Routine {
 			while { this.isOver.not } {
 				server.sendMsg('/sync', watchId);
 				0.25.wait;
-				if(Main.elapsedTime - lastAnswerT > lostAfterS) {
-					this.prLost("the server % stopped answering (no /synced for % s)".format(server.name,
-						(Main.elapsedTime - lastAnswerT).round(0.01)))
-				}
+				case
+					{ this.prStoodStill.notNil } { this.prLost(this.prStoodStill) }
+					{ Main.elapsedTime - lastAnswerT > lostAfterS } {
+						this.prLost("the server % stopped answering (no /synced for % s)".format(server.name,
+							(Main.elapsedTime - lastAnswerT).round(0.01)))
+					}
+					{ this.prWatchDevice };
+				watchTickT = Main.elapsedTime;
 			};
 			answered.free;
+			deviceStatus.free;
 		}.play(AppClock);
 	}
 
-	// The instrument is gone: the session's routine, which may be waiting on that server, stops;
-	// the session fails with the reason in session.csv, the condition's events and the post
-	// window. What was stored stays; the trial in flight is not stored.
+	// A reason if the watch's 0.25 s tick came more than lostAfterS late: sclang did not run
+	// meanwhile (the computer slept, sclang was stopped). The participant's times and the trial
+	// in flight cannot be trusted; the server's answers, which did not come, would be blamed.
+	prStoodStill {
+		var still = Main.elapsedTime - watchTickT;
+		^if(still > (lostAfterS + 0.25)) {
+			"sclang stood still for % s (the computer asleep, or sclang stopped)".format(still.round(0.01))
+		}
+	}
+
+	// While a condition runs, the device it plays on must stay open: its slot closed (kfClose, a
+	// failed reopen, another client) fails the session. Its status is asked each tick, the reply
+	// read by prWatch's responder (not FrictionAnswers': a dead server's time-out would post).
+	prWatchDevice {
+		if(state == \running and: { conditionDevice.notNil }) { server.listSendMsg(conditionDevice.statusMsg(false)) }
+	}
+
+	// The instrument is gone: the session fails with the reason in session.csv, the condition's
+	// events and the post window, and its routine, which may be waiting on that server, stops
+	// (last: called from inside that routine, its stop does not return). What was stored stays;
+	// the trial in flight is not stored.
 	prLost { |reason|
 		if(this.isOver) { ^this };
-		routine.stop;
 		state = \failed;
 		this.log(\lost, reason);
 		this.prSessionLog(\error, reason);
@@ -394,6 +431,7 @@ FrictionStudySession {
 		experimenterWindow !? { experimenterWindow.refresh };
 		onEnd.value(this);
 		this.prFreeAfterFailure;  // a server that still runs (jackd gone, a hang) plays on otherwise
+		routine.stop;
 	}
 
 	// A session that failed frees what its condition started: the experiment's stimulus and
@@ -536,6 +574,21 @@ FrictionStudySession {
 		^if(File.exists(path)) { File.readAllString(path).interpret[\version] } { "unknown" }
 	}
 
+	// Every threshold condition's stimuli against the device's range before the session starts
+	// (FrictionThreshold.checkRange): a level the device would clamp is refused now, not when its
+	// condition comes. The simulated participant's devices have the paper's specs.
+	prCheckStimuli {
+		var specs = device !? _.specs ?? { FrictionDevice.paperSpecs };
+		order.select(_.isThreshold).do { |c|
+			var experiment = c.makeExperiment.value;
+			if(experiment.respondsTo(\checkRange)) {
+				try { experiment.checkRange(specs, device ? "the simulated device") } { |error|
+					Error("FrictionStudy: condition %: %".format(c.name, error.what)).throw
+				}
+			}
+		}
+	}
+
 	prResume { |manifest|
 		var names = manifest["order"];
 		if(names.size != order.size or: { names.any { |n| study.conditionNamed(n.asSymbol).isNil } }) {
@@ -554,6 +607,7 @@ FrictionStudySession {
 		FrictionStudyFiles.readCsv(folder +/+ "session.csv").last !? { |last|
 			sessionTimeOffsetS = max(0, last[\timeS].asFloat - Main.elapsedTime)
 		};
+		this.prCheckStimuli;
 		this.prSessionLog(\resume, "at % of %".format(position + 1, order.size));
 		this.prPlay;
 	}

@@ -83,7 +83,7 @@ FrictionThreshold {
 			Error("%: answers must be \\keys, \\buttons or a FrictionObserver, got %".format(where, answers)).throw
 		};
 		server = FrictionCheck.serverRunning(device.server, where);
-		this.prCheckForces(device, procedure.tryPerform(\levelRange) ? []);
+		this.checkRange(device.specs, device);
 		def = FrictionThresholdStimuli.synthDef(kind, device, settings).add;
 		if(kind == \asynchrony) {
 			// The signal is sent in parts: the run starts once all of it is on the server.
@@ -100,7 +100,7 @@ FrictionThreshold {
 		protect { while { (level = procedure.next).notNil } {
 			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
 				target: target, startS: thisThread.seconds - startS);
-			this.prCheckForces(device, [level]);
+			this.prCheckForces(device.specs, [level], device);
 			[1, 2].do { |interval|
 				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
 				server.bind { runSynth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
@@ -147,14 +147,19 @@ FrictionThreshold {
 
 	// The force experiment's reference and targets must be forces the device renders: one outside
 	// its minForceN..maxForceN would be clamped, and both intervals could hold the same force.
-	// Checked before the first trial for every level the procedure can name (its levelRange;
-	// infinite ends are left to the trials), and before each trial for its level. An Error with
-	// the reason.
-	prCheckForces { |device, levels|
+	// checkRange checks every level the procedure can name (its levelRange; infinite ends are left
+	// to the trials) against specs (a device's; FrictionDevice.paperSpecs for a simulated one):
+	// run does before the first trial, a study session for each threshold condition when it
+	// starts. run checks each trial's level too. An Error with the reason; what: the device named.
+	checkRange { |specs, what = "the device"|
+		this.prCheckForces(specs, procedure.tryPerform(\levelRange) ? [], what)
+	}
+
+	prCheckForces { |specs, levels, device|
 		var lo, hi, base = settings[\baseForceN];
 		if(kind != \force) { ^this };
-		lo = device.specs[\minForceN];
-		hi = device.specs[\maxForceN];
+		lo = specs[\minForceN];
+		hi = specs[\maxForceN];
 		([0] ++ levels.reject { |l| l.abs == inf }).do { |level|
 			var force = base + level;
 			if(force.isNaN or: { force < (lo - 1e-9) } or: { force > (hi + 1e-9) }) {

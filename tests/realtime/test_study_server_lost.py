@@ -1,7 +1,9 @@
-"""A study session whose server dies (kill -9 of scsynth, or of jackd: the server's audio stops,
-mid-threshold-condition) fails at once:
+"""A study session whose instrument is gone mid-threshold-condition fails at once: its server dies
+(kill -9 of scsynth, or of jackd: the server's audio stops), its device's slot is closed under it,
+or sclang itself stands still (stopped by SIGSTOP for 5 s, as a computer that slept). Checked:
 the session's state, its reason in session.csv and the condition's events, and no trial stored
-after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS)."""
+after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS; the
+device's status each tick; the watch's own tick late by more than lostAfterS)."""
 import shutil
 
 import pytest
@@ -19,8 +21,7 @@ study = FrictionStudy("lost", [
 session = study.run("L1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
 session.onEnd = { overT = Main.elapsedTime; atOver = rows.value };
 while { rows.value < 3 } { 0.01.wait };
-("kill -9 " ++ @VICTIM@).systemCmd;
-killT = Main.elapsedTime;
+@ACTION@
 atKill = rows.value;
 while { session.isOver.not and: { Main.elapsedTime - killT < 30 } } { 0.05.wait };
 3.wait;  // what a session that went on would store meanwhile: a trial every 0.4 s
@@ -32,25 +33,48 @@ later = rows.value;
 """
 
 
-@pytest.mark.parametrize("victim", ["scsynth", "jackd"])
+STOPPED_S = 5  # how long sclang is stopped (SIGSTOP, then SIGCONT)
+ACTIONS = {
+    "scsynth": '("kill -9 " ++ s.pid).systemCmd;\nkillT = Main.elapsedTime;',
+    "jackd": '("kill -9 " ++ @JACKD@).systemCmd;\nkillT = Main.elapsedTime;',
+    # Its slot closed as another client (or a failed reopen) would close it.
+    "device": "s.sendMsg('/cmd', \\kfClose, 0);\nkillT = Main.elapsedTime;",
+    # The shell stops sclang, waits, and lets it go on: sclang's clock runs on meanwhile.
+    "sclang": 'killT = Main.elapsedTime;\n"kill -STOP %; sleep @STOPPED@; kill -CONT %".format(thisProcess.pid, '
+              'thisProcess.pid).systemCmd;',
+}
+REASONS = {"scsynth": "stopped answering", "jackd": "stopped answering", "device": "closed under the session",
+           "sclang": "sclang stood still"}
+
+
+@pytest.mark.parametrize("victim", list(ACTIONS))
 def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack, victim):
     root = paths.work_dir() / f"study-server-lost-{victim}"
     shutil.rmtree(root, ignore_errors=True)
-    pid = "s.pid" if victim == "scsynth" else str(jack.proc.pid)
-    run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root)), VICTIM=pid), jack, timeout=90,
-                                 name="study-server-lost", server_options={"numOutputBusChannels": 4})
+    action = sclang.fill(ACTIONS[victim], JACKD=jack.proc.pid, STOPPED=STOPPED_S)
+    run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root)), ACTION=action), jack,
+                                 timeout=90, name="study-server-lost", server_options={"numOutputBusChannels": 4})
     assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]
     lost_after_s = float(run.lines("KF-LOST-AFTER")[0][0])
     death_to_failure_s = float(run.lines("KF-DEATH-TO-FAILURE")[0][0])
     print(f"KF-FIGURE study_{victim}_death_to_session_failure_s {death_to_failure_s:.3f}")
-    # The watch sends a /sync every 0.25 s, on AppClock, and fails the session lostAfterS after
-    # the last answer. That answer came up to 0.25 s (a watch period) before the kill, and the
-    # script notes the kill's time after `kill -9` has returned (its fork and exec: a few ms,
-    # 0.1 s allowed): so the failure comes at least lostAfterS - 0.35 s after that time (a fresh
-    # clone's run: 2.996 s after it, lostAfterS 3). At most lostAfterS + 0.25 s, plus the time
-    # its routine waits for the CPU (beside two CPU hogs at normal priority, tens of ms); 1 s of
-    # room covers that with margin.
-    assert lost_after_s - 0.35 <= death_to_failure_s <= lost_after_s + 1.0
+    if victim == "device":
+        # Found at the next tick's status reply: within a tick (0.25 s) and a round trip, plus the
+        # routine's wait for the CPU beside two hogs (tens of ms); 1 s of room.
+        assert 0 <= death_to_failure_s <= 1.0
+    elif victim == "sclang":
+        # Found at the first tick after sclang goes on (at most a tick, 0.25 s), or by the trial
+        # in flight, whichever runs first; the same 1 s of room for the CPU.
+        assert STOPPED_S <= death_to_failure_s <= STOPPED_S + 1.0
+    else:
+        # The watch sends a /sync every 0.25 s, on AppClock, and fails the session lostAfterS after
+        # the last answer. That answer came up to 0.25 s (a watch period) before the kill, and the
+        # script notes the kill's time after `kill -9` has returned (its fork and exec: a few ms,
+        # 0.1 s allowed): so the failure comes at least lostAfterS - 0.35 s after that time (a
+        # fresh clone's run: 2.996 s after it, lostAfterS 3). At most lostAfterS + 0.25 s, plus
+        # the time its routine waits for the CPU (beside two CPU hogs at normal priority, tens of
+        # ms); 1 s of room covers that with margin.
+        assert lost_after_s - 0.35 <= death_to_failure_s <= lost_after_s + 1.0
     at_kill, at_over, later = (int(n) for n in run.lines("KF-ROWS")[0])
     # At most the trial whose store (after its /synced) crossed the kill; nothing after the failure
     # (the old session stored a trial every 0.4 s until the end).
@@ -58,7 +82,7 @@ def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jac
     folder = root / "L1"
     assert len(read_csv(folder / "trials.csv")) == later
     session = read_csv(folder / "session.csv")
-    assert session[-1]["event"] == "error" and "stopped answering" in session[-1]["detail"], session
+    assert session[-1]["event"] == "error" and REASONS[victim] in session[-1]["detail"], session
     events = [e["event"] for e in read_csv(folder / "01-forceStep" / "events.csv")]
     assert events[-1] == "lost" and "done" not in events and "estimate" not in events, events
     assert "the session failed" in run.output

@@ -90,3 +90,40 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
     assert counts["n_correct"].sum() == right
     assert list(tables["participants.tsv"]["participant_id"]) == ["sub-T1"]
     assert json.loads((root / "report" / "bids" / "dataset_description.json").read_text())["BIDSVersion"] == "1.9.0"
+
+
+REFUSALS = r"""
+var root = @ROOT@, sim = FrictionStudySimParticipant(4, 2), study, refused = { |tag, make|
+	var study = FrictionStudy("stimuli", [FrictionStudyCondition(\first, (mapping: \mapping1), "Explore.", [], 60),
+		FrictionStudyCondition.threshold(\forceStep, make, "Which?", [], 60, \keys,
+			{ |seed| FrictionObserver(0.1, seed: seed) })]);
+	try { study.run(tag.asString, root, s, simulated: sim, windows: false); "KF-ACCEPTED %".format(tag).postln }
+	{ |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
+};
+refused.(\unrenderable, { FrictionThreshold.force(FrictionConstantStimuli([0.05, 2]), 0.3) });
+refused.(\negativeBase, { FrictionThreshold.force(FrictionStaircase(0.1), -0.3) });
+refused.(\nanInterval, { FrictionThreshold.force(FrictionStaircase(0.1), 0.3, 0/0) });
+"""
+
+
+def test_stimuli_the_device_cannot_render_are_refused_before_the_session_starts(jack):
+    """A threshold condition whose levels or base force lie outside the (simulated) device's
+    0.14-1.4 N, or whose interval is NaN, second in the order: the session is refused when it is
+    run, with the reason, before its first condition (nothing written but the empty folder)."""
+    root = paths.work_dir() / "study-refused-stimuli"
+    shutil.rmtree(root, ignore_errors=True)
+    run = sclang.require_ok(sclang.run_with_server(
+        sclang.fill(REFUSALS, ROOT=sclang.sc_string(str(root))), jack, timeout=60, name="study-refused-stimuli",
+        server_options={"numOutputBusChannels": 4}))
+    assert not run.lines("KF-ACCEPTED"), run.output[-3000:]
+    refused = {fields[0]: " ".join(fields[1:]) for fields in run.lines("KF-REFUSED")}
+    expected = {
+        "unrenderable": "condition forceStep: FrictionThreshold.force: 2.3 N (the reference 0.3 N + the level 2) "
+                        "is outside the 0.14 N to 1.4 N that the simulated device renders",
+        "negativeBase": "-0.3 N (the reference -0.3 N + the level 0)",
+        "nanInterval": "intervalS must be a finite number",
+    }
+    for tag, words in expected.items():
+        assert words in refused.get(tag, ""), (tag, refused.get(tag), run.output[-3000:])
+    for tag in expected:
+        assert not any((root / tag).iterdir()), f"{tag}: the refused session wrote {list((root / tag).iterdir())}"
