@@ -277,6 +277,13 @@ bool parseCommandArgs(CommandShape shape, OscArgReader& args, int numSlots, Comm
       out.numbers[0] = 1.0;
       return (args.atEnd() || readWhole(args, 0.0, 1.0, "post", out.numbers[0], error, errorSize)) &&
              noneLeft(args, error, errorSize);
+    case CommandShape::kHeartbeat:
+      out.numbers[0] = -1.0;
+      if (args.atEnd()) return true;
+      if (!args.readNumber(out.numbers[0])) return fail(error, errorSize, "timeoutS: %s", describe(args));
+      if (!(out.numbers[0] >= 0.0 && out.numbers[0] <= 3600.0))
+        return fail(error, errorSize, "timeoutS = %g is out of range 0..3600 s", shown(out.numbers[0]));
+      return noneLeft(args, error, errorSize);
     case CommandShape::kPosition:
       out.positionMm[0] = out.positionMm[1] = 0.0;
       for (int axis = 0; axis < 2 && !args.atEnd(); ++axis) {

@@ -59,6 +59,7 @@ enum class CommandShape {
   kListMice,    // backend answerPath (no index)
   kBoardOpen,   // index serial emulate(0/1) inFlight(1..4)
   kFlag,        // index flag(0/1)
+  kHeartbeat,   // kfHeartbeat: index [timeoutS (0 no watch, up to 3600)]
 };
 
 struct CommandArgs {
@@ -73,7 +74,8 @@ struct CommandArgs {
   double positionMm[2] = {0.0, 0.0};  // kPosition: x, y
   char which[kMaxPathChars];          // kOpenMouse: the mouse selector ("" the first)
   char backend[kMaxKeyChars];         // kOpenMouse, kListMice: "hidapi", "evdev" ("" default)
-  double numbers[2] = {0.0, 0.0};     // kBoardOpen: emulate, inFlight; kFlag, kStatus: the flag
+  double numbers[2] = {0.0, 0.0};     // kBoardOpen: emulate, inFlight; kFlag, kStatus: the flag;
+                                      // kHeartbeat: the timeout (-1 when not given)
 };
 
 // Storage for `count` hand script values (RTAlloc in the plugin); null: out of memory.

@@ -16,6 +16,9 @@
 //   kfClose      index
 //   kfZero       index [xMm yMm]   (the puck's latest reported position becomes (x, y), 0 by
 //                                   default, for every reader, from the next block on)
+//   kfHeartbeat  index [timeoutS]  (the client is alive; with timeoutS, the device's client watch
+//                                   is set: magnet off once no heartbeat came for timeoutS, 0 no
+//                                   watch; Device::watchClient)
 //
 // Replies follow the server's conventions (CommandRunner.hpp): `/done cmdName` when a command
 // succeeded; when it failed, no /done but `/kfFail` to the notified clients, and the reason is
@@ -319,6 +322,26 @@ void zeroCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   run(world, replyAddr, data, nrtHop, rtNothing, nrtHop);
 }
 
+// --- kfHeartbeat ---------------------------------------------------------------------------
+
+bool heartbeatStage(World*, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->device == nullptr) {
+    failWith(data, "kfHeartbeat: no device is open at index %d", data->args.index);
+    return false;
+  }
+  if (data->args.numbers[0] >= 0.0)
+    data->device->watchClient(data->args.numbers[0]);
+  else
+    data->device->heartbeat();
+  return true;
+}
+
+void heartbeatCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  CommandData* data = newCommand(world, "kfHeartbeat", CommandShape::kHeartbeat, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, heartbeatStage);
+}
+
 }  // namespace
 
 void registerDeviceCommands() {
@@ -330,4 +353,5 @@ void registerDeviceCommands() {
   DefinePlugInCmd("kfStatus", statusCmd, nullptr);
   DefinePlugInCmd("kfClose", closeCmd, nullptr);
   DefinePlugInCmd("kfZero", zeroCmd, nullptr);
+  DefinePlugInCmd("kfHeartbeat", heartbeatCmd, nullptr);
 }

@@ -219,7 +219,14 @@ void Device::pumpLocked(double nowS, double scheduledS) {
   if (!(nowS > lastPumpS_)) return;
 
   if (offRequested_.exchange(false, std::memory_order_acq_rel)) applyOffRequestLocked(nowS, OffCause::kStop);
-  if (lockstep_) {
+  // A silent watched client: the frames its orphaned synths still send go nowhere, and
+  // nothing is recorded after the off.
+  const bool clientSilent = !lockstep_ && clientSilentLocked(nowS);
+  if (clientSilent) {
+    ForceFrame dropped;
+    while (frameQueue_.pop(dropped)) {
+    }
+  } else if (lockstep_) {
     ForceFrame frame;  // only frames whose push found the state busy
     while (frameQueue_.pop(frame)) applyLockstepFrameLocked(frame, nowS);
   } else {
@@ -231,7 +238,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
   }
   // Frames still waiting in the jitter buffer are coming: no trip while there are any, so a
   // long audio period does not make the watchdog chatter.
-  if (pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
+  if (!clientSilent && pendingCount_ == 0 && safety_.checkWatchdog(nowS)) {
     force_->driveOff();
     if (board_) board_->driveOff();
     telemetry_.countWatchdogTrip();
@@ -249,7 +256,7 @@ void Device::pumpLocked(double nowS, double scheduledS) {
       pollBuffer_[i].xCounts = xCounts_;
       pollBuffer_[i].yCounts = yCounts_;
       telemetry_.countReport(pollBuffer_[i].deviceTimeS);
-      recorder_.writeReport(nowS, pollBuffer_[i]);
+      if (!clientSilent) recorder_.writeReport(nowS, pollBuffer_[i]);
       reportQueue_.push(pollBuffer_[i]);  // a full queue counts the overflow
     }
   } while (polled == kPollBatch);
@@ -258,6 +265,22 @@ void Device::pumpLocked(double nowS, double scheduledS) {
   lastPumpS_ = nowS;
   lastPumpAtomicS_.store(nowS, std::memory_order_relaxed);
   telemetry_.countPump();
+}
+
+void Device::watchClient(double timeoutS) {
+  heartbeat();
+  clientTimeoutS_.store(timeoutS > 0.0 ? timeoutS : 0.0, std::memory_order_release);
+}
+
+bool Device::clientSilentLocked(double nowS) {
+  const double timeoutS = clientTimeoutS_.load(std::memory_order_acquire);
+  const bool silent = timeoutS > 0.0 && nowS - lastHeartbeatS_.load(std::memory_order_acquire) > timeoutS;
+  if (!silent) {
+    clientSilent_.store(false, std::memory_order_release);
+    return false;
+  }
+  if (!clientSilent_.exchange(true, std::memory_order_acq_rel)) applyOffRequestLocked(nowS, OffCause::kClient);
+  return true;
 }
 
 void Device::requestOff() {

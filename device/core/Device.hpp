@@ -111,6 +111,17 @@ class Device {
   // Why the last recording stopped by itself (a write error, also posted), or empty.
   std::string recordingError();
 
+  // The client watch (realtime only; a study session's sclang keeps it alive): once no
+  // heartbeat() has come for timeoutS of device time, the next pump drives the magnet off,
+  // drops the frames still coming and records the off (cause "client") as the recording's last
+  // line; nothing more is recorded or driven while the client stays silent. A heartbeat brings
+  // both back. timeoutS 0: no watch (the default: a live coder's synths play on without sclang,
+  // as SC's servers do). From a non-realtime thread; heartbeat() from any thread, never waits.
+  void watchClient(double timeoutS);
+  void heartbeat() { lastHeartbeatS_.store(nowS(), std::memory_order_release); }
+  // The watched client has been silent past its timeout (the magnet held off).
+  bool clientSilent() const { return clientSilent_.load(std::memory_order_acquire); }
+
   // Async-signal-safe, from any thread (the handlers of host/ExitSafety.cpp): drives the
   // magnet off without a lock and appends an off record to the recording; no pump runs after
   // it (one under way on another thread is waited for, at most 50 ms). The process is on its
@@ -149,6 +160,9 @@ class Device {
   // requestOff() in the pump (and haltInOrder): the frames not sent dropped, the magnet off, the
   // off recorded with its cause.
   void applyOffRequestLocked(double nowS, OffCause cause);
+  // The client watch in the pump: true while the watched client is silent (nothing driven or
+  // recorded); the off and its record once, as it falls silent.
+  bool clientSilentLocked(double nowS);
   // Hands the recording's new lines to its writer; a recording that failed is posted, once.
   void flushRecordingLocked();
   void threadMain();
@@ -198,6 +212,9 @@ class Device {
   ThreadSchedulingCell threadScheduling_;
   bool memoryLocked_ = false;  // the device's own memory, by start()
   std::atomic<bool> stopRequested_{false};
+  std::atomic<double> clientTimeoutS_{0.0};  // watchClient's; 0 no watch
+  std::atomic<double> lastHeartbeatS_{0.0};  // device time of the last heartbeat()
+  std::atomic<bool> clientSilent_{false};
   std::atomic<bool> offRequested_{false};  // requestOff()
   std::atomic<bool> closed_{false};
   // emergencyOff() and haltInOrder(): no pump runs any more (halted_), and none is under way (pumping_).

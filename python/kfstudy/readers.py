@@ -42,7 +42,7 @@ def read_session(path):
 class Session:
     """A kf-session file as arrays: `reports` (R: hostTimeS deviceTimeS dxCounts dyCounts buttons
     flags), `frames` (F: hostTimeS frameTimeS requestedForceN commandedForceN), `offs` (O times) and
-    `off_causes` (why each: stop, quit, close, watchdog, failure, signal)."""
+    `off_causes` (why each: stop, quit, close, watchdog, failure, signal, client)."""
 
     def __init__(self, path):
         self.header, records = read_session(path)

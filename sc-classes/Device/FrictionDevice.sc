@@ -16,6 +16,8 @@ FrictionDevice {
 	var <boardSetup;
 	// The audio drive (extFrictionDeviceDrive.sc): (path:, circuitLatencyS:) once loaded, else nil.
 	var <driveSetup;
+	// watchClient's: the Routine sending the heartbeats, and its timeout (s; 0 no watch).
+	var heartbeat, <clientTimeoutS = 0;
 
 	*initClass {
 		// The names specs had before every name carried its unit. A user may have typed them, so
@@ -209,6 +211,30 @@ FrictionDevice {
 	}
 	closeMsg { ^['/cmd', \kfClose, index] }
 
+	// The client watch: the server turns this device's force off (the magnet off, the off the
+	// recording's last line until sclang is heard again) once sclang has sent no heartbeat for
+	// timeoutS, as when sclang crashed or was killed with the synths still playing. sclang sends
+	// one every timeoutS / 4 from now on (SystemClock), until watchClient(0), the device closes,
+	// or Cmd-. stops the heartbeats' Routine (so Cmd-. also turns the force off, timeoutS later).
+	// Off by default: SC's servers play on without their client, as a live coder may want. A
+	// study session turns it on for its devices (FrictionStudySession.clientTimeoutS).
+	watchClient { |timeoutS = 2|
+		var where = "FrictionDevice.watchClient";
+		FrictionCheck.finite(timeoutS, "timeoutS", where);
+		if(timeoutS < 0 or: { timeoutS > 3600 }) { Error("%: timeoutS must be 0 to 3600 s, got %".format(where,
+			timeoutS)).throw };
+		if(this.isOpen.not) { Error("%: % is not open".format(where, this)).throw };
+		heartbeat !? _.stop;
+		heartbeat = nil;
+		clientTimeoutS = timeoutS;
+		server.listSendMsg(['/cmd', \kfHeartbeat, index, timeoutS.asFloat]);
+		if(timeoutS > 0) {
+			heartbeat = Routine {
+				loop { (timeoutS / 4).wait; server.listSendMsg(['/cmd', \kfHeartbeat, index]) }
+			}.play(SystemClock)
+		}
+	}
+
 	printOn { |stream| stream << this.class.name << "(" << kind << ", " << index << ")" }
 
 	// A device stands for its slot wherever a UGen input or a synth argument wants one, as a
@@ -306,6 +332,9 @@ FrictionDevice {
 
 	prForget { |newState|
 		var held = slots[server], holdsBuses = state != \quit;
+		heartbeat !? _.stop;
+		heartbeat = nil;
+		clientTimeoutS = 0;
 		if(held.notNil and: { held[index] === this }) { held[index] = nil };
 		state = newState;
 		// A node may be gone already (s.freeAll just before): freed without the server's complaint.
@@ -390,6 +419,8 @@ FrictionDevice {
 		FrictionAnswers.sendSequence(server, index, this.prOpenSteps, {
 			state = \open;
 			this.prStartBusSynths;
+			// The new server's device has no client watch: given again (the heartbeats went on).
+			if(clientTimeoutS > 0) { this.watchClient(clientTimeoutS) };
 		}, { |reason, step|
 			this.prForget(\failed);
 			this.prUndoOpen(step)

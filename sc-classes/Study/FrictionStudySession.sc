@@ -15,6 +15,9 @@ FrictionStudySession {
 	classvar <answersHeader, <eventsHeader, <trialsHeader;
 	// A server that has not answered a /sync for this long (s) is lost: the session fails.
 	classvar <>lostAfterS = 3;
+	// The client watch of the devices a session plays on (FrictionDevice.watchClient): a server
+	// that has not heard this sclang for this long (s) turns the force off. 0: no watch.
+	classvar <>clientTimeoutS = 2;
 	var <study, <participant, <folder, <server, <participantIndex, <seed, <device, <simulated, <windows;
 	var <participantOut, <experimenterOut, <deviceIndex;
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
@@ -22,7 +25,7 @@ FrictionStudySession {
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
 	var buttonsSynth, buttonsResponder;
-	var routine, lastAnswerT, watchTickT, watchId, experiment, sessionTimeOffsetS = 0;
+	var routine, lastAnswerT, watchTickT, watchId, experiment, sessionTimeOffsetS = 0, deviceTimeoutBefore;
 
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
@@ -133,6 +136,7 @@ FrictionStudySession {
 	// ---- the run ----
 
 	prPlay {
+		deviceTimeoutBefore = device !? _.clientTimeoutS;
 		routine = Routine {
 			var result;
 			try {
@@ -163,6 +167,7 @@ FrictionStudySession {
 				error.reportError;
 				this.prFreeAfterFailure;
 			};
+			this.prReleaseDevice;
 			participantWindow !? { participantWindow.showEnd };
 			experimenterWindow !? { experimenterWindow.refresh };
 			onEnd.value(this);
@@ -193,6 +198,7 @@ FrictionStudySession {
 		} { device };
 		conditionDevice.record(conditionDir +/+ "device.kfsession");
 		this.log(\recordDevice);
+		if(clientTimeoutS > 0) { conditionDevice.watchClient(clientTimeoutS) };
 		if(condition.isThreshold) { ^this.prRunThreshold };
 		pilot = FrictionPilot(conditionDevice, s[\mapping], s[\friction], s[\origin], if(s[\audio]) { s[\amp] } { 0 },
 			participantOut);
@@ -431,6 +437,7 @@ FrictionStudySession {
 		experimenterWindow !? { experimenterWindow.refresh };
 		onEnd.value(this);
 		this.prFreeAfterFailure;  // a server that still runs (jackd gone, a hang) plays on otherwise
+		this.prReleaseDevice;
 		routine.stop;
 	}
 
@@ -454,6 +461,12 @@ FrictionStudySession {
 				}
 			}
 		}.defer
+	}
+
+	// A person's device gets back the client watch it had before the session (the session gave
+	// it clientTimeoutS for each condition).
+	prReleaseDevice {
+		device !? { if(device.isOpen and: { server.serverRunning }) { device.watchClient(deviceTimeoutBefore) } }
 	}
 
 	// Ends the condition's audio.wav. Recorder.stopRecording frees its DiskOut and closes the file

@@ -19,7 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<char> message(data, data + size);
   using kf::sc::CommandShape;
   for (CommandShape shape : {CommandShape::kIndex, CommandShape::kStatus, CommandShape::kOpenSim,
-                             CommandShape::kOpenReplay, CommandShape::kRecord}) {
+                             CommandShape::kOpenReplay, CommandShape::kRecord, CommandShape::kHeartbeat}) {
     kf::sc::OscArgReader reader = kf::sc::OscArgReader::fromMessage(message.data(), message.size());
     kf::sc::CommandArgs args;
     char error[200];

@@ -147,6 +147,20 @@ TEST_CASE("kfStatus posts by default, post 0 asks for the figures only", "[comma
   CHECK(contains(parse(CommandShape::kStatus, Message().i(2).i(0).i(0).bytes()).error, "unexpected argument 3"));
 }
 
+TEST_CASE("kfHeartbeat: a beat alone, or the client watch's timeout in s (0 none)", "[commands]") {
+  Parsed beat = parse(CommandShape::kHeartbeat, Message().i(1).bytes());
+  REQUIRE(beat.ok);
+  CHECK(beat.args.numbers[0] == -1.0);
+  Parsed watch = parse(CommandShape::kHeartbeat, Message().i(1).f(2.5f).bytes());
+  REQUIRE(watch.ok);
+  CHECK(watch.args.numbers[0] == 2.5);
+  CHECK(parse(CommandShape::kHeartbeat, Message().i(1).i(0).bytes()).args.numbers[0] == 0.0);
+  CHECK(contains(parse(CommandShape::kHeartbeat, Message().i(1).f(-1.0f).bytes()).error, "out of range 0..3600"));
+  CHECK_FALSE(parse(CommandShape::kHeartbeat, Message().i(1).f(std::nanf("")).bytes()).ok);
+  CHECK_FALSE(parse(CommandShape::kHeartbeat, Message().i(1).s("2").bytes()).ok);
+  CHECK(contains(parse(CommandShape::kHeartbeat, Message().i(1).i(1).i(1).bytes()).error, "unexpected argument"));
+}
+
 TEST_CASE("hand script counts must match the values sent", "[commands]") {
   // Count 4, two values, then a key: the key used to be eaten as a value.
   Parsed short_ = parse(CommandShape::kOpenSim, Message().i(0).i(0).i(4).f(0.f).f(0.f).s("maxForceN").f(1.f).bytes());

@@ -6,9 +6,11 @@ after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after 
 device's status each tick; the watch's own tick late by more than lostAfterS)."""
 import shutil
 
+import numpy as np
 import pytest
 
 from kfharness import paths, sclang
+from kfstudy import readers
 from kfstudy.session_folder import read_csv
 
 SCRIPT = r"""
@@ -117,3 +119,50 @@ def test_a_failed_session_frees_what_it_started(jack):
     assert run.lines("KF-LEFT") == [["synths", "0", "slot", "nil"]], run.output[-3000:]
     session = read_csv(root / "F1" / "session.csv")
     assert session[-1]["event"] == "error" and "cannot write" in session[-1]["detail"], session
+
+
+SILENT = r"""
+var study, session, path = @ROOT@ +/+ "C1/trials.csv";
+var rows = { if(File.exists(path)) { File.readAllString(path).split($\n).reject(_.isEmpty).size - 1 } { 0 } };
+study = FrictionStudy("silent", [
+	FrictionStudyCondition.threshold(\forceStep, {
+		FrictionThreshold.force(FrictionConstantStimuli([0.3, 0.5], 20, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
+session = study.run("C1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
+while { rows.value < 2 } { 0.01.wait };
+"KF-TIMEOUT %".format(FrictionStudySession.clientTimeoutS).postln;
+// sclang falls silent (as a crashed or killed one would), its synths playing on in the server.
+"kill -STOP %; sleep @STOPPED@; kill -CONT %".format(thisProcess.pid, thisProcess.pid).systemCmd;
+while { session.isOver.not } { 0.05.wait };
+"KF-STATE %".format(session.state).postln;
+"""
+
+
+def test_a_silent_client_turns_the_force_off(jack):
+    """sclang stopped (SIGSTOP) for 4 s mid-threshold-condition, its stimulus synth holding the 0.3 N
+    reference (or a target) it was last told to: the server turns the magnet off once no heartbeat has
+    come for clientTimeoutS (the off's cause "client" in the device recording), and records and
+    drives nothing more until sclang is heard again (the old server held the force for as long as
+    it ran)."""
+    root = paths.work_dir() / "study-silent-client"
+    shutil.rmtree(root, ignore_errors=True)
+    stopped_s = 4
+    run = sclang.run_with_server(sclang.fill(SILENT, ROOT=sclang.sc_string(str(root)), STOPPED=stopped_s), jack,
+                                 timeout=90, name="study-silent-client", server_options={"numOutputBusChannels": 4})
+    assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]  # it stood still (the test above)
+    timeout_s = float(run.lines("KF-TIMEOUT")[0][0])
+    recording = readers.Session(root / "C1" / "01-forceStep" / "device.kfsession")
+    assert "client" in recording.off_causes, recording.off_causes
+    off_s = recording.offs[recording.off_causes.index("client")]
+    frames, reports = recording.frames, recording.reports
+    before = frames[(frames[:, 0] > off_s - 1.0) & (frames[:, 0] < off_s)]
+    # The magnet was driven up to the off (the stimulus played on while sclang was stopped), at
+    # the reference or more: above the 0.14 N of the magnet off.
+    assert len(before) > 900 and before[:, 3].min() >= 0.3 - 1e-6, before[:, 3].min() if len(before) else None
+    # Nothing recorded after the off until sclang was heard again. The stop came at most a
+    # heartbeat period (timeout / 4) after the last heartbeat, the off timeout after it, and the
+    # first heartbeat after the stop ends it: so the quiet lasts at least stopped - timeout s.
+    after = np.concatenate([frames[frames[:, 0] > off_s, 0], reports[reports[:, 0] > off_s, 0]])
+    quiet_s = (after.min() if len(after) else np.inf) - off_s
+    print(f"KF-FIGURE study_silent_client_quiet_s {quiet_s:.3f}")
+    assert quiet_s >= stopped_s - timeout_s - 0.05, quiet_s

@@ -133,6 +133,8 @@ const char* offCauseName(OffCause cause) {
       return "failure";
     case OffCause::kSignal:
       return "signal";
+    case OffCause::kClient:
+      return "client";
   }
   return "unknown";
 }

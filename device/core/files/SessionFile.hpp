@@ -39,6 +39,7 @@ enum class OffCause {
   kWatchdog,  // frames stopped without a stop
   kFailure,   // the device thread failed (a backend threw)
   kSignal,    // the server ended on a signal (the signal handler's record)
+  kClient,    // the client that watched the device fell silent (Device::watchClient)
 };
 const char* offCauseName(OffCause cause);
 
