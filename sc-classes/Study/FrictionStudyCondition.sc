@@ -23,15 +23,19 @@ FrictionStudyCondition {
 		^super.newCopyArgs(name, scene, instruction, questions ? [], maxTimeS).prCheck
 	}
 
-	// A threshold condition: makeExperiment.value gives an object that runs inside a Routine with
-	// run(device, answers, onTrial, onEnd, out) (FrictionThreshold: a procedure's trials, each
-	// passed to onTrial as an Event) and returns the estimate. answers: \keys or \buttons for a
-	// person; makeObserver.value(seed): the answers of a simulated participant (FrictionObserver);
-	// nil: the simulated participant's own observer for the experiment's kind (observerFor).
+	// A threshold condition: makeExperiment.value gives a new FrictionThreshold for each run (made
+	// once here too, so that a Function giving anything else is refused when the study is made).
+	// answers: \keys or \buttons for a person; makeObserver.value(seed): the answers of a
+	// simulated participant (FrictionObserver); nil: the simulated participant's own observer for
+	// the experiment's kind (observerFor).
 	*threshold { |name, makeExperiment, instruction = "", questions, maxTimeS = 1800, answers = \keys, makeObserver|
 		var c = this.new(name, (mapping: \mapping2, surfaceMm: 40), instruction, questions, maxTimeS);
 		if(makeExperiment.isFunction.not) {
 			Error("FrictionStudyCondition.threshold(%): makeExperiment must be a Function".format(name)).throw
+		};
+		makeExperiment.value.isKindOf(FrictionThreshold).not.if {
+			Error("FrictionStudyCondition.threshold(%): makeExperiment must give a FrictionThreshold, got %".format(
+				name, makeExperiment.value)).throw
 		};
 		if(answers != \keys and: { answers != \buttons }) {
 			Error("FrictionStudyCondition.threshold(%): answers must be \\keys or \\buttons, got %".format(name,
@@ -65,7 +69,7 @@ FrictionStudyCondition {
 	asEvent {
 		^(name: name, scene: this.settings, areaMm: this.areaMm, instruction: instruction, maxTimeS: maxTimeS,
 			questions: questions.collect(_.asEvent), threshold: this.isThreshold, answers: answers,
-			experiment: makeExperiment !? { |make| make.value.tryPerform(\asEvent) })
+			experiment: makeExperiment !? { |make| make.value.asEvent })
 	}
 
 	printOn { |stream| stream << this.class.name << "(" << name.cs << ")" }

@@ -1,7 +1,7 @@
 // The method of constant stimuli: every level `repeats` times, in a seeded random order; the
 // estimate is the maximum-likelihood Weibull (FrictionPsychometric) over a grid of thresholds,
 // slopes and lapse rates (FrictionPsychometricGrid), fitted to the counts per level.
-FrictionConstantStimuli {
+FrictionConstantStimuli : FrictionProcedure {
 	var <levels, <repeats, <seed, <grid, <order, <trials;
 
 	// levels: the stimulus levels (> 0); grid: a FrictionPsychometricGrid to fit on (nil: 80

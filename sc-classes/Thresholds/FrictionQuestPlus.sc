@@ -4,7 +4,7 @@
 // entropy in it. As Debian's python3-questplus with stim_selection_method 'min_entropy' and
 // param_estimation_method 'mean' (the bench and tests/scenes/test_threshold_procedures.py give
 // both the same answers and compare).
-FrictionQuestPlus {
+FrictionQuestPlus : FrictionProcedure {
 	var <levels, <grid, <maxTrials, <trials;
 	// Per level (Arrays over the grid): p(correct), and p log p + (1 - p) log(1 - p).
 	var correctOf, negEntropyOf;

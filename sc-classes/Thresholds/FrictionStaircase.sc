@@ -5,7 +5,7 @@
 // log10 units, multiplied (\log: level * 10 ^ step). It ends after `reversals` reversals or
 // maxTrials trials; the estimate is the mean of the levels at the last `estimateReversals`
 // reversals (their geometric mean for \log).
-FrictionStaircase {
+FrictionStaircase : FrictionProcedure {
 	var <start, <down, <stepSizes, <stepType, <reversals, <maxTrials, <minLevel, <maxLevel, <estimateReversals;
 	var nextLevel, <trials, <reversalLevels, direction, rightInRow = 0;
 

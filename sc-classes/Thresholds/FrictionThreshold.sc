@@ -41,9 +41,9 @@ FrictionThreshold {
 		if(FrictionThresholdStimuli.kinds.includes(argKind).not) {
 			Error("%: kind must be one of %, got %".format(where, FrictionThresholdStimuli.kinds, argKind)).throw
 		};
-		if(#[next, respond, isFinished, estimate, trials].every { |m| argProcedure.respondsTo(m) }.not) {
-			Error("%: procedure must be a procedure (next, respond, estimate...), got %".format(where,
-				argProcedure)).throw
+		if(argProcedure.isKindOf(FrictionProcedure).not) {
+			Error("%: procedure must be a FrictionProcedure (FrictionStaircase, FrictionQuestPlus, "
+				"FrictionConstantStimuli or a subclass of one's own), got %".format(where, argProcedure)).throw
 		};
 		argSettings.keysValuesDo { |key, value| FrictionCheck.finite(value, key, where) };
 		[\intervalS, argIntervalS, \gapS, argGapS].pairsDo { |name, s|
@@ -152,7 +152,7 @@ FrictionThreshold {
 	// run does before the first trial, a study session for each threshold condition when it
 	// starts. run checks each trial's level too. An Error with the reason; what: the device named.
 	checkRange { |specs, what = "the device"|
-		this.prCheckForces(specs, procedure.tryPerform(\levelRange) ? [], what)
+		this.prCheckForces(specs, procedure.levelRange, what)
 	}
 
 	prCheckForces { |specs, levels, device|

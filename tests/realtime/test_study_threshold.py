@@ -93,23 +93,28 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
 
 
 REFUSALS = r"""
-var root = @ROOT@, sim = FrictionStudySimParticipant(4, 2), study, refused = { |tag, make|
-	var study = FrictionStudy("stimuli", [FrictionStudyCondition(\first, (mapping: \mapping1), "Explore.", [], 60),
-		FrictionStudyCondition.threshold(\forceStep, make, "Which?", [], 60, \keys,
-			{ |seed| FrictionObserver(0.1, seed: seed) })]);
-	try { study.run(tag.asString, root, s, simulated: sim, windows: false); "KF-ACCEPTED %".format(tag).postln }
-	{ |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
+var root = @ROOT@, sim = FrictionStudySimParticipant(4, 2), refused = { |tag, make|
+	try {
+		FrictionStudy("stimuli", [FrictionStudyCondition(\first, (mapping: \mapping1), "Explore.", [], 60),
+			FrictionStudyCondition.threshold(\forceStep, make, "Which?", [], 60, \keys,
+				{ |seed| FrictionObserver(0.1, seed: seed) })]).run(tag.asString, root, s, simulated: sim, windows: false);
+		"KF-ACCEPTED %".format(tag).postln
+	} { |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
 };
 refused.(\unrenderable, { FrictionThreshold.force(FrictionConstantStimuli([0.05, 2]), 0.3) });
 refused.(\negativeBase, { FrictionThreshold.force(FrictionStaircase(0.1), -0.3) });
 refused.(\nanInterval, { FrictionThreshold.force(FrictionStaircase(0.1), 0.3, 0/0) });
+refused.(\notAnExperiment, { FrictionStaircase(0.1) });
+refused.(\notAProcedure, { FrictionThreshold.force((next: 0.1), 0.3) });
 """
 
 
 def test_stimuli_the_device_cannot_render_are_refused_before_the_session_starts(jack):
     """A threshold condition whose levels or base force lie outside the (simulated) device's
-    0.14-1.4 N, or whose interval is NaN, second in the order: the session is refused when it is
-    run, with the reason, before its first condition (nothing written but the empty folder)."""
+    0.14-1.4 N, second in the order: the session is refused when it is run, with the reason, before
+    its first condition (nothing written but the empty folder). A NaN interval, an experiment that
+    is not a FrictionThreshold, a procedure that is not a FrictionProcedure: refused when the study
+    is made."""
     root = paths.work_dir() / "study-refused-stimuli"
     shutil.rmtree(root, ignore_errors=True)
     run = sclang.require_ok(sclang.run_with_server(
@@ -122,8 +127,11 @@ def test_stimuli_the_device_cannot_render_are_refused_before_the_session_starts(
                         "is outside the 0.14 N to 1.4 N that the simulated device renders",
         "negativeBase": "-0.3 N (the reference -0.3 N + the level 0)",
         "nanInterval": "intervalS must be a finite number",
+        "notAnExperiment": "makeExperiment must give a FrictionThreshold, got a FrictionStaircase",
+        "notAProcedure": "procedure must be a FrictionProcedure",
     }
     for tag, words in expected.items():
         assert words in refused.get(tag, ""), (tag, refused.get(tag), run.output[-3000:])
     for tag in expected:
-        assert not any((root / tag).iterdir()), f"{tag}: the refused session wrote {list((root / tag).iterdir())}"
+        written = list((root / tag).iterdir()) if (root / tag).exists() else []
+        assert not written, f"{tag}: the refused session wrote {written}"
