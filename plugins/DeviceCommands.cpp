@@ -76,6 +76,7 @@ enum StatusField {
   kReportIntervalS,
   kReportJitterS,
   kLastForceN,
+  kRecording,  // 1 while a recording is open and has not stopped by itself (a write error)
   kStatusFields
 };
 
@@ -188,7 +189,7 @@ void recordCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 }
 
 // The figures of the reply (statusStage).
-void fillStatusValues(const kf::Device& device, const kf::ThreadScheduling& usbThread, float* v) {
+void fillStatusValues(kf::Device& device, const kf::ThreadScheduling& usbThread, float* v) {
   const kf::TelemetrySnapshot t = device.telemetry();
   auto f = [](double value) { return static_cast<float>(value); };
   v[kOpen] = 1.0f;
@@ -219,6 +220,7 @@ void fillStatusValues(const kf::Device& device, const kf::ThreadScheduling& usbT
   v[kReportIntervalS] = f(t.reportIntervalMeanS);
   v[kReportJitterS] = f(t.reportIntervalJitterS);
   v[kLastForceN] = t.lastCommandedForceN;
+  v[kRecording] = device.isRecording() ? 1.0f : 0.0f;
 }
 
 // The board's event thread, if the device has a board.

@@ -417,6 +417,11 @@ void Device::stopRecording() {
   if (recorder_.takeFailure()) postDeviceMessage(("kfRecord: " + recorder_.error()).c_str());
 }
 
+bool Device::isRecording() {
+  std::lock_guard<PiMutex> lock(stateMutex_);
+  return recorder_.isOpen();
+}
+
 std::string Device::recordingError() {
   std::lock_guard<PiMutex> lock(stateMutex_);
   return recorder_.error();

@@ -110,6 +110,8 @@ class Device {
   void stopRecording();
   // Why the last recording stopped by itself (a write error, also posted), or empty.
   std::string recordingError();
+  // A recording is open and has not stopped by itself. From a non-realtime thread.
+  bool isRecording();
 
   // The client watch (realtime only; a study session's sclang keeps it alive): once no
   // heartbeat() has come for timeoutS of device time, the next pump drives the magnet off,

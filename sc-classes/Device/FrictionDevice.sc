@@ -176,12 +176,12 @@ FrictionDevice {
 		^#[open, realtime, deviceThreadPriority, mouseThreadPriority, usbThreadPriority, memoryLocked, reports,
 			frames, watchdogTrips, missedDeadlines, skippedFrames, lateFrames, reportQueueOverflows,
 			frameQueueOverflows, loopP50S, loopP99S, loopMaxS, forceP50S, forceP99S, forceP999S, forceMaxS,
-			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN]
+			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN, recording]
 	}
 	*statusOf { |values|
 		var event = ();
 		this.statusFields.do { |name, i| event[name] = values[i] };
-		#[open, realtime, memoryLocked].do { |name| event[name] = event[name] == 1 };
+		#[open, realtime, memoryLocked, recording].do { |name| event[name] = event[name] == 1 };
 		^event
 	}
 

@@ -13,13 +13,18 @@
 		watchId = UniqueID.next;
 		lastAnswerT = watchTickT = Main.elapsedTime;
 		answered = OSCFunc({ lastAnswerT = Main.elapsedTime }, '/synced', server.addr, argTemplate: [watchId]);
-		// A /kfStatus reply (index, then FrictionDevice.statusFields: open first) for the device the
-		// condition runs on, saying it is closed. Not in force between conditions (state is not
-		// running: a simulated participant's device is closed on purpose then).
+		// A /kfStatus reply (index, then FrictionDevice.statusFields) for the device the condition
+		// runs on, saying it is closed or its recording stopped by itself (a write error, a full
+		// disk: the server posted why). Not in force between conditions (state is not running: a
+		// simulated participant's device is closed on purpose then).
 		deviceStatus = OSCFunc({ |msg|
-			var polled = conditionDevice;
-			if(state == \running and: { polled.notNil } and: { msg[2] == polled.index } and: { msg[3] == 0 }) {
-				this.prLost("the device % closed under the session".format(polled))
+			var polled = conditionDevice, status = FrictionDevice.statusOf(msg[3..]);
+			if(state == \running and: { polled.notNil } and: { msg[2] == polled.index }) {
+				case
+					{ status[\open].not } { this.prLost("the device % closed under the session".format(polled)) }
+					{ status[\recording].not } {
+						this.prLost("the recording of % stopped (the post window says why)".format(polled))
+					}
 			}
 		}, '/kfStatus', server.addr);
 		Routine {
@@ -50,9 +55,10 @@
 		}
 	}
 
-	// While a condition runs, the device it plays on must stay open: its slot closed (kfClose, a
-	// failed reopen, another client) fails the session. Its status is asked each tick, the reply
-	// read by prWatch's responder (not FrictionAnswers': a dead server's time-out would post).
+	// While a condition runs, the device it plays on must stay open and recording: its slot closed
+	// (kfClose, a failed reopen, another client) or its recording stopped fails the session. Its
+	// status is asked each tick, the reply read by prWatch's responder (not FrictionAnswers': a
+	// dead server's time-out would post).
 	prWatchDevice {
 		if(state == \running and: { conditionDevice.notNil }) { server.listSendMsg(conditionDevice.statusMsg(false)) }
 	}

@@ -1,6 +1,6 @@
 """A study session whose instrument is gone mid-threshold-condition fails at once: its server dies
 (kill -9 of scsynth, or of jackd: the server's audio stops), its device's slot is closed under it,
-or sclang itself stands still (stopped by SIGSTOP for 5 s, as a computer that slept). Checked:
+its device recording stops (a file size limit: as a full disk), or sclang itself stands still (stopped by SIGSTOP for 5 s, as a computer that slept). Checked:
 the session's state, its reason in session.csv and the condition's events, and no trial stored
 after the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS; the
 device's status each tick; the watch's own tick late by more than lostAfterS)."""
@@ -41,28 +41,33 @@ ACTIONS = {
     "jackd": '("kill -9 " ++ @JACKD@).systemCmd;\nkillT = Main.elapsedTime;',
     # Its slot closed as another client (or a failed reopen) would close it.
     "device": "s.sendMsg('/cmd', \\kfClose, 0);\nkillT = Main.elapsedTime;",
+    # The server may write 2000 bytes more into any file (its device recording grows by about 40 kB
+    # a second): the recording stops on the write that would pass it (SIGXFSZ ignored).
+    "recording": 'killT = Main.elapsedTime;\n("prlimit --pid " ++ s.pid ++ " --fsize=" ++ (File.fileSize(@ROOT@ +/+ '
+                 '"L1/01-forceStep/device.kfsession") + 2000)).systemCmd;',
     # The shell stops sclang, waits, and lets it go on: sclang's clock runs on meanwhile.
     "sclang": 'killT = Main.elapsedTime;\n"kill -STOP %; sleep @STOPPED@; kill -CONT %".format(thisProcess.pid, '
               'thisProcess.pid).systemCmd;',
 }
 REASONS = {"scsynth": "stopped answering", "jackd": "stopped answering", "device": "closed under the session",
-           "sclang": "sclang stood still"}
+           "recording": "stopped (the post window says why)", "sclang": "sclang stood still"}
 
 
 @pytest.mark.parametrize("victim", list(ACTIONS))
 def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jack, victim):
     root = paths.work_dir() / f"study-server-lost-{victim}"
     shutil.rmtree(root, ignore_errors=True)
-    action = sclang.fill(ACTIONS[victim], JACKD=jack.proc.pid, STOPPED=STOPPED_S)
+    action = sclang.fill(ACTIONS[victim], JACKD=jack.proc.pid, STOPPED=STOPPED_S, ROOT=sclang.sc_string(str(root)))
     run = sclang.run_with_server(sclang.fill(SCRIPT, ROOT=sclang.sc_string(str(root)), ACTION=action), jack,
                                  timeout=90, name="study-server-lost", server_options={"numOutputBusChannels": 4})
     assert run.lines("KF-STATE") == [["failed"]], run.output[-3000:]
     lost_after_s = float(run.lines("KF-LOST-AFTER")[0][0])
     death_to_failure_s = float(run.lines("KF-DEATH-TO-FAILURE")[0][0])
     print(f"KF-FIGURE study_{victim}_death_to_session_failure_s {death_to_failure_s:.3f}")
-    if victim == "device":
+    if victim in ("device", "recording"):
         # Found at the next tick's status reply: within a tick (0.25 s) and a round trip, plus the
-        # routine's wait for the CPU beside two hogs (tens of ms); 1 s of room.
+        # routine's wait for the CPU beside two hogs (tens of ms), and for the recording the 2000
+        # bytes it may still write (50 ms); 1 s of room.
         assert 0 <= death_to_failure_s <= 1.0
     elif victim == "sclang":
         # Found at the first tick after sclang goes on (at most a tick, 0.25 s), or by the trial
