@@ -243,3 +243,32 @@ def fill(template, **values):
         template = template.replace(f"@{k}@", str(v))
     assert "@" not in re.sub(r'"[^"]*"', "", template), "unfilled placeholder"
     return template
+
+
+def pids_file(name):
+    """The file a script run by run_and_kill(name=name) writes "<sclang pid> <scsynth pid>" into."""
+    return paths.work_dir() / f"{name}-pids.txt"
+
+
+def run_and_kill(code, jack, ready, name="killed", timeout=120, server_options=None, wait_s=90):
+    """Runs `code` with a server (run_with_server) in a thread of its own and kills sclang and
+    scsynth with SIGKILL, by pid, once ready() is true (a crash mid-session). `code` must write
+    "<sclang pid> <scsynth pid>" to pids_file(name). Returns the run; an AssertionError if
+    ready() did not come within wait_s."""
+    import signal
+    import threading
+    pids = pids_file(name)
+    pids.unlink(missing_ok=True)
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(run=run_with_server(
+        code, jack, timeout=timeout, name=name, server_options=server_options)))
+    thread.start()
+    deadline = time.monotonic() + wait_s
+    while time.monotonic() < deadline and not (pids.exists() and ready()):
+        time.sleep(0.02)
+    assert pids.exists() and ready(), f"{name}: what the kill waits for never came"
+    sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
+    os.kill(scsynth_pid, signal.SIGKILL)
+    os.kill(sclang_pid, signal.SIGKILL)
+    thread.join(60)
+    return result["run"]

@@ -220,11 +220,7 @@ FrictionStudySession {
 		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m, resumed| this.prFrame(m, resumed) });
 		participantWindow !? { participantWindow.showInstruction(condition.instruction) };
 		experimenterWindow !? { experimenterWindow.showCondition };
-		ending = nil;
-		endedBy = nil;
-		conditionT0 = Main.elapsedTime;
-		state = \running;
-		this.log(\start, condition.name);
+		this.prStartRunning;
 		while { ending.isNil } {
 			0.05.wait;
 			if(paused.not) {
@@ -251,6 +247,15 @@ FrictionStudySession {
 		server.sync;
 		if(ending == \repeat or: { ending == \abort }) { ^ending };
 		^this.prQuestions
+	}
+
+	// The condition's time starts: it runs until something ends it.
+	prStartRunning {
+		ending = nil;
+		endedBy = nil;
+		conditionT0 = Main.elapsedTime;
+		state = \running;
+		this.log(\start, condition.name);
 	}
 
 	// The questions after a condition, each answer written and flushed as it is given.

@@ -32,11 +32,7 @@
 			participantWindow.doneButton.visible = false;  // the experiment ends it
 		};
 		experimenterWindow !? { experimenterWindow.refresh };
-		ending = nil;
-		endedBy = nil;
-		conditionT0 = Main.elapsedTime;
-		state = \running;
-		this.log(\start, condition.name);
+		this.prStartRunning;
 		estimate = experiment.run(conditionDevice, how, { |trial|
 			var endT = Main.elapsedTime;
 			// Stored once the server has answered since the trial ended (a round trip: a few ms): a

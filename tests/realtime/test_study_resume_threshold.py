@@ -6,11 +6,7 @@ up from the trials stored, so the levels and the estimate are those of the same 
 run straight through; the trials are numbered on, session.csv's times count on, and the report
 and the BIDS tables take exactly the trials the procedure used, saying how the attempts joined."""
 import json
-import os
 import shutil
-import signal
-import threading
-import time
 
 import numpy as np
 
@@ -35,30 +31,19 @@ KILL_AFTER = 6  # trials stored
 
 def test_a_resumed_threshold_condition_continues_its_procedure(jack):
     root = paths.work_dir() / "study-resume-threshold"
-    pids = paths.work_dir() / "study-resume-threshold-pids.txt"
     session = root / "R1"
     shutil.rmtree(root, ignore_errors=True)
-    pids.unlink(missing_ok=True)
     first = STUDY + sclang.fill(r"""
 ~session = ~study.(@MAX@).run("R1", @ROOT@, s, simulated: @SIM@, windows: false, experimenterOut: 2);
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
 while { ~session.isOver.not } { 0.1.wait };
 "KF-NOT-KILLED".postln;
-""", MAX=MAX_TRIALS, ROOT=sclang.sc_string(str(root)), SIM=SIM, PIDS=sclang.sc_string(str(pids)))
-    result = {}
-    thread = threading.Thread(target=lambda: result.update(run=sclang.run_with_server(
-        first, jack, timeout=120, name="study-threshold-run", server_options={"numOutputBusChannels": 4})))
-    thread.start()
+""", MAX=MAX_TRIALS, ROOT=sclang.sc_string(str(root)), SIM=SIM,
+                                PIDS=sclang.sc_string(str(sclang.pids_file("study-threshold-run"))))
     trials_csv = session / "trials.csv"
-    deadline = time.monotonic() + 90
-    while time.monotonic() < deadline and not (
-            trials_csv.exists() and len(read_csv(trials_csv)) >= KILL_AFTER and pids.exists()):
-        time.sleep(0.02)
-    sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
-    os.kill(scsynth_pid, signal.SIGKILL)
-    os.kill(sclang_pid, signal.SIGKILL)
-    thread.join(60)
-    assert "KF-NOT-KILLED" not in result["run"].output
+    run = sclang.run_and_kill(first, jack, lambda: trials_csv.exists() and len(read_csv(trials_csv)) >= KILL_AFTER,
+                              name="study-threshold-run", server_options={"numOutputBusChannels": 4})
+    assert "KF-NOT-KILLED" not in run.output
     stored = read_csv(trials_csv)
     k = len(stored)
     assert KILL_AFTER <= k < MAX_TRIALS - 4, k

@@ -2,11 +2,8 @@
 session killed mid-condition (scsynth and sclang, by pid) that loses nothing and resumes from
 sclang at the condition it was in."""
 import json
-import os
 import shutil
-import signal
 import subprocess
-import threading
 import time
 
 from kfharness import paths, sclang
@@ -69,10 +66,8 @@ def events_of(folder):
 
 def test_a_killed_session_resumes_with_nothing_lost(jack):
     root = paths.work_dir() / "study-resume"
-    pids = paths.work_dir() / "study-resume-pids.txt"
     session = root / "P7"
     shutil.rmtree(root, ignore_errors=True)
-    pids.unlink(missing_ok=True)
     # Run 1: the session starts; the test kills scsynth and sclang once the second condition runs.
     first = STUDY + sclang.fill(r"""
 ~session = ~study.run("P7", @ROOT@, s, 0, 11, simulated: FrictionStudySimParticipant(3, 2.5), windows: false,
@@ -80,23 +75,19 @@ def test_a_killed_session_resumes_with_nothing_lost(jack):
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
 while { ~session.isOver.not } { 0.1.wait };
 "KF-NOT-KILLED".postln;
-""", ROOT=sclang.sc_string(str(root)), PIDS=sclang.sc_string(str(pids)))
-    result = {}
-    thread = threading.Thread(target=lambda: result.update(run=sclang.run_with_server(
-        first, jack, timeout=120, name="study-run", server_options={"numOutputBusChannels": 4})))
-    thread.start()
+""", ROOT=sclang.sc_string(str(root)), PIDS=sclang.sc_string(str(sclang.pids_file("study-run"))))
     second_events = session / "02-second" / "events.csv"
-    deadline = time.monotonic() + 90
-    while time.monotonic() < deadline and not (second_events.exists() and "start" in second_events.read_text()):
-        time.sleep(0.05)
-    assert second_events.exists(), "the second condition never started"
-    # Mid-condition: 0.6 s into its 2.5 s of exploring (1.9 s to spare for a slow wake-up here).
-    time.sleep(0.6)
-    sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
-    os.kill(scsynth_pid, signal.SIGKILL)
-    os.kill(sclang_pid, signal.SIGKILL)
-    thread.join(60)
-    assert "KF-NOT-KILLED" not in result["run"].output
+    started = {}
+
+    def mid_condition():
+        # 0.6 s into the second condition's 2.5 s of exploring (1.9 s to spare for a slow wake-up).
+        if "at" not in started and second_events.exists() and "start" in second_events.read_text():
+            started["at"] = time.monotonic()
+        return "at" in started and time.monotonic() - started["at"] >= 0.6
+
+    run = sclang.run_and_kill(first, jack, mid_condition, name="study-run",
+                              server_options={"numOutputBusChannels": 4})
+    assert "KF-NOT-KILLED" not in run.output
 
     # What the kill left: the manifest, the first condition whole with its answers, the second begun.
     manifest = json.loads((session / "manifest.json").read_text())
