@@ -29,13 +29,14 @@ FrictionStudyCondition {
 	// simulated participant (FrictionObserver); nil: the simulated participant's own observer for
 	// the experiment's kind (observerFor).
 	*threshold { |name, makeExperiment, instruction = "", questions, maxTimeS = 1800, answers = \keys, makeObserver|
-		var c = this.new(name, (mapping: \mapping2, surfaceMm: 40), instruction, questions, maxTimeS);
+		var c = this.new(name, (mapping: \mapping2, surfaceMm: 40), instruction, questions, maxTimeS), made;
 		if(makeExperiment.isFunction.not) {
 			Error("FrictionStudyCondition.threshold(%): makeExperiment must be a Function".format(name)).throw
 		};
-		makeExperiment.value.isKindOf(FrictionThreshold).not.if {
+		made = makeExperiment.value;
+		if(made.isKindOf(FrictionThreshold).not) {
 			Error("FrictionStudyCondition.threshold(%): makeExperiment must give a FrictionThreshold, got %".format(
-				name, makeExperiment.value)).throw
+				name, made)).throw
 		};
 		if(answers != \keys and: { answers != \buttons }) {
 			Error("FrictionStudyCondition.threshold(%): answers must be \\keys or \\buttons, got %".format(name,
