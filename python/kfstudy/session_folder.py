@@ -22,6 +22,14 @@ from . import checked_csv, readers
 # speed is a staircase of 2.6 mm/s steps at slow speeds.
 SPEED_REPORTS = 5
 
+# The events a condition's events.csv and a session's session.csv may hold: the same names as
+# FrictionStudySession.conditionEvents and .sessionEvents, which its log refuses any other name
+# with (tests/scenes/test_session_events.py holds the two lists together).
+CONDITION_EVENTS = ("prepare", "recordDevice", "recordAudio", "experiment", "observer", "continue", "start",
+                    "pause", "resume", "trial", "done", "maxTime", "repeat", "abort", "lost", "coverage",
+                    "estimate", "answer", "end")
+SESSION_EVENTS = ("start", "resume", "finish", "abort", "error")
+
 
 def read_csv(path, damaged=None):
     """A study CSV's rows as dicts; damaged rows are skipped and listed in `damaged`."""
@@ -40,10 +48,12 @@ class Condition:
     is_threshold: bool = False  # a threshold experiment's trials, not free exploration
 
     def event_time(self, name):
+        assert name in CONDITION_EVENTS, name
         times = [float(e["timeS"]) for e in self.events if e["event"] == name]
         return times[-1] if times else None
 
     def event_detail(self, name):
+        assert name in CONDITION_EVENTS, name
         details = [e["detail"] for e in self.events if e["event"] == name]
         return details[-1] if details else None
 

@@ -17,7 +17,7 @@
 // conditions (extFrictionStudySessionThreshold.sc), the watch of the server, the device and sclang
 // (extFrictionStudySessionWatch.sc), the folder, manifest and resume (extFrictionStudySessionFolder.sc).
 FrictionStudySession {
-	classvar <answersHeader, <eventsHeader, <trialsHeader;
+	classvar <answersHeader, <eventsHeader, <trialsHeader, <conditionEvents, <sessionEvents;
 	// A server that has not answered a /sync for this long (s) is lost: the session fails.
 	classvar <>lostAfterS = 3;
 	// The client watch of the devices a session plays on (FrictionDevice.watchClient): a server
@@ -35,6 +35,11 @@ FrictionStudySession {
 	*initClass {
 		answersHeader = #[participant, position, condition, attempt, question, kind, answer, source, timeS, wallTime];
 		eventsHeader = #[timeS, event, detail, wallTime];
+		// What events.csv and session.csv may hold (log refuses anything else: a misspelt event
+		// would be lost on the report): the same names as kfstudy.session_folder's.
+		conditionEvents = #[prepare, recordDevice, recordAudio, experiment, observer, continue, start, pause, resume,
+			trial, done, maxTime, repeat, abort, lost, coverage, estimate, answer, end];
+		sessionEvents = #[start, resume, finish, abort, error];
 		trialsHeader = #[participant, position, condition, attempt, trial, level, target, answer, correct, startS,
 			interval1S, interval2S, answerS, wallTime];
 	}
@@ -126,8 +131,19 @@ FrictionStudySession {
 		this.prPlay;
 	}
 
+	// event, if it is one of conditionEvents (inSession: sessionEvents); else an Error.
+	*checkEvent { |event, inSession = false|
+		var names = if(inSession) { sessionEvents } { conditionEvents };
+		if(names.includes(event).not) {
+			Error("FrictionStudySession: % is not a % event (%)".format(event.cs,
+				if(inSession) { "session" } { "condition" }, names.join(", "))).throw
+		};
+		^event
+	}
+
 	// A line in the condition's events.csv, with the time since its prepare line.
 	log { |event, detail = ""|
+		this.class.checkEvent(event);
 		conditionDir !? {
 			FrictionStudyFiles.appendCsv(conditionDir +/+ "events.csv",
 				[this.prLogTime, event, detail, FrictionStudyFiles.now], eventsHeader)

@@ -17,6 +17,7 @@
 	// session.csv's times count on across a resume (a new sclang's clock starts again): they go on
 	// from the last one stored (the wallTime column says how long the session stood).
 	prSessionLog { |event, detail|
+		this.class.checkEvent(event, true);
 		FrictionStudyFiles.appendCsv(folder +/+ "session.csv",
 			[(Main.elapsedTime + sessionTimeOffsetS).round(0.001), event, detail, FrictionStudyFiles.now],
 			eventsHeader);
