@@ -29,10 +29,12 @@
 		}, '/kfStatus', server.addr);
 		Routine {
 			while { this.isOver.not } {
+				var stoodStill;
 				server.sendMsg('/sync', watchId);
 				0.25.wait;
+				stoodStill = this.prStoodStill;
 				case
-					{ this.prStoodStill.notNil } { this.prLost(this.prStoodStill) }
+					{ stoodStill.notNil } { this.prLost(stoodStill) }
 					{ Main.elapsedTime - lastAnswerT > lostAfterS } {
 						this.prLost("the server % stopped answering (no /synced for % s)".format(server.name,
 							(Main.elapsedTime - lastAnswerT).round(0.01)))
