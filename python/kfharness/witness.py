@@ -47,6 +47,18 @@ print("# Histogram Overflows: %d" % stalls)
 """
 
 
+def summary(output):
+    """{"max_us", "avg_us", "stalls"} from cyclictest's (or NORMAL_SAMPLER's) summary lines, or None:
+    the worst and the mean wake-up latency over the threads, and the most stalls of any thread."""
+    def values(name):
+        m = re.search(rf"^# {name}: ([\d ]+)$", output, re.M)
+        return [int(v) for v in m.group(1).split()] if m else []
+    maxima, means, overflows = values("Max Latencies"), values("Avg Latencies"), values("Histogram Overflows")
+    if not (maxima and means):
+        return None
+    return {"max_us": max(maxima), "avg_us": sum(means) / len(means), "stalls": max(overflows or [0])}
+
+
 class Witness:
     def __init__(self, stall_us=100000, normal_priority=False):
         self.stall_us = stall_us
@@ -75,15 +87,8 @@ class Witness:
             self.proc.kill()
             self.output = self.proc.communicate()[0]
         self.proc = None
-        maxima, means = self._values("Max"), self._values("Avg")
-        overflows = self._values("Histogram Overflows")
-        self.result = ({"max_us": max(maxima), "avg_us": sum(means) / len(means), "stalls": max(overflows or [0])}
-                       if maxima and means else None)
+        self.result = summary(self.output)
         return self.result
-
-    def _values(self, name):
-        m = re.search(rf"^# {name} Latencies: ([\d ]+)$", self.output, re.M)
-        return [int(v) for v in m.group(1).split()] if m else []
 
     def __enter__(self):
         return self.start()

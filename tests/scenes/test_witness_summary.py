@@ -1,0 +1,38 @@
+"""The witness's reading of cyclictest's summary (kfharness.witness): its stall count once read
+no line at all (it looked for "# Histogram Overflows Latencies:"), so every realtime test that
+weighed watchdog trips against the machine's stalls saw none."""
+import os
+import signal
+import time
+
+from kfharness.witness import Witness, summary
+
+# cyclictest 2.40's summary after -q -h 300 on two threads (measured here beside two CPU hogs).
+CYCLICTEST = """# /dev/cpu_dma_latency set to 0us
+# Histogram
+000000 000000\t000000
+# Total: 000004997 000004989
+# Min Latencies: 00006 00005
+# Avg Latencies: 00014 00013
+# Max Latencies: 00580 02121
+# Histogram Overflows: 00004 00008
+# Histogram Overflow at cycle number:
+# Thread 0: 00057 00087 00099 00118
+# Thread 1: 00004 00056 00138 00147 00171 00180 00202 00224
+"""
+
+
+def test_the_summary_gives_the_worst_latency_the_mean_and_the_most_stalls_of_a_thread():
+    assert summary(CYCLICTEST) == {"max_us": 2121, "avg_us": 13.5, "stalls": 8}
+    assert summary("cyclictest: no summary") is None
+
+
+def test_a_witness_held_longer_than_its_threshold_counts_one_stall():
+    # The normal-priority sampler (it needs no realtime rights), held 0.1 s by SIGSTOP: one stall.
+    with Witness(stall_us=20000, normal_priority=True) as w:
+        time.sleep(0.3)
+        os.kill(w.proc.pid, signal.SIGSTOP)
+        time.sleep(0.1)
+        os.kill(w.proc.pid, signal.SIGCONT)
+        time.sleep(0.3)
+    assert w.result["stalls"] == 1 and w.result["max_us"] >= 90000, w.result
