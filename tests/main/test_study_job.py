@@ -132,9 +132,12 @@ def check_binds():
     every 6.25 mm; it is felt where the puck is when it acts, 10 to 15 ms after the position it was
     computed from (the report's interpolation, the block, the frame), so the low parts lie up to
     0.5 mm past a crossing when crossed at 40 mm/s and further when faster. A part 1.5 mm or more
-    from a crossing (|sine| >= 0.71, -3 dB: 0.45 N when crossed slowly) is raised whatever the
-    speed it was crossed at (measured: all 50 of them in a run of this job); some parts, at the
-    crossings, are not."""
+    from a crossing (|sine| >= 0.71, -3 dB: 0.45 N when crossed slowly) and more than 2 mm from the
+    fragment's ends (where the hands turn, slowly, and the sound and its force fall: as in mappings
+    1 and 2) is raised but for a few crossed fast: measured in four fresh clones' runs of this job,
+    0, 0, 1 and 1 of 47 to 53 such parts were not, each 1.5 mm from a crossing, and 1 of 2 at the
+    ends was not (96.75 mm of 97); in CI, 5 of 50 counted with the ends were not. Some parts, at the
+    crossings, are not raised."""
     parts = session_folder.read_csv(OUT / "binds-parts.csv")
     judged = {m: [p for p in parts if p["mapping"] == m and p["mean_force_n"] not in ("", "nan")]
               for m in ("mapping1", "mapping2", "mapping3")}
@@ -150,7 +153,8 @@ def check_binds():
     middles = np.array([(float(p["from_mm"]) + float(p["to_mm"])) / 2 for p in judged["mapping3"]])
     raised = np.array([p["raised"] == "True" for p in judged["mapping3"]])
     from_crossing_mm = np.abs((middles + 3.125) % 6.25 - 3.125)
-    crest = from_crossing_mm >= 1.5
+    ends = (float(judged["mapping3"][0]["from_mm"]), float(judged["mapping3"][-1]["to_mm"]))
+    crest = (from_crossing_mm >= 1.5) & (middles > ends[0] + 2) & (middles < ends[1] - 2)
     low_crests = [float(m) for m in middles[crest & ~raised]]
     assert crest.sum() >= 10 and raised[crest].mean() > 0.9, (low_crests, frame_rates())
     assert 0 < raised.sum() < len(raised), raised
