@@ -76,7 +76,8 @@ enum StatusField {
   kReportIntervalS,
   kReportJitterS,
   kLastForceN,
-  kRecording,  // 1 while a recording is open and has not stopped by itself (a write error)
+  kRecording,      // 1 while a recording is open and has not stopped by itself (a write error)
+  kAudioCallMaxS,  // the longest block of a FrictionOut on the audio thread (realtime)
   kStatusFields
 };
 
@@ -221,6 +222,7 @@ void fillStatusValues(kf::Device& device, const kf::ThreadScheduling& usbThread,
   v[kReportJitterS] = f(t.reportIntervalJitterS);
   v[kLastForceN] = t.lastCommandedForceN;
   v[kRecording] = device.isRecording() ? 1.0f : 0.0f;
+  v[kAudioCallMaxS] = f(t.audioCallMaxS);
 }
 
 // The board's event thread, if the device has a board.

@@ -114,6 +114,8 @@ class FrictionOut : public SCUnit {
     } else {
       std::fill_n(out(0), numSamples, force->lastCommandedN());
     }
+    // Our share of the audio thread (a lockstep device's clock is audio time: nothing to time).
+    if (!device->isLockstep()) device->noteAudioCall(device->nowS() - sink.deviceNowS);
   }
 
   // Registers this writer with a slot (moving from the previous one), so that the slot knows

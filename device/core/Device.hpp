@@ -91,6 +91,8 @@ class Device {
   void requestOff();
   // The force last sent to the magnet after the safety path (watchdog trips and close too).
   float commandedForceN() const { return telemetry_.commandedForceN(); }
+  // Audio thread: how long one block of a writer (FrictionOut) took, for telemetry (no lock).
+  void noteAudioCall(double seconds) { telemetry_.recordAudioCall(seconds); }
   // The device clock: seconds since start() in realtime (steady clock, any thread, no lock);
   // in lockstep the last pumped time.
   double nowS() const;

@@ -37,6 +37,9 @@ struct TelemetrySnapshot {
   uint64_t missedDeadlines = 0;
   uint64_t skippedFrames = 0;
   uint64_t orderlyOffs = 0;  // requestOff() carried out: the last writer went away
+  // Realtime: the longest a FrictionOut's block held the audio thread (s): our own share of any
+  // stall of the frames at their source, told apart from the server's and the machine's.
+  double audioCallMaxS = 0.0;
   // How the device thread and the mouse's reader thread are scheduled (ThreadScheduling).
   ThreadScheduling deviceThread;
   ThreadScheduling mouseThread;
@@ -64,6 +67,12 @@ class Telemetry {
   void countSkippedFrame() { skippedFrames_.fetch_add(1, std::memory_order_relaxed); }
   void countOrderlyOff() { orderlyOffs_.fetch_add(1, std::memory_order_relaxed); }
   void setReleaseLatency(double latencyS) { releaseLatencyS_.store(latencyS, std::memory_order_relaxed); }
+  // Audio thread: one block of a FrictionOut took this long (a lock-free maximum).
+  void recordAudioCall(double seconds) {
+    double seen = audioCallMaxS_.load(std::memory_order_relaxed);
+    while (seconds > seen && !audioCallMaxS_.compare_exchange_weak(seen, seconds, std::memory_order_relaxed)) {
+    }
+  }
   float commandedForceN() const { return lastCommandedForceN_.load(std::memory_order_relaxed); }
 
   // Queue overflow counts live in the queues; Device fills them in.
@@ -89,6 +98,7 @@ class Telemetry {
   std::atomic<uint64_t> skippedFrames_{0};
   std::atomic<uint64_t> orderlyOffs_{0};
   std::atomic<double> releaseLatencyS_{0.0};
+  std::atomic<double> audioCallMaxS_{0.0};
 };
 
 inline void Telemetry::countReport(double deviceTimeS) {
@@ -129,6 +139,7 @@ inline TelemetrySnapshot Telemetry::snapshot() const {
   s.missedDeadlines = missedDeadlines_.load(std::memory_order_relaxed);
   s.skippedFrames = skippedFrames_.load(std::memory_order_relaxed);
   s.orderlyOffs = orderlyOffs_.load(std::memory_order_relaxed);
+  s.audioCallMaxS = audioCallMaxS_.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -1,7 +1,6 @@
 """A JACK server on the dummy driver: a real-time audio clock without a sound card."""
 import os
 import random
-import shlex
 import subprocess
 import sys
 import time
@@ -77,13 +76,6 @@ class JackServer:
             return self.log_path.read_text(errors="replace")[-3000:]
         except OSError:
             return ""
-
-    def dropped_cycles_command(self, client="SuperCollider"):
-        """A shell command printing how many cycles, since this server started, JACK reported
-        `client` as woken and not yet begun ("client = <client> was not finished, state =
-        Triggered", JackEngine's xrun line): cycles the client's thread did not get to run, before
-        any of its process code (ours included: that runs once the cycle has begun, "Running")."""
-        return f"grep -c {shlex.quote(f'client = {client} was not finished, state = Triggered')} {shlex.quote(str(self.log_path))}"
 
     def __enter__(self):
         return self.start()

@@ -176,7 +176,8 @@ FrictionDevice {
 		^#[open, realtime, deviceThreadPriority, mouseThreadPriority, usbThreadPriority, memoryLocked, reports,
 			frames, watchdogTrips, missedDeadlines, skippedFrames, lateFrames, reportQueueOverflows,
 			frameQueueOverflows, loopP50S, loopP99S, loopMaxS, forceP50S, forceP99S, forceP999S, forceMaxS,
-			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN, recording]
+			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN, recording,
+			audioCallMaxS]
 	}
 	*statusOf { |values|
 		var event = ();

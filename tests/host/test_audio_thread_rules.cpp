@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -263,6 +264,9 @@ void Scenario::run() {
     check(v[17] < 0.02f, "/kfStatus: force latency p50 sane (" + std::to_string(v[17]) + " s)");
     check(v[21] > 0.f && v[21] < 0.02f,
           "/kfStatus: reports reached the UGens, latency p50 sane (" + std::to_string(v[21]) + " s)");
+    // audioCallMaxS: FrictionOut's blocks were timed on the audio thread.
+    check(v.size() > 29 && v[29] > 0.f && std::isfinite(v[29]),
+          "/kfStatus: FrictionOut's longest block measured (" + std::to_string(v.size() > 29 ? v[29] : -1.f) + " s)");
   }
   check(server_.repliesNamed("/kfBoardStatus") == 1, "/kfBoardStatus replied");
   for (const std::string& problem : server_.problems())

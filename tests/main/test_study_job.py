@@ -154,7 +154,8 @@ def check_binds():
     raised = np.array([p["raised"] == "True" for p in judged["mapping3"]])
     from_crossing_mm = np.abs((middles + 3.125) % 6.25 - 3.125)
     ends = (float(judged["mapping3"][0]["from_mm"]), float(judged["mapping3"][-1]["to_mm"]))
-    crest = (from_crossing_mm >= 1.5) & (middles > ends[0] + 2) & (middles < ends[1] - 2)
+    inner = np.array([float(p["from_mm"]) >= ends[0] + 2 and float(p["to_mm"]) <= ends[1] - 2 for p in judged["mapping3"]])
+    crest = (from_crossing_mm >= 1.5) & inner
     low_crests = [float(m) for m in middles[crest & ~raised]]
     assert crest.sum() >= 10 and raised[crest].mean() > 0.9, (low_crests, frame_rates())
     assert 0 < raised.sum() < len(raised), raised
