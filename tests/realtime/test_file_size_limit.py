@@ -8,6 +8,7 @@ import pytest
 
 from kfharness import paths, procs, sclang, status
 from kfharness.load import realtime_allowed
+from kfharness.witness import Witness
 from kfstudy import readers
 
 LIMIT_BYTES = 64 * 1024
@@ -34,30 +35,32 @@ def trip_diagnosis(record):
 def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     record = paths.work_dir() / "fsize-session.txt"
     record.unlink(missing_ok=True)
-    run = sclang.require_ok(sclang.run_with_server("var dev, syn, before, second;\n" + status.SC_POST + f"""
-    dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 10]]));
-    s.sync;
-    syn = {{ FrictionOut.ar(0, DC.ar({FORCE_N})) * 0 }}.play;
-    0.3.wait;
-    ("prlimit --pid " ++ s.pid ++ " --fsize={LIMIT_BYTES}").systemCmd;
-    dev.record({sclang.sc_string(record)});
-    s.sync;
-    3.wait;  // about 40 kB a second of frames and reports: the limit comes after ~1.5 s
-    ~kfPostStatus.(dev, "KF-STATUS-A");
-    // One second of audio time (1000 frames framed), not of the wall clock: see AUDIO_FRAMES.
-    second = Condition.new;
-    OSCFunc({{ second.test = true; second.signal }}, '/kfAudioSecond').oneShot;
-    {{ var done = Done.kr(Line.kr(0, 1, 1));
-        SendReply.kr(done, '/kfAudioSecond'); FreeSelf.kr(done); Silent.ar }}.play;
-    second.wait;
-    ~kfPostStatus.(dev, "KF-STATUS-B");
-    dev.status;
-    s.sync;
-    "KF-ALIVE %".format(s.serverRunning).postln;
-    syn.free;
-    dev.close;
-    s.sync;
-    """, jack, name="fsize"))
+    # The machine's own stalls in the same window (below).
+    with Witness() as witness:
+        run = sclang.require_ok(sclang.run_with_server("var dev, syn, before, second;\n" + status.SC_POST + f"""
+        dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 10]]));
+        s.sync;
+        syn = {{ FrictionOut.ar(0, DC.ar({FORCE_N})) * 0 }}.play;
+        0.3.wait;
+        ("prlimit --pid " ++ s.pid ++ " --fsize={LIMIT_BYTES}").systemCmd;
+        dev.record({sclang.sc_string(record)});
+        s.sync;
+        3.wait;  // about 40 kB a second of frames and reports: the limit comes after ~1.5 s
+        ~kfPostStatus.(dev, "KF-STATUS-A");
+        // One second of audio time (1000 frames framed), not of the wall clock: see AUDIO_FRAMES.
+        second = Condition.new;
+        OSCFunc({{ second.test = true; second.signal }}, '/kfAudioSecond').oneShot;
+        {{ var done = Done.kr(Line.kr(0, 1, 1));
+            SendReply.kr(done, '/kfAudioSecond'); FreeSelf.kr(done); Silent.ar }}.play;
+        second.wait;
+        ~kfPostStatus.(dev, "KF-STATUS-B");
+        dev.status;
+        s.sync;
+        "KF-ALIVE %".format(s.serverRunning).postln;
+        syn.free;
+        dev.close;
+        s.sync;
+        """, jack, name="fsize"))
     assert run.lines("KF-ALIVE ") == [["true"]], run.output[-3000:]
     assert run.scsynth_pid is None or procs.wait_pid_gone(run.scsynth_pid, 5)
     # One message, and the status entry.
@@ -87,12 +90,16 @@ def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
     # kept scsynth from its cycles for up to 36 ms with the machine's witness (cyclictest, SCHED_FIFO
     # 90) quiet (perf: scsynth's audio thread and jackd's asleep in JACK's waits), and this test,
     # which bounded trips by the witness's stalls, failed in CI and here on them. Without realtime
-    # scheduling a block can be preempted by the hogs, so there the figure is only reported.
-    print(f"KF-FIGURE fsize_watchdog_trips {b['watchdogTrips']:.0f} audio_call_max_s {b['audioCallMaxS']:.6f}")
+    # scheduling a block can be preempted by the hogs, so there the figure is only reported. With
+    # it, a stall of the machine (a vCPU paused by the host) that falls inside a block is counted in
+    # it too, up to the longest the witness saw (cyclictest at SCHED_FIFO 90, above every thread).
+    print(f"KF-FIGURE fsize_watchdog_trips {b['watchdogTrips']:.0f} audio_call_max_s {b['audioCallMaxS']:.6f} "
+          f"witness {witness.result}")
     if realtime_allowed():
-        assert b["audioCallMaxS"] < BLOCK_S, (
-            f"a FrictionOut block held the audio thread {b['audioCallMaxS'] * 1000:.2f} ms "
-            f"({b['watchdogTrips']:.0f} watchdog trips; {trip_diagnosis(record)})")
+        machine_s = witness.result["max_us"] * 1e-6 if witness.result else 0.0
+        assert b["audioCallMaxS"] < BLOCK_S + machine_s, (
+            f"a FrictionOut block held the audio thread {b['audioCallMaxS'] * 1000:.2f} ms, the machine stalled "
+            f"{machine_s * 1000:.2f} ms at most ({b['watchdogTrips']:.0f} watchdog trips; {trip_diagnosis(record)})")
     # The file: within the limit, whole lines only, readable to its end.
     size = record.stat().st_size
     assert 0 < size <= LIMIT_BYTES
