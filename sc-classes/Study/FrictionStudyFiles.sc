@@ -139,6 +139,23 @@ FrictionStudyFiles {
 	}
 
 	// Local date and time, ISO 8601 (seconds).
+	// Ends a Recorder's file (in a Routine). Recorder.stopRecording closes its buffer with the
+	// buffer's free as the close's completion and gives the number back to sclang's allocator at
+	// once, while the server frees it only after the close: a recording started meanwhile (the next
+	// condition, another session) gets that number, and the late free empties its buffer before its
+	// file is opened, which leaves it 0 bytes ("could not be opened: Format not recognised"; 7 of 10
+	// back to back, and once in a study job of five sessions). So the buffer is closed and freed
+	// here, in that order, before its number is free.
+	*closeRecorder { |recorder, server|
+		var buffer = if(Recorder.instVarNames.includes(\recordBuf)) { recorder.instVarAt(\recordBuf) };
+		if(buffer.isNil) { ^recorder.stopRecording };
+		recorder.instVarPut(\recordBuf, nil);  // its stopRecording leaves the buffer alone
+		recorder.stopRecording;
+		buffer.close;
+		server.sync;
+		buffer.free;
+	}
+
 	*now { ^Date.getDate.format("%Y-%m-%dT%H:%M:%S") }
 
 	*prEscape { |string|

@@ -308,17 +308,16 @@ FrictionStudySession {
 	prStopAudio {
 		var path = recorder.path, size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
 		if(path.isNil) { ^this };  // closed already
-		if(recorder.isRecording.not or: { Recorder.instVarNames.includes(\recordNode).not }) {
-			^recorder.stopRecording
+		if(recorder.isRecording and: { Recorder.instVarNames.includes(\recordNode) }) {
+			recorder.instVarAt(\recordNode) !? { |node| node.releaseDependants; node.free };
+			server.sync;
+			while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
+				var now = File.fileSize(path);
+				if(now != size) { size = now; stableSince = Main.elapsedTime };
+				0.01.wait
+			};
 		};
-		recorder.instVarAt(\recordNode) !? { |node| node.releaseDependants; node.free };
-		server.sync;
-		while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
-			var now = File.fileSize(path);
-			if(now != size) { size = now; stableSince = Main.elapsedTime };
-			0.01.wait
-		};
-		recorder.stopRecording;
+		FrictionStudyFiles.closeRecorder(recorder, server);
 	}
 
 	// The participant's output pair into the condition's audio.wav; the report places its first
