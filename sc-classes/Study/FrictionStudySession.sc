@@ -299,26 +299,8 @@ FrictionStudySession {
 		^\end
 	}
 
-	// Ends the condition's audio.wav. Recorder.stopRecording frees its DiskOut and closes the file
-	// in one go, but DiskOut's last part (up to half its buffer, 0.68 s at 48 kHz) reaches the file
-	// from scsynth's disk thread after the free: a close that came first lost it (a 0.4 s condition
-	// left 0 frames). So the DiskOut goes first, without the Recorder's own close on its /n_end (its
-	// onFree, a dependant of the node); the file is closed once its size has stopped growing (the
-	// disk thread wrote), at most 2 s later. Recorder has no flush of its own to call instead.
-	prStopAudio {
-		var path = recorder.path, size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
-		if(path.isNil) { ^this };  // closed already
-		if(recorder.isRecording and: { Recorder.instVarNames.includes(\recordNode) }) {
-			recorder.instVarAt(\recordNode) !? { |node| node.releaseDependants; node.free };
-			server.sync;
-			while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
-				var now = File.fileSize(path);
-				if(now != size) { size = now; stableSince = Main.elapsedTime };
-				0.01.wait
-			};
-		};
-		FrictionStudyFiles.closeRecorder(recorder, server);
-	}
+	// Ends the condition's audio.wav, all of it (FrictionStudyFiles.closeRecorder says why not stopRecording).
+	prStopAudio { recorder !? { FrictionStudyFiles.closeRecorder(recorder, server) } }
 
 	// The participant's output pair into the condition's audio.wav; the report places its first
 	// sample at the recordAudio line.
