@@ -138,7 +138,6 @@ FrictionStudyFiles {
 		^cut
 	}
 
-	// Local date and time, ISO 8601 (seconds).
 	// Ends a Recorder's file (in a Routine), all of it, and frees its buffer before its number is free.
 	// Recorder.stopRecording frees its DiskOut and closes the file in one go, but DiskOut's last part
 	// (up to half its buffer, 0.68 s at 48 kHz) reaches the file from scsynth's disk thread after the
@@ -171,6 +170,7 @@ FrictionStudyFiles {
 		buffer !? { buffer.close; server.sync; buffer.free };
 	}
 
+	// Local date and time, ISO 8601 (seconds).
 	*now { ^Date.getDate.format("%Y-%m-%dT%H:%M:%S") }
 
 	*prEscape { |string|

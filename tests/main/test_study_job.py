@@ -150,11 +150,12 @@ def check_binds():
         low = [(float(p["from_mm"]), float(p["to_mm"])) for p in judged[mapping] if p["raised"] != "True"]
         assert len(judged[mapping]) >= 10, (mapping, judged[mapping])
         assert all(a < ends[0] + 2 or b > ends[1] - 2 for a, b in low), (mapping, ends, low, frame_rates())
-    middles = np.array([(float(p["from_mm"]) + float(p["to_mm"])) / 2 for p in judged["mapping3"]])
+    lo = np.array([float(p["from_mm"]) for p in judged["mapping3"]])
+    hi = np.array([float(p["to_mm"]) for p in judged["mapping3"]])
+    middles = (lo + hi) / 2
     raised = np.array([p["raised"] == "True" for p in judged["mapping3"]])
     from_crossing_mm = np.abs((middles + 3.125) % 6.25 - 3.125)
-    ends = (float(judged["mapping3"][0]["from_mm"]), float(judged["mapping3"][-1]["to_mm"]))
-    inner = np.array([float(p["from_mm"]) >= ends[0] + 2 and float(p["to_mm"]) <= ends[1] - 2 for p in judged["mapping3"]])
+    inner = (lo >= lo[0] + 2) & (hi <= hi[-1] - 2)
     crest = (from_crossing_mm >= 1.5) & inner
     low_crests = [float(m) for m in middles[crest & ~raised]]
     assert crest.sum() >= 10 and raised[crest].mean() > 0.9, (low_crests, frame_rates())
