@@ -3,10 +3,12 @@
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
 # fuzz targets, the scene and realtime tests against the sanitized plugin, the cross builds), then
 # every test of build/: Catch2 (dsp, device, host), the NRT scene tests (scsynth and supernova),
-# the help files, the QEMU guest, and the realtime tests against JACK's dummy driver: as many at
-# a time as there are cores, except the realtime tests and the main jobs, which run alone
-# (RUN_SERIAL). A failing stage does not stop the next: every stage runs, and the command fails
-# if any did (with ctest's exit code when ctest was the one).
+# the help files, the QEMU guest, and the realtime tests against JACK's dummy driver: one more at a
+# time than there are cores, so that the realtime tests, which run one at a time (RESOURCE_LOCK
+# kf_realtime) and mostly wait on the audio clock, each run beside as many CPU-bound tests as there
+# are cores (the two hogs they are built to hold); the main jobs run alone (RUN_SERIAL). A failing
+# stage does not stop the next: every stage runs, and the command fails if any did (with ctest's
+# exit code when ctest was the one).
 #
 # At the end each stage's wall time is printed and written to build/test-stages.txt, with what
 # the machine was (cores, realtime scheduling allowed, the CPU time the hypervisor stole), so
@@ -84,13 +86,13 @@ if ((rc != 0)); then
 fi
 source scripts/env.sh
 if $quick; then
-  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(nproc)" \
+  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
   for check in format pyflakes sanitize fuzz sanitize-plugin cross; do
     stage "$check" scripts/check.sh "$check"
   done
-  stage ctest ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
+  stage ctest ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" "$@"
 fi
 summary build/test-stages.txt
 exit "$rc"
