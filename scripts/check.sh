@@ -8,15 +8,17 @@
 #   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh)
 #   sanitize-plugin
 #              the scene and realtime tests against the plugin built with both sanitizers
-#              (build-asan-plugin/), their runtimes preloaded into every scsynth the tests start
-#              (KF_SERVER_PRELOAD); any finding fails. KF_SANITIZED_TESTS: a ctest regex to run
-#              fewer of them.
+#              (build-asan-plugin/, tests named sanitized/...), their runtimes preloaded into every
+#              scsynth the tests start (KF_SERVER_PRELOAD); any finding fails. KF_SANITIZED_TESTS: a
+#              ctest regex to run fewer of them. scripts/test.sh runs its halves,
+#              sanitize-plugin-build and sanitize-plugin-findings, around one ctest with build/'s.
 #   cross      the platform code off Linux, as far as this machine runs it: the Windows build
 #              (MinGW-w64, no hardware backends: build-mingw/) with its dsp/, device/ and host/
 #              suites under Wine, and the Clang + libc++ build with the POSIX code macOS takes
 #              (build-libcxx/); both build every default target, as a user's cmake --build
 #              does (the plugin .scx, the bench), and the suites
-# Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin|cross]...
+# Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin|cross|
+#                         sanitize-plugin-build|sanitize-plugin-findings]...
 #        (none: all but sclang-lines, which format runs, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -84,29 +86,36 @@ check_sanitize() {
     ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/|host/'
 }
 
-check_sanitize_plugin() {
-  echo "== scene and realtime tests against the plugin under ASan + UBSan (build-asan-plugin/)"
+# The plugin under ASan + UBSan, its scene and realtime tests registered as sanitized/... with
+# the environment their servers need (tests/CMakeLists.txt); the finding logs emptied.
+build_sanitized_plugin() {
+  echo "== the plugin under ASan + UBSan (build-asan-plugin/)"
   configure_and_build build-asan-plugin -DKF_SANITIZE=address,undefined -DKF_SUPERNOVA=OFF -- --target KineticFriction
-  # A finding aborts scsynth, which fails its test; the reports also go to files, so that one in
-  # a server whose test did not notice (at exit, say) fails the check too. The leak check stays
-  # off in the server: scsynth does not free its own allocations at exit. As in scripts/test.sh:
-  # one test more than the cores, the realtime ones one at a time beside the scenes.
-  local logs=$PWD/build-asan-plugin/sanitizer-logs rc=0
-  rm -rf "$logs" && mkdir -p "$logs"
-  # The runtimes of the compiler that built the plugin.
-  local cxx
-  cxx=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' build-asan-plugin/CMakeCache.txt)
-  KF_SERVER_PRELOAD="$("$cxx" -print-file-name=libasan.so) $("$cxx" -print-file-name=libubsan.so)" \
-    ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:log_path=$logs/asan \
-    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$logs/ubsan \
-    ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 1))" \
-    -R "${KF_SANITIZED_TESTS:-scenes/|realtime/}" || rc=$?
-  # The reports went to files only: show them whether or not a test noticed.
+  rm -rf build-asan-plugin/sanitizer-logs && mkdir -p build-asan-plugin/sanitizer-logs
+}
+
+# A finding aborts scsynth, which fails its test; the reports also go to files, so that one in a
+# server whose test did not notice (at exit, say) fails the check too: shown whether or not a
+# test noticed.
+sanitized_plugin_findings() {
+  echo "== sanitizer findings in the servers of the sanitized plugin's tests"
+  local logs=build-asan-plugin/sanitizer-logs
   if compgen -G "$logs/*" >/dev/null; then
     echo "sanitizer findings in servers:" >&2
     cat "$logs"/* >&2
-    rc=1
+    return 1
   fi
+}
+
+check_sanitize_plugin() {
+  build_sanitized_plugin
+  echo "== scene and realtime tests against the plugin under ASan + UBSan"
+  local rc=0
+  # As scripts/test.sh runs ctest: one test more than the cores, the realtime ones one at a time
+  # beside the scenes.
+  ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 1))" \
+    -R "${KF_SANITIZED_TESTS:-^sanitized/(scenes|realtime)/}" || rc=$?
+  sanitized_plugin_findings || rc=1
   return "$rc"
 }
 
@@ -187,7 +196,11 @@ for check in "${checks[@]}"; do
     sanitize) check_sanitize ;;
     fuzz) check_fuzz ;;
     sanitize-plugin) check_sanitize_plugin ;;
+    sanitize-plugin-build) build_sanitized_plugin ;;
+    sanitize-plugin-findings) sanitized_plugin_findings ;;
     cross) check_cross ;;
-    *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin, cross)" >&2; exit 2 ;;
+    *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin, cross;" \
+         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh)" >&2
+       exit 2 ;;
   esac
 done

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
-# fuzz targets, the scene and realtime tests against the sanitized plugin, the cross builds), then
-# every test of build/: Catch2 (dsp, device, host), the NRT scene tests (scsynth and supernova),
+# fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
+# sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
+# (dsp, device, host), the NRT scene tests (scsynth and supernova),
 # the help files, the QEMU guest, and the realtime tests against JACK's dummy driver: one more at a
-# time than there are cores, so that the realtime tests, which run one at a time (RESOURCE_LOCK
-# kf_realtime) and mostly wait on the audio clock, each run beside as many CPU-bound tests as there
-# are cores (the two hogs they are built to hold); the main jobs run alone (RUN_SERIAL). A failing
+# time than there are cores. The realtime tests mostly wait on the audio clock and run one at a
+# time per build (tests/realtime/CMakeLists.txt), so each has beside it at most the other build's
+# and one CPU-bound test (the two hogs they are built to hold); the QEMU guest and the main jobs
+# run alone (RUN_SERIAL). A failing
 # stage does not stop the next: every stage runs, and the command fails if any did (with ctest's
 # exit code when ctest was the one).
 #
@@ -89,10 +91,17 @@ if $quick; then
   stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
-  for check in format pyflakes sanitize fuzz sanitize-plugin cross; do
+  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross; do
     stage "$check" scripts/check.sh "$check"
   done
-  stage ctest ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" "$@"
+  # build/'s tests and the sanitized plugin's scene and realtime tests (sanitized/...) in one
+  # ctest, so that the two builds' realtime chains run side by side and the CPU-bound tests of
+  # either fill the cores beside them: a folder whose CTestTestfile names both.
+  mkdir -p build/with-sanitized
+  printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
+    > build/with-sanitized/CTestTestfile.cmake
+  stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 1))" "$@"
+  stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
 fi
 summary build/test-stages.txt
 exit "$rc"
