@@ -64,14 +64,14 @@ summary() {
   {
     echo "$machine_line"
     echo "CPU time stolen by the hypervisor during the run: ${stolen} per mille"
-    printf '%-18s %8s  %s\n' stage seconds result
+    printf '%-26s %8s  %s\n' stage seconds result
     for i in "${!stages[@]}"; do
       total=$((total + seconds[i]))
       line=passed
       ((results[i] != 0)) && line="FAILED (exit ${results[i]})"
-      printf '%-18s %8d  %s\n' "${stages[i]}" "${seconds[i]}" "$line"
+      printf '%-26s %8d  %s\n' "${stages[i]}" "${seconds[i]}" "$line"
     done
-    printf '%-18s %8d\n' total "$total"
+    printf '%-26s %8d\n' total "$total"
   } > "$1"
   echo "== stage timings (also in $1)"
   cat "$1"
