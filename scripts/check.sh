@@ -95,8 +95,7 @@ build_sanitized_plugin() {
 }
 
 # A finding aborts scsynth, which fails its test; the reports also go to files, so that one in a
-# server whose test did not notice (at exit, say) fails the check too: shown whether or not a
-# test noticed.
+# server whose test did not notice (at exit, say) fails the check too. Each is shown here.
 sanitized_plugin_findings() {
   echo "== sanitizer findings in the servers of the sanitized plugin's tests"
   local logs=build-asan-plugin/sanitizer-logs

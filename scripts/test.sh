@@ -3,14 +3,13 @@
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
 # fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
 # sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
-# (dsp, device, host), the NRT scene tests (scsynth and supernova),
-# the help files, the QEMU guest, and the realtime tests against JACK's dummy driver: one more at a
-# time than there are cores. The realtime tests mostly wait on the audio clock and run one at a
-# time per build (tests/realtime/CMakeLists.txt), so each has beside it at most the other build's
-# and one CPU-bound test (the two hogs they are built to hold); the QEMU guest and the main jobs
-# run alone (RUN_SERIAL). A failing
-# stage does not stop the next: every stage runs, and the command fails if any did (with ctest's
-# exit code when ctest was the one).
+# (dsp, device, host), the NRT scene tests (scsynth and supernova), the help files, the QEMU guest,
+# and the realtime tests against JACK's dummy driver: one more at a time than there are cores. The
+# realtime tests mostly wait on the audio clock and run one at a time per build
+# (tests/realtime/CMakeLists.txt), so each has beside it at most the other build's and one CPU-bound
+# test (the two hogs they are built to hold); the QEMU guest and the main jobs run alone
+# (RUN_SERIAL). A failing stage does not stop the next: every stage runs, and the command fails if
+# any did (with ctest's exit code when ctest was the one).
 #
 # At the end each stage's wall time is printed and written to build/test-stages.txt, with what
 # the machine was (cores, realtime scheduling allowed, the CPU time the hypervisor stole), so
