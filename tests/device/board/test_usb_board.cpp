@@ -16,6 +16,7 @@ using namespace kf;
 using namespace kf::board;
 using kf::test::armAlone;
 using kf::test::openBoard;
+using kf::test::StallWitness;
 using kf::test::waitFor;
 using namespace std::chrono_literals;
 
@@ -289,24 +290,37 @@ TEST_CASE("a device with the board: frames drive it, the watchdog and close turn
                                          std::make_shared<CountingForceSink>(), false);
   device->start();
   REQUIRE(device->attachBoard(board) == nullptr);
-  // 200 ms of 1.4 N frames at 1 kHz, as FrictionOut stamps them.
+  // 200 ms of 1.4 N frames at 1 kHz, as FrictionOut stamps them. A frame pushed more than 5 ms
+  // late (this normal-priority thread held up) can leave the device 10 ms without one: a correct
+  // watchdog trip, allowed for as test_frame_timing allows for it.
   const double startS = device->nowS();
+  int lateFrames = 0;
   for (int i = 0; i < 200; ++i) {
     const double frameS = startS + i * 0.001;
     while (device->nowS() < frameS + 0.001) std::this_thread::sleep_for(100us);
+    if (device->nowS() > frameS + 0.001 + 0.005) ++lateFrames;
     device->pushForceFrame({frameS, 1.4f, frameS + 0.001});
   }
   const double lastPushBusS = bus->nowS();
+  StallWitness witness;
   CHECK(waitFor([&] { return bus->drive() == kDriveFull; }));
   // Frames stop: the device's 10 ms watchdog drives the board off (before the board's own 20 ms).
   REQUIRE(waitFor([&] { return bus->drive() == 0; }));
+  const double stalledS = witness.stop();
   const auto timeline = bus->timeline();
   const double offS = bus->timeline().back().timeS;
-  std::printf("device + board: current off %.2f ms after the last frame was pushed (%s)\n", (offS - lastPushBusS) * 1e3,
-              timeline.back().why);
+  std::printf(
+      "device + board: current off %.2f ms after the last frame was pushed (%s), machine stalled %.2f ms, "
+      "%d late frames\n",
+      (offS - lastPushBusS) * 1e3, timeline.back().why, stalledS * 1e3, lateFrames);
   CHECK(std::string(timeline.back().why) == "set-point");  // a zero set-point, not the board's watchdog
-  CHECK(offS - lastPushBusS < 0.030);
-  CHECK(device->telemetry().watchdogTrips == 1);
+  // The 10 ms watchdog from the last frame's play time, then the pump's and the board thread's
+  // 1 ms periods: 13.2-19.4 ms in 53 runs, alone, beside two CPU hogs and beside a test run. 25 ms
+  // leaves 5 ms of scheduling slack and stays under the 10 + 20 ms the board's own watchdog would
+  // take; a stall holds the chain up by at most its length. A 25 ms device watchdog fails it.
+  CHECK(offS - lastPushBusS < 0.025 + stalledS);
+  CHECK(device->telemetry().watchdogTrips >= 1);
+  CHECK(device->telemetry().watchdogTrips <= 1 + static_cast<uint64_t>(lateFrames));
   // Close: the board is driven off, disarmed, released when the device lets go of it.
   device->pushForceFrame({device->nowS(), 1.4f, device->nowS()});
   CHECK(waitFor([&] { return bus->drive() == kDriveFull; }));
