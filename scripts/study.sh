@@ -14,9 +14,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-# The report (the extension's python/kfstudy) needs scipy beside the main job's numpy,
-# matplotlib and soundfile.
+# The report (the extension's python/kfstudy) needs scipy and pandas beside the main job's
+# numpy, matplotlib and soundfile.
 source scripts/packages.sh
-kf_install_missing python3-scipy
+kf_install_missing python3-scipy python3-pandas
 source scripts/env.sh
 "$KF_PYTHON" scripts/study/study_job.py "$@"

@@ -6,8 +6,8 @@ import importlib
 import sys
 
 # The module each needs, and its Debian package.
-NEEDED = [("numpy", "python3-numpy"), ("matplotlib", "python3-matplotlib"), ("scipy", "python3-scipy"),
-          ("soundfile", "python3-soundfile")]
+NEEDED = [("numpy", "python3-numpy"), ("pandas", "python3-pandas"), ("matplotlib", "python3-matplotlib"),
+          ("scipy", "python3-scipy"), ("soundfile", "python3-soundfile")]
 MISSING_STATUS = 3
 
 
@@ -35,10 +35,10 @@ def main(argv):
     from .report import write_report
     summary = write_report(argv[0], argv[1])
     print(f"{len(summary['sessions'])} sessions reported into {argv[1]}/report.md")
-    for r in summary["binds"]:
+    for r in summary["binds"].to_dict("records"):
         print(f"binds, {r['mapping']}: off {r['mean_off']:.1f} mm/s, on {r['mean_on']:.1f} mm/s, "
               f"t({r['df']}) = {r['t']:.2f}, p = {r['p']:.3g}")
-    for f in summary["thresholds"]:
+    for f in summary["thresholds"].to_dict("records"):
         print(f"threshold, {f['participant']} {f['condition']}: {f['threshold']:.4g} {f['unit']} "
               f"(model observer's {f['observer_threshold']:.4g}) from {f['trials']} trials")
     return 0

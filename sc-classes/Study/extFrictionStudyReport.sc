@@ -1,5 +1,5 @@
 // The report of a study's sessions, from sclang: the extension's own Python (its python/kfstudy
-// folder, installed with the classes) run by python3 with numpy, matplotlib, scipy and soundfile.
+// folder, installed with the classes) run by python3 with numpy, pandas, matplotlib, scipy and soundfile.
 // It writes report.md with PNG figures and CSV files beside it into a folder, and report.log (what
 // python3 said). A missing package is named, with the Debian packages that hold them.
 + FrictionStudy {
@@ -40,9 +40,9 @@
 		case
 			{ status == 0 } { said.postln; ^reportFolder +/+ "report.md" }
 			{ status == 127 } {
-				Error("%: % was not found: the report runs python3 with numpy, matplotlib, scipy and soundfile "
-					"(on Debian or Ubuntu: sudo apt-get install python3 python3-numpy python3-matplotlib python3-scipy "
-					"python3-soundfile)".format(where, python)).throw
+				Error("%: % was not found: the report runs python3 with numpy, pandas, matplotlib, scipy and "
+					"soundfile (on Debian or Ubuntu: sudo apt-get install python3 python3-numpy python3-pandas "
+					"python3-matplotlib python3-scipy python3-soundfile)".format(where, python)).throw
 			}
 			{ Error("%: the report failed (% exit %): %".format(where, python, status,
 				said.split($\n).reject(_.isEmpty).keep(-12).join("\n"))).throw }

@@ -97,7 +97,7 @@ estimate = FrictionObserver(0.1, 3.5, 0.02, seed: 4).runProcedure(straight);
 
     # The report fits exactly the trials the procedure used and says how the attempts joined.
     summary = report.write_report(root, root / "report")
-    (fit,) = summary["thresholds"]
+    (fit,) = summary["thresholds"].to_dict("records")
     assert fit["trials"] == len(straight_levels) and fit["estimate"] == straight_estimate
     own = psychometric.fit(straight_levels, [c == "true" for c in straight_correct])
     assert fit["threshold"] == own["threshold"]

@@ -158,7 +158,7 @@ while { ~session.isOver.not } { 0.1.wait };
     assert "`P8` cannot be read" in text and "## Participant P9" in text and "answers.csv line 3" in text
     p9 = text.split("## Participant P9")[1]
     assert "Not reported: its files cannot be read" in p9 and "01-first/device.kfsession: not UTF-8" in p9 and "Not reported" not in text.split("## Participant P7")[1].split("## ")[0]
-    assert {r["participant"] for r in summary["rows"]} == {"P7"}
+    assert set(summary["conditions"].participant) == {"P7"}
 
 
 # A person's session on a replayed recording whose puck's right button goes down 2.0 s after the

@@ -65,7 +65,7 @@ def test_a_threshold_condition_writes_its_trials_and_the_report_fits_them(jack):
 
     # The report fits these trials (psychometric.fit, as on its own) and draws them.
     summary = report.write_report(root, root / "report")
-    (fit,) = summary["thresholds"]
+    (fit,) = summary["thresholds"].to_dict("records")
     own = psychometric.fit([float(t["level"]) for t in trials], [t["correct"] == "true" for t in trials])
     assert fit["threshold"] == own["threshold"] and fit["trials"] == count
     assert fit["observer_threshold"] == THRESHOLD and fit["unit"] == "N"
