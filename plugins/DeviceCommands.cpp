@@ -19,6 +19,8 @@
 //   kfHeartbeat  index [timeoutS]  (the client is alive; with timeoutS, the device's client watch
 //                                   is set: magnet off once no heartbeat came for timeoutS, 0 no
 //                                   watch; Device::watchClient)
+//   kfSimFail    index             (a simulated realtime device's thread fails, as a driver that
+//                                   lost its device would: to rehearse what a study does then)
 //
 // Replies follow the server's conventions (CommandRunner.hpp): `/done cmdName` when a command
 // succeeded; when it failed, no /done but `/kfFail` to the notified clients, and the reason is
@@ -39,6 +41,7 @@
 #include "PluginShared.hpp"
 #include "board/UsbBoardBackend.hpp"
 #include "core/threads/DeviceMessages.hpp"
+#include "sim/SimDevice.hpp"
 
 namespace {
 
@@ -78,6 +81,7 @@ enum StatusField {
   kLastForceN,
   kRecording,      // 1 while a recording is open and has not stopped by itself (a write error)
   kAudioCallMaxS,  // the longest block of a FrictionOut on the audio thread (realtime)
+  kFault,          // what of the device failed (DeviceFault): 0 nothing
   kStatusFields
 };
 
@@ -189,6 +193,27 @@ void recordCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, recordStage);
 }
 
+// What of an open device failed, for kFault (sclang: FrictionDevice.faultOf).
+enum DeviceFault {
+  kNoFault = 0,
+  kThreadStopped = 1,      // a backend threw: nothing pumps the device (Device::threadFailed)
+  kMouseUnplugged = 2,     // its real mouse is gone (kfReopenMouse when it is back)
+  kBoardNotConnected = 3,  // its board is unplugged or not answering
+  kBoardFault = 4,         // its board tripped to its fault state (over-current, a power loss)
+};
+
+DeviceFault faultOf(kf::Device& device) {
+  if (device.threadFailed()) return kThreadStopped;
+  if (!device.mouseBackend().connected()) return kMouseUnplugged;
+  const std::shared_ptr<kf::ForceBackend> holder = device.board();
+  if (const auto* board = dynamic_cast<const kf::UsbBoardBackend*>(holder.get())) {
+    const kf::BoardTelemetry t = board->telemetry();
+    if (!t.connected) return kBoardNotConnected;
+    if (t.haveStatus && t.status.state == kf::board::BoardState::kFault) return kBoardFault;
+  }
+  return kNoFault;
+}
+
 // The figures of the reply (statusStage).
 void fillStatusValues(kf::Device& device, const kf::ThreadScheduling& usbThread, float* v) {
   const kf::TelemetrySnapshot t = device.telemetry();
@@ -223,6 +248,7 @@ void fillStatusValues(kf::Device& device, const kf::ThreadScheduling& usbThread,
   v[kLastForceN] = t.lastCommandedForceN;
   v[kRecording] = device.isRecording() ? 1.0f : 0.0f;
   v[kAudioCallMaxS] = f(t.audioCallMaxS);
+  v[kFault] = static_cast<float>(faultOf(device));
 }
 
 // The board's event thread, if the device has a board.
@@ -268,6 +294,11 @@ bool statusStage(World*, void* raw) {  // NRT
   line("force to magnet", t.forceLatency);
   const std::string recordingError = data->device->recordingError();
   if (!recordingError.empty()) Print("kfStatus %d: recording failed: %s\n", data->args.index, recordingError.c_str());
+  static const char* const kFaultTexts[] = {"", "its thread stopped (the post window said why): reopen the device",
+                                            "its mouse is unplugged", "its board is not connected",
+                                            "its board is in its fault state"};
+  if (const DeviceFault fault = faultOf(*data->device))
+    Print("kfStatus %d: FAILED: %s\n", data->args.index, kFaultTexts[fault]);
   const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
   if (pumps > 0)
     Print(
@@ -346,6 +377,29 @@ void heartbeatCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, heartbeatStage);
 }
 
+// --- kfSimFail -----------------------------------------------------------------------------
+
+bool simFailStage(World*, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->device == nullptr) {
+    failWith(data, "kfSimFail: no device is open at index %d", data->args.index);
+    return false;
+  }
+  auto* sim = dynamic_cast<kf::SimDevice*>(&data->device->mouseBackend());
+  // In lockstep the audio thread pumps the device: an exception there would end the server.
+  if (sim == nullptr || data->device->isLockstep()) {
+    failWith(data, "kfSimFail: device %d is not a simulated realtime device; refused", data->args.index);
+    return false;
+  }
+  sim->failNextPoll();
+  return true;
+}
+
+void simFailCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  CommandData* data = newCommand(world, "kfSimFail", CommandShape::kIndex, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, simFailStage);
+}
+
 }  // namespace
 
 void registerDeviceCommands() {
@@ -358,4 +412,5 @@ void registerDeviceCommands() {
   DefinePlugInCmd("kfClose", closeCmd, nullptr);
   DefinePlugInCmd("kfZero", zeroCmd, nullptr);
   DefinePlugInCmd("kfHeartbeat", heartbeatCmd, nullptr);
+  DefinePlugInCmd("kfSimFail", simFailCmd, nullptr);
 }

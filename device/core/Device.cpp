@@ -90,6 +90,7 @@ void Device::failThread(const char* what) noexcept {
   }
   safety_.resetToOff();
   telemetry_.setCommandedForce(safety_.commandedForceN());
+  threadFailed_.store(true, std::memory_order_release);
   try {
     recorder_.writeOff(std::max(lastPumpS_, 0.0), OffCause::kFailure);
     recorder_.close();

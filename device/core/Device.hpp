@@ -125,6 +125,9 @@ class Device {
   void heartbeat() { lastHeartbeatS_.store(nowS(), std::memory_order_release); }
   // The watched client has been silent past its timeout (the magnet held off).
   bool clientSilent() const { return clientSilent_.load(std::memory_order_acquire); }
+  // The device thread stopped on a backend's exception (failThread): nothing pumps the device
+  // any more, its magnet is off and its recording closed, until it is opened again.
+  bool threadFailed() const { return threadFailed_.load(std::memory_order_acquire); }
 
   // Async-signal-safe, from any thread (the handlers of host/ExitSafety.cpp): drives the
   // magnet off without a lock and appends an off record to the recording; no pump runs after
@@ -219,6 +222,7 @@ class Device {
   std::atomic<double> clientTimeoutS_{0.0};  // watchClient's; 0 no watch
   std::atomic<double> lastHeartbeatS_{0.0};  // device time of the last heartbeat()
   std::atomic<bool> clientSilent_{false};
+  std::atomic<bool> threadFailed_{false};
   std::atomic<bool> offRequested_{false};  // requestOff()
   std::atomic<bool> closed_{false};
   // emergencyOff() and haltInOrder(): no pump runs any more (halted_), and none is under way (pumping_).

@@ -16,6 +16,8 @@ class MouseBackend {
   // then, oldest first. Their deviceTimeS is the device's own clock (it may drift). Reports
   // that do not fit stay for the next call. Returns how many were written. One thread only.
   virtual int pollReports(double untilTimeS, MouseReport* out, int capacity) = 0;
+  // False while the source is gone (a real mouse unplugged). Any non-realtime thread.
+  virtual bool connected() const { return true; }
   // A line for kfStatus about the source itself (a real mouse: state, losses); empty for none.
   // Non-realtime threads only.
   virtual std::string statusLine() const { return {}; }

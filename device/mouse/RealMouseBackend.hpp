@@ -66,6 +66,7 @@ class RealMouseBackend : public MouseBackend {
   // One line for kfStatus.
   std::string describe() const;
   std::string statusLine() const override { return describe(); }
+  bool connected() const override { return state() != MouseState::kUnplugged; }
   ThreadScheduling readerScheduling() const override { return readerScheduling_.load(); }
   virtual std::string kindName() const = 0;
   // True when the kernel does not say it dropped reports and lossEvents is inferred.

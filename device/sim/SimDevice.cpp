@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace kf {
 
@@ -74,6 +75,8 @@ void SimDevice::storeReport(const MouseReport& report) {
 }
 
 int SimDevice::pollReports(double untilTimeS, MouseReport* out, int capacity) {
+  if (failNextPoll_.exchange(false, std::memory_order_acq_rel))
+    throw std::runtime_error("the simulated device failed (kfSimFail)");
   advanceTo(untilTimeS);
   int written = 0;
   while (written < capacity && bufferCount_ > 0) {

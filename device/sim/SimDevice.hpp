@@ -7,6 +7,7 @@
 // device thread or, in lockstep, the audio thread) and read the truth accessors there.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +33,9 @@ class SimDevice : public MouseBackend, public ForceBackend {
   void advanceTo(double timeS);
 
   int pollReports(double untilTimeS, MouseReport* out, int capacity) override;
+  // The next pollReports throws, as a driver that lost its device would: for rehearsing what a
+  // study or a performance does when its device fails (kfSimFail). From any thread.
+  void failNextPoll() { failNextPoll_.store(true, std::memory_order_release); }
   // Advances to timeS first, so the command takes effect from then on (late commands: now).
   void commandForce(double timeS, float forceN) override;
   void driveOff() override;
@@ -76,6 +80,7 @@ class SimDevice : public MouseBackend, public ForceBackend {
   int bufferHead_ = 0;
   int bufferCount_ = 0;
   uint64_t bufferOverflows_ = 0;
+  std::atomic<bool> failNextPoll_{false};
 };
 
 }  // namespace kf

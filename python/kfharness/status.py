@@ -7,7 +7,9 @@ bench and the soak."""
 SC_POST = r"""
 ~kfPostStatus = { |dev, tag|
 	dev.statusValues({ |v|
-		var number = { |x| if(x.isKindOf(Boolean)) { x.binaryValue } { x.asFloat } };
+		// fault is a Symbol or nil (FrictionDevice.faultOf): 1 for a fault, 0 for none.
+		var number = { |x| case { x.isKindOf(Boolean) } { x.binaryValue } { x.isNumber } { x.asFloat }
+			{ x.isNil } { 0 } { 1 } };
 		"% % %".format(tag, dev.index,
 			FrictionDevice.statusFields.collect { |k| "%=%".format(k, number.(v[k])) }.join(" ")).postln
 	});

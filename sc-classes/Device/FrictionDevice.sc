@@ -177,14 +177,25 @@ FrictionDevice {
 			frames, watchdogTrips, missedDeadlines, skippedFrames, lateFrames, reportQueueOverflows,
 			frameQueueOverflows, loopP50S, loopP99S, loopMaxS, forceP50S, forceP99S, forceP999S, forceMaxS,
 			reportP50S, reportP99S, reportMaxS, releaseLatencyS, reportIntervalS, reportJitterS, lastForceN, recording,
-			audioCallMaxS]
+			audioCallMaxS, fault]
 	}
 	*statusOf { |values|
 		var event = ();
 		this.statusFields.do { |name, i| event[name] = values[i] };
 		#[open, realtime, memoryLocked, recording].do { |name| event[name] = event[name] == 1 };
+		event[\fault] = this.faultOf(event[\fault]);
 		^event
 	}
+	// What of an open device failed, from the code in a /kfStatus reply: nil (nothing),
+	// \threadStopped (a backend failed: nothing drives the device until it is opened again),
+	// \mouseUnplugged, \boardNotConnected or \boardFault (the board tripped: over-current, power).
+	*faultOf { |code| ^#[nil, \threadStopped, \mouseUnplugged, \boardNotConnected, \boardFault][code ? 0] }
+
+	// A simulated realtime device's thread fails at once, as a driver that lost its device
+	// would: the magnet off, the recording ended (cause failure), statusValues' fault
+	// \threadStopped. To rehearse what a study or a set does when its device fails.
+	simulateFailure { this.prSendAnswered(\kfSimFail, this.simulateFailureMsg) }
+	simulateFailureMsg { ^['/cmd', \kfSimFail, index] }
 
 	// A 4-channel control Bus of the puck's [x, y, speedX, speedY] (mm, mm/s), made on first
 	// use and written by one reader synth at the head of the server: for GUIs and re-centring

@@ -14,7 +14,8 @@
 		lastAnswerT = watchTickT = Main.elapsedTime;
 		answered = OSCFunc({ lastAnswerT = Main.elapsedTime }, '/synced', server.addr, argTemplate: [watchId]);
 		// A /kfStatus reply (index, then FrictionDevice.statusFields) for the device the condition
-		// runs on, saying it is closed or its recording stopped by itself (a write error, a full
+		// runs on, saying it is closed, it failed (FrictionDevice.faultOf: its thread stopped, its
+		// mouse or board gone or tripped) or its recording stopped by itself (a write error, a full
 		// disk: the server posted why). Not in force between conditions (state is not running: a
 		// simulated participant's device is closed on purpose then).
 		deviceStatus = OSCFunc({ |msg|
@@ -22,6 +23,9 @@
 			if(state == \running and: { polled.notNil } and: { msg[2] == polled.index }) {
 				case
 					{ status[\open].not } { this.prLost("the device % closed under the session".format(polled)) }
+					{ status[\fault].notNil } {
+						this.prLost("the device % failed (%; the post window says why)".format(polled, status[\fault]))
+					}
 					{ status[\recording].not } {
 						this.prLost("the recording of % stopped (the post window says why)".format(polled))
 					}

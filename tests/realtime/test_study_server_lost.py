@@ -1,7 +1,7 @@
 """A study session whose instrument is gone mid-threshold-condition fails at once: its server dies
 (kill -9 of scsynth, or of jackd: the server's audio stops), its device's slot is closed under it,
 its device recording stops (a file size limit: as a full disk), or sclang itself stands still
-(stopped by SIGSTOP for 5 s, as a computer that slept). Checked: the session's state, its reason in
+(stopped by SIGSTOP for 5 s, as a computer that slept), or the device's thread fails. Checked: the session's state, its reason in
 session.csv and the condition's events, and no trial stored after the death (FrictionStudySession's
 watch: a /sync every 0.25 s, lost after lostAfterS; the device's status each tick; the watch's own
 tick late by more than lostAfterS). And sclang killed, its server playing on: the server stops the
@@ -45,6 +45,8 @@ ACTIONS = {
     "jackd": '("kill -9 " ++ @JACKD@).systemCmd;\nkillT = Main.elapsedTime;',
     # Its slot closed as another client (or a failed reopen) would close it.
     "device": "s.sendMsg('/cmd', \\kfClose, 0);\nkillT = Main.elapsedTime;",
+    # Its thread fails, as when a driver loses its device (the simulated device's kfSimFail).
+    "failing": "s.sendMsg('/cmd', \\kfSimFail, 0);\nkillT = Main.elapsedTime;",
     # The server may write 2000 bytes more into any file (its device recording grows by about 40 kB
     # a second): the recording stops on the write that would pass it (SIGXFSZ ignored).
     "recording": 'killT = Main.elapsedTime;\n("prlimit --pid " ++ s.pid ++ " --fsize=" ++ (File.fileSize(@ROOT@ +/+ '
@@ -54,6 +56,7 @@ ACTIONS = {
               'thisProcess.pid).systemCmd;',
 }
 REASONS = {"scsynth": "stopped answering", "jackd": "stopped answering", "device": "closed under the session",
+           "failing": "failed (threadStopped",
            "recording": "stopped (the post window says why)", "sclang": "sclang stood still"}
 
 
@@ -68,7 +71,7 @@ def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jac
     lost_after_s = float(run.lines("KF-LOST-AFTER")[0][0])
     death_to_failure_s = float(run.lines("KF-DEATH-TO-FAILURE")[0][0])
     print(f"KF-FIGURE study_{victim}_death_to_session_failure_s {death_to_failure_s:.3f}")
-    if victim in ("device", "recording"):
+    if victim in ("device", "failing", "recording"):
         # Found at the next tick's status reply: within a tick (0.25 s) and a round trip, plus the
         # routine's wait for the CPU beside two hogs (tens of ms), and for the recording the 2000
         # bytes it may still write (50 ms); 1 s of room.
@@ -97,6 +100,11 @@ def test_a_dead_server_fails_the_session_at_once_and_nothing_is_stored_after(jac
     events = [e["event"] for e in read_csv(folder / "01-forceStep" / "events.csv")]
     assert events[-1] == "lost" and "done" not in events and "estimate" not in events, events
     assert "the session failed" in run.output
+    if victim == "failing":
+        # The device's own part: the magnet off and the recording ended by the failure, at once.
+        recording = readers.Session(folder / "01-forceStep" / "device.kfsession")
+        assert recording.off_causes[-1:] == ["failure"], recording.off_causes
+        assert "the simulated device failed (kfSimFail)" in run.output
 
 
 FAILING = r"""

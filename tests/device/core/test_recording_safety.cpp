@@ -198,6 +198,7 @@ TEST_CASE("an exception on the device thread drives the magnet off and is posted
   }
   CHECK(force->offs.load() == 1);
   CHECK(device.telemetry().lastCommandedForceN == Approx(DeviceSpec{}.minForceN));
+  CHECK(device.threadFailed());  // what kfStatus reports as its fault
   REQUIRE(messages.size() == 1);
   CHECK(contains(messages[0], "driver lost the device"));
   device.close();  // joins the ended thread
