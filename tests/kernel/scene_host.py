@@ -17,6 +17,13 @@ COUNT_MM = 0.125           # one count, one sample of the pilot signal at mappin
 # apart, and the device's 10 ms watchdog, there for a stuck audio thread, would turn the force
 # off between them. The scene is about which force reaches the board, not when: 0.5 s.
 WATCHDOG_S = 0.5
+# sclang's hang guard for the whole scene: no shorter than the guest program's own guards
+# (test_pilot_scene.cpp: 120 s for sclang to be ready, then five steps of two 30 s waits), which
+# say which step hung. At 150 s it ended scenes that were slow, not hung: 186 s of a guest whose
+# 10 s board stream ran at 0.6 set-points per ms (1.8 at earlier stops), and the scene's play took
+# 11.7 to 73 s in runs that passed. A scene that hangs is still ended: by the guest program's
+# guards, or by the whole guest run's 480 s limit (test_kernel_guest.HANG_GUARD_S), whichever first.
+SCENE_TIMEOUT_S = 420
 
 SCENE = r"""
 var stopFile = @stopFile@, finish;
@@ -79,7 +86,7 @@ class SceneHost:
     def start(self):
         self.stop_path.unlink(missing_ok=True)
         script = self.work_dir / "scene.scd"
-        script.write_text(sclang.fill(SCENE, stopFile=sclang.sc_string(self.stop_path), timeoutS=150,
+        script.write_text(sclang.fill(SCENE, stopFile=sclang.sc_string(self.stop_path), timeoutS=SCENE_TIMEOUT_S,
                                       port=self.port, mouse=sclang.sc_string(MOUSE),
                                       serial=sclang.sc_string(SERIAL), countMm=COUNT_MM, watchdogS=WATCHDOG_S))
         self.log = open(self.log_path, "w")
