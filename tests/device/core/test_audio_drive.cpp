@@ -1,7 +1,9 @@
 // The audio drive's chain (AudioDrive, DriveCircuit): force -> safety path per sample -> magnet
 // table -> current -> volts -> sample value, and the kf-drive file's checks.
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -44,9 +46,18 @@ std::vector<float> drive(const std::vector<float>& forces, const DriveCircuit& c
   return out;
 }
 
+// Written whole under a name of its own, then renamed into place: ctest runs test cases side by
+// side, two of them write the same magnet table, and one read it while the other had it cut to 0
+// bytes (a fresh clone's sanitized run). A reader now sees the old text or the new, never a cut one.
 std::string writeFile(const std::string& name, const std::string& text) {
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/" + name;
-  std::ofstream(path) << text;
+  const std::string temporary =
+      path + ".tmp" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
+  std::ofstream(temporary) << text;
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {  // Windows renames onto no existing file
+    std::remove(path.c_str());
+    std::rename(temporary.c_str(), path.c_str());
+  }
   return path;
 }
 
