@@ -297,7 +297,7 @@ bool statusStage(World*, void* raw) {  // NRT
   static const char* const kFaultTexts[] = {"", "its thread stopped (the post window said why): reopen the device",
                                             "its mouse is unplugged", "its board is not connected",
                                             "its board is in its fault state"};
-  if (const DeviceFault fault = faultOf(*data->device))
+  if (const auto fault = static_cast<DeviceFault>(data->replyValues[kFault]))
     Print("kfStatus %d: FAILED: %s\n", data->args.index, kFaultTexts[fault]);
   const uint64_t pumps = t.framesPerPump[0] + t.framesPerPump[1] + t.framesPerPump[2] + t.framesPerPump[3];
   if (pumps > 0)
