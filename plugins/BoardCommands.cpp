@@ -50,6 +50,9 @@ enum BoardStatusField {
   kReopens,
   kOnePerPump,
   kOffsetP50S,
+  kForceRateHz,    // the board's: levels per 1 ms frame x 1000 (2.1: up to 8 kHz)
+  kLevelsPadded,   // levels sent again: the device's next had not come
+  kLevelsDropped,  // levels never sent: more than two frames were waiting
   kBoardStatusFields
 };
 
@@ -97,6 +100,10 @@ bool openStage(World*, void* raw) {  // NRT
   options.transfersInFlight = static_cast<int>(data->args.numbers[1]);
   options.minForceN = data->device->spec().minForceN;
   options.maxForceN = data->device->spec().maxForceN;
+  // The board is asked for the device's force rate: 8 levels per 1 ms frame at 8 kHz.
+  options.subSetPoints =
+      static_cast<int>(std::clamp(std::lround(kf::board::kFramePeriodS / data->device->spec().forceFramePeriodS), 1L,
+                                  static_cast<long>(kf::board::kMaxSubSetPoints)));
   options.thread = data->device->options().thread;
   std::unique_ptr<kf::usb::Port> port;
   if (emulate)
@@ -115,10 +122,17 @@ bool openStage(World*, void* raw) {  // NRT
   data->device->setCalibration(
       kf::CalibrationTable::linear(data->device->spec().minForceN, data->device->spec().maxForceN));
   const kf::BoardTelemetry t = board->telemetry();
-  Print("kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA) is disarmed\n",
-        data->args.index, t.serial.empty() ? "(no serial)" : t.serial.c_str(), emulate ? " (emulated)" : "",
-        t.version.protocolMajor, t.version.protocolMinor, t.version.firmwareMajor, t.version.firmwareMinor,
-        t.version.firmwarePatch, t.version.fullScaleCurrentMa);
+  Print(
+      "kfBoardOpen %d board %s%s (protocol %d.%d, firmware %d.%d.%d, full scale %d mA, force at %d kHz) is "
+      "disarmed\n",
+      data->args.index, t.serial.empty() ? "(no serial)" : t.serial.c_str(), emulate ? " (emulated)" : "",
+      t.version.protocolMajor, t.version.protocolMinor, t.version.firmwareMajor, t.version.firmwareMinor,
+      t.version.firmwarePatch, t.version.fullScaleCurrentMa, t.subSetPoints);
+  if (t.subSetPoints < options.subSetPoints)
+    Print(
+        "kfBoardOpen %d: the device frames force at %d kHz, this board plays %d kHz: it is sent the mean of each "
+        "%d frames\n",
+        data->args.index, options.subSetPoints, t.subSetPoints, options.subSetPoints / t.subSetPoints);
   return true;
 }
 
@@ -225,6 +239,9 @@ bool collectStatusStage(World*, void* raw) {  // NRT
   v[kBadStatus] = static_cast<float>(b.badStatus);
   v[kUnplugs] = static_cast<float>(b.unplugs);
   v[kReopens] = static_cast<float>(b.reopens);
+  v[kForceRateHz] = static_cast<float>(1000 * b.subSetPoints);
+  v[kLevelsPadded] = static_cast<float>(b.subStepsPadded);
+  v[kLevelsDropped] = static_cast<float>(b.subStepsDropped);
   return true;
 }
 
@@ -263,21 +280,24 @@ void postBoardStatus(int index, Device& device) {
   const BoardTelemetry t = board->telemetry();
   const board::Status& s = t.status;
   auto count = [](uint64_t value) { return static_cast<unsigned long long>(value); };
-  Print("kfStatus %d: board %s %s, %s; board state %s, current %.3f of full scale, %.2f degC, errors 0x%04x%s\n", index,
-        t.serial.empty() ? "(no serial)" : t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED",
-        t.armed ? "armed" : "disarmed",
-        !t.haveStatus                             ? "unknown"
-        : s.state == board::BoardState::kArmed    ? "armed"
-        : s.state == board::BoardState::kDisarmed ? "disarmed"
-                                                  : "FAULT",
-        s.currentDrive / static_cast<double>(board::kDriveFull), s.temperatureCentiC / 100.0, s.errors,
-        (s.errors & board::kErrWatchdog) ? " (its watchdog tripped)" : "");
+  Print(
+      "kfStatus %d: board %s %s, %s, force at %d kHz; board state %s, current %.3f of full scale, %.2f degC, errors "
+      "0x%04x%s\n",
+      index, t.serial.empty() ? "(no serial)" : t.serial.c_str(), t.connected ? "connected" : "NOT CONNECTED",
+      t.armed ? "armed" : "disarmed", t.subSetPoints,
+      !t.haveStatus                             ? "unknown"
+      : s.state == board::BoardState::kArmed    ? "armed"
+      : s.state == board::BoardState::kDisarmed ? "disarmed"
+                                                : "FAULT",
+      s.currentDrive / static_cast<double>(board::kDriveFull), s.temperatureCentiC / 100.0, s.errors,
+      (s.errors & board::kErrWatchdog) ? " (its watchdog tripped)" : "");
   Print(
       "kfStatus %d: board set-points sent %llu (last drive %.3f), late %llu, lost %llu (timeouts %llu, partial "
-      "%llu), stalls %llu, bad status %llu, unplugs %llu, reopens %llu, resets %llu%s%s%s\n",
+      "%llu), stalls %llu, bad status %llu, unplugs %llu, reopens %llu, resets %llu, levels padded %llu, dropped "
+      "%llu%s%s%s\n",
       index, count(t.setPointsSent), t.lastDriveSent / static_cast<double>(board::kDriveFull), count(t.lateTransfers),
       count(t.lostTransfers), count(t.timeouts), count(t.partials), count(t.stalls), count(t.badStatus),
-      count(t.unplugs), count(t.reopens), count(t.boardResets),
+      count(t.unplugs), count(t.reopens), count(t.boardResets), count(t.subStepsPadded), count(t.subStepsDropped),
       t.transfersLeaked ? "; a transfer never came back (left allocated)" : "",
       t.lastError.empty() ? "" : "; last error ", t.lastError.c_str());
 }

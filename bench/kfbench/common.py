@@ -13,7 +13,7 @@ BENCH_DIR = Path(__file__).resolve().parents[1]
 SR = 48000
 BLOCK = 64
 T0 = time.monotonic()
-PARTS = ["build", "log", "timing", "spatial", "loudness", "drift", "reconstruction", "report_rate", "e2e", "rtload", "scale", "drive", "patterns", "thresholds"]
+PARTS = ["build", "log", "timing", "spatial", "loudness", "drift", "reconstruction", "report_rate", "e2e", "rtload", "scale", "drive", "patterns", "texture_rate", "thresholds"]
 
 PILOT = profile.pilot()
 MAPPING = profile.mapping()

@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import drive_path, goals, patterns, realtime, report_rate, spatial, thresholds, timing
+from . import drive_path, goals, patterns, realtime, report_rate, spatial, texture_rate, thresholds, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -176,6 +176,15 @@ def patterns_section(pt, build_dir):
                   cost=patterns.cost_table(pt, table), alias=patterns.alias_table(pt, table))
 
 
+def texture_rate_section(tr, build_dir):
+    return render("texture_rate", cmd=CMD, exe=f"{build_dir}/bench/kf_texture_rate_bench", rounds=tr["rounds"],
+                  rate_khz=tr["sample_rate_hz"] // 1000, block=tr["block"], weber=tr["weber"],
+                  within_1k=tr["within_weber_hz"][0], within_8k=tr["within_weber_hz"][1],
+                  latency_1k=tr["latency_ms"][0], latency_8k=tr["latency_ms"][1], cpu_1k=tr["cpu_ms_per_s"][0],
+                  cpu_8k=tr["cpu_ms_per_s"][1], cpu_ratio=tr["cpu_ratio"], cpu_lo=tr["cpu_ratio_range"][0],
+                  cpu_hi=tr["cpu_ratio_range"][1], fidelity=texture_rate.fidelity_table(tr, table))
+
+
 def thresholds_section(th):
     procedures, fits = thresholds.tables(th, table)
     q = th["questplus_reference"]
@@ -265,6 +274,7 @@ def write(results, path, build_dir="build"):
                       ("report_rate", lambda: report_rate_section(get("report_rate"), build_dir)),
                       ("drive", lambda: drive_section(get("drive"))),
                       ("patterns", lambda: patterns_section(get("patterns"), build_dir)),
+                      ("texture_rate", lambda: texture_rate_section(get("texture_rate"), build_dir)),
                       ("thresholds", lambda: thresholds_section(get("thresholds"))),
                       ("e2e", lambda: e2e_section(get("e2e"))),
                       ("rtload", lambda: rtload_section(get("rtload"))),

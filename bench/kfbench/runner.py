@@ -9,6 +9,7 @@ import time
 from kfharness import nrt
 
 from . import build, drift, drive_path, goals, loudness, native, patterns, plots, provenance, realtime, report, report_rate, \
+    texture_rate, \
     rtload, scores, spatial, thresholds, timing
 from .common import BENCH_DIR, PARTS, T0, Bench, fmt, log
 from .summary import summary_lines
@@ -111,6 +112,10 @@ def run_parts(bench, args, parts):
         log("patterns: FrictionPattern's kinds, ns/sample with anti-aliasing on and off, and the alias it removes")
         results["patterns"] = patterns.run(bench)
         _print({"patterns": results["patterns"]})
+    if "texture_rate" in parts:
+        log("texture_rate: a grating's force through the framing and the board at 1 and 8 kHz, against the ideal")
+        results["texture_rate"] = texture_rate.run(bench)
+        _print({"texture_rate": results["texture_rate"]})
     if "thresholds" in parts:
         log(f"thresholds: the procedures against a model observer, {thresholds.RUNS} runs each, beside "
             "python3-questplus and psignifit")

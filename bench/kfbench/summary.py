@@ -3,7 +3,7 @@ over the repeated measurements of the run."""
 import numpy as np
 
 from .common import BLOCK, MAPPING, MAPPINGS, SR, fmt
-from . import drive_path, patterns, report_rate, thresholds
+from . import drive_path, patterns, report_rate, texture_rate, thresholds
 from .native import reconstruction_checks
 from .timing import READERS
 
@@ -72,6 +72,8 @@ def summary_lines(results):
         lines += drive_path.summary_lines(results["drive"])
     if results.get("patterns"):
         lines += patterns.summary_lines(results["patterns"])
+    if results.get("texture_rate"):
+        lines += texture_rate.summary_lines(results["texture_rate"])
     if results.get("thresholds"):
         lines += thresholds.summary_lines(results["thresholds"])
     rr = results.get("report_rate")

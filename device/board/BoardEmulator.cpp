@@ -14,6 +14,7 @@ VersionReply emulatedVersion() {
   version.firmwareMajor = 1;
   version.flags = 1;
   version.fullScaleCurrentMa = 1500;
+  version.maxSubSetPoints = kMaxSubSetPoints;  // its coil's target changes at the exact times
   return version;
 }
 }  // namespace

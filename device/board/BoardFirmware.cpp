@@ -1,5 +1,6 @@
 #include "board/BoardFirmware.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace kf::board {
@@ -13,19 +14,37 @@ void BoardFirmware::setDrive(uint16_t drive, double timeS, const char* why) {
   coil_.setTarget(drive, timeS, why);
 }
 
+void BoardFirmware::turnOff(double timeS, const char* why) {
+  subCount_ = subNext_ = 0;
+  setDrive(0, timeS, why);
+}
+
+void BoardFirmware::playSubSetPoints(double nowS) {
+  const double stepS = kFramePeriodS / subCount_;
+  for (; subNext_ < subCount_; ++subNext_) {
+    const double dueS = subStartS_ + subNext_ * stepS;
+    if (dueS > nowS) return;
+    // Each step checks what the frame's first did: armed, not over temperature.
+    const bool mayDrive = state_ == BoardState::kArmed && !(errors_ & kErrOverTemperature);
+    setDrive(mayDrive ? subDrives_[subNext_] : 0, dueS, "set-point");
+  }
+}
+
 void BoardFirmware::advance(double nowS) {
-  // The watchdog's moment comes first, at its exact time.
+  // The frame's steps come first (they end within a frame of its arrival), then the watchdog's
+  // moment, each at its exact time.
+  playSubSetPoints(nowS);
   if (watchdogPending_ && nowS >= lastValidS_ + kBoardWatchdogS) {
     const double fireS = lastValidS_ + kBoardWatchdogS;
     watchdogPending_ = false;
     if (state_ == BoardState::kArmed) errors_ |= kErrWatchdog;  // it only runs while armed
-    setDrive(0, fireS, "watchdog");
+    turnOff(fireS, "watchdog");
   }
   // Over temperature is live: set while it lasts, the target held at 0.
   temperatureC_ = coil_.temperatureC(nowS);
   if (temperatureC_ > kOverTemperatureC) {
     errors_ |= kErrOverTemperature;
-    setDrive(0, nowS, "over temperature");
+    turnOff(nowS, "over temperature");
   } else {
     errors_ &= static_cast<uint16_t>(~kErrOverTemperature);
   }
@@ -33,8 +52,12 @@ void BoardFirmware::advance(double nowS) {
 
 void BoardFirmware::receiveSetPoint(const uint8_t* data, size_t size, double nowS) {
   advance(nowS);
-  SetPoint setPoint;
-  if (!decodeSetPoint(data, size, setPoint)) {
+  MultiSetPoint setPoint;
+  // A 2.0 board knows only the single set-point; a 2.1 board plays up to its announced count.
+  const bool known =
+      decodeAnySetPoint(data, size, setPoint) &&
+      (data[0] == kSetPointType || (version_.protocolMinor >= 1 && setPoint.count <= version_.maxSubSetPoints));
+  if (!known) {
     errors_ |= kErrBadFrame;
     ++rejectedFrames_;
     return;
@@ -51,8 +74,12 @@ void BoardFirmware::receiveSetPoint(const uint8_t* data, size_t size, double now
   // The watchdog runs while armed only: a disarmed board's target is 0 already (PROTOCOL.md 6).
   lastValidS_ = nowS;
   watchdogPending_ = state_ == BoardState::kArmed;
-  const bool mayDrive = state_ == BoardState::kArmed && !(errors_ & kErrOverTemperature);
-  setDrive(mayDrive ? setPoint.drive : 0, nowS, "set-point");
+  // A newer frame replaces what is left of the one in play; its first step plays at once.
+  std::copy(setPoint.drives, setPoint.drives + setPoint.count, subDrives_);
+  subCount_ = setPoint.count;
+  subNext_ = 0;
+  subStartS_ = nowS;
+  playSubSetPoints(nowS);
 }
 
 Status BoardFirmware::status(double nowS) {
@@ -77,24 +104,30 @@ ControlReply BoardFirmware::control(uint8_t requestType, uint8_t request, uint16
   const bool in = (requestType & 0x80) != 0;
   if ((requestType & 0x7F) != 0x41) return stall;  // vendor, interface
   switch (static_cast<Request>(request)) {
-    case Request::kGetVersion:
-      if (!in || length < kVersionSize) return stall;
-      encodeVersion(version_, data);
-      return {false, kVersionSize};
+    case Request::kGetVersion: {
+      if (!in || length < kVersionSizeMinor0) return stall;
+      // A 2.0 host asks for 8 bytes and gets them: the 2.1 field comes after.
+      uint8_t reply[kVersionSize];
+      encodeVersion(version_, reply);
+      const auto size = static_cast<uint16_t>(std::min<size_t>(length, versionReplySize(version_)));
+      std::copy(reply, reply + size, data);
+      return {false, size};
+    }
     case Request::kArm:
       if (in || value != kArmKey || refuseArm_ || state_ == BoardState::kFault || (errors_ & kErrOverTemperature))
         return stall;
       if (state_ == BoardState::kArmed) return done;  // ARM while armed: changes nothing
       state_ = BoardState::kArmed;
-      haveSequence_ = false;  // the first frame after arming is taken whatever its sequence
-      lastValidS_ = nowS;     // the watchdog starts with ARM
+      haveSequence_ = false;     // the first frame after arming is taken whatever its sequence
+      subCount_ = subNext_ = 0;  // the rest of a frame sent while disarmed never drives
+      lastValidS_ = nowS;        // the watchdog starts with ARM
       watchdogPending_ = true;
       return done;
     case Request::kDisarm:
       if (in) return stall;
       state_ = BoardState::kDisarmed;
       watchdogPending_ = false;
-      setDrive(0, nowS, "disarm");
+      turnOff(nowS, "disarm");
       return done;
     case Request::kClearErrors: {
       if (!in || length < kClearReplySize) return stall;
@@ -117,7 +150,7 @@ void BoardFirmware::usbReset(double nowS, const char* why) {
   state_ = BoardState::kDisarmed;
   errors_ |= kErrUsbReset;
   watchdogPending_ = false;
-  setDrive(0, nowS, why);
+  turnOff(nowS, why);
 }
 
 void BoardFirmware::overCurrent(double nowS, bool persists) {
@@ -126,14 +159,14 @@ void BoardFirmware::overCurrent(double nowS, bool persists) {
   errors_ |= kErrOverCurrent;
   overCurrentPresent_ = persists;
   watchdogPending_ = false;
-  setDrive(0, nowS, "over current");
+  turnOff(nowS, "over current");
 }
 
 void BoardFirmware::powerLoss(double nowS) {
   advance(nowS);
   state_ = BoardState::kDisarmed;
   watchdogPending_ = false;
-  setDrive(0, nowS, "power");
+  turnOff(nowS, "power");
 }
 
 void BoardFirmware::powerOn(double nowS) {
@@ -144,6 +177,7 @@ void BoardFirmware::powerOn(double nowS) {
   overCurrentPresent_ = false;
   validFrames_ = rejectedFrames_ = 0;
   watchdogPending_ = false;
+  subCount_ = subNext_ = 0;
 }
 
 }  // namespace kf::board

@@ -1,8 +1,8 @@
 // BoardFirmware: the friction board's behaviour (device/board/PROTOCOL.md, sections 3 to 7) as a
 // state machine on explicit times, apart from any transport: set-point validation and sequence
-// rules, arming (and ARM while armed), the 20 ms watchdog (idle while disarmed), status,
-// error flags and CLEAR_ERRORS, the vendor control requests, USB reset, suspend, power loss and
-// an over-current fault. One implementation, two transports: the emulator on the host
+// rules, the sub-set-points of a multi set-point frame played at their own times, arming (and ARM while armed), the 20
+// ms watchdog (idle while disarmed), status, error flags and CLEAR_ERRORS, the vendor control requests, USB reset,
+// suspend, power loss and an over-current fault. One implementation, two transports: the emulator on the host
 // (BoardEmulator inside EmulatedUsb, for the tests) and the FunctionFS gadget
 // (device/board/gadget/, a reference firmware on any Linux board with a USB device port) feed
 // it the same events. What it drives and senses is a CoilDriver: the emulator's simulated coil,
@@ -41,8 +41,11 @@ class BoardFirmware {
   // `version` is what GET_VERSION answers (protocol, firmware, flags, full-scale current).
   BoardFirmware(CoilDriver& coil, const VersionReply& version, double nowS);
 
-  // The board's own timers up to nowS: the watchdog fires at exactly last valid + 20 ms (the
-  // coil's target changes at that time), the over-temperature condition is read.
+  // The board's own timers up to nowS: each sub-set-point of a multi set-point frame is played
+  // at exactly its own time, the watchdog fires at exactly last valid + 20 ms (the coil's target
+  // changes at those times), the over-temperature condition is read. A transport that plays
+  // sub-set-points calls it at least once per sub-step (the gadget's tick; the emulator at
+  // every event, with the exact times in the coil's timeline).
   void advance(double nowS);
   void receiveSetPoint(const uint8_t* data, size_t size, double nowS);
   Status status(double nowS);
@@ -61,6 +64,11 @@ class BoardFirmware {
   // ARM is STALLed without a flag (a fault the board keeps; the emulator's failure mode).
   void setRefuseArm(bool refuse) { refuseArm_ = refuse; }
   void setProtocolMajor(uint8_t major) { version_.protocolMajor = major; }
+  // A 2.0 board: an 8-byte version reply, multi set-point frames rejected as bad frames.
+  void setProtocolMinor0() {
+    version_.protocolMinor = 0;
+    version_.maxSubSetPoints = 1;
+  }
 
   uint16_t drive() const { return drive_; }
   BoardState state() const { return state_; }
@@ -70,6 +78,10 @@ class BoardFirmware {
 
  private:
   void setDrive(uint16_t drive, double timeS, const char* why);
+  // Plays the sub-set-points due by nowS, each at its own time.
+  void playSubSetPoints(double nowS);
+  // Target 0 and nothing more of the frame in play: every way the current goes off.
+  void turnOff(double timeS, const char* why);
 
   CoilDriver& coil_;
   VersionReply version_;
@@ -83,6 +95,11 @@ class BoardFirmware {
   uint16_t errors_ = kErrUsbReset;  // a board starts enumerated: reported until CLEAR_ERRORS
   uint64_t validFrames_ = 0;
   uint64_t rejectedFrames_ = 0;
+  // The frame in play: its drive levels, the next one to play, when the frame started.
+  uint16_t subDrives_[kMaxSubSetPoints] = {};
+  int subCount_ = 0;
+  int subNext_ = 0;
+  double subStartS_ = 0.0;
   bool refuseArm_ = false;
   bool overCurrentPresent_ = false;
 };

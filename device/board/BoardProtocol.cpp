@@ -1,5 +1,7 @@
 #include "board/BoardProtocol.hpp"
 
+#include <algorithm>
+
 namespace kf::board {
 
 namespace {
@@ -43,6 +45,32 @@ bool decodeSetPoint(const uint8_t* data, size_t size, SetPoint& out) {
   return true;
 }
 
+void encodeMultiSetPoint(const MultiSetPoint& frame, uint8_t* out) {
+  out[0] = kMultiSetPointType;
+  out[1] = static_cast<uint8_t>(frame.count);
+  put16(out + 2, frame.sequence);
+  for (int i = 0; i < frame.count; ++i) put16(out + 4 + 2 * i, frame.drives[i]);
+  sealFrame(out, multiSetPointSize(frame.count));
+}
+
+bool decodeAnySetPoint(const uint8_t* data, size_t size, MultiSetPoint& out) {
+  if (size >= 1 && data[0] == kSetPointType) {
+    SetPoint single;
+    if (!decodeSetPoint(data, size, single)) return false;
+    out.sequence = single.sequence;
+    out.count = 1;
+    out.drives[0] = single.drive;
+    return true;
+  }
+  if (size < 2 || data[0] != kMultiSetPointType) return false;
+  const int count = data[1];
+  if (count < 1 || count > kMaxSubSetPoints || size != multiSetPointSize(count) || !isSealed(data, size)) return false;
+  out.sequence = get16(data + 2);
+  out.count = count;
+  for (int i = 0; i < count; ++i) out.drives[i] = get16(data + 4 + 2 * i);
+  return true;
+}
+
 void encodeStatus(const Status& status, uint8_t* out) {
   out[0] = kStatusType;
   out[1] = static_cast<uint8_t>(status.state);
@@ -70,6 +98,10 @@ bool decodeStatus(const uint8_t* data, size_t size, Status& out) {
   return true;
 }
 
+size_t versionReplySize(const VersionReply& version) {
+  return version.protocolMinor == 0 ? kVersionSizeMinor0 : kVersionSize;
+}
+
 void encodeVersion(const VersionReply& version, uint8_t* out) {
   out[0] = version.protocolMajor;
   out[1] = version.protocolMinor;
@@ -78,10 +110,13 @@ void encodeVersion(const VersionReply& version, uint8_t* out) {
   out[4] = version.firmwarePatch;
   out[5] = version.flags;
   put16(out + 6, version.fullScaleCurrentMa);
+  if (versionReplySize(version) == kVersionSizeMinor0) return;
+  out[8] = version.maxSubSetPoints;
+  out[9] = 0;  // reserved
 }
 
 bool decodeVersion(const uint8_t* data, size_t size, VersionReply& out) {
-  if (size != kVersionSize) return false;
+  if (size != kVersionSizeMinor0 && size != kVersionSize) return false;
   out.protocolMajor = data[0];
   out.protocolMinor = data[1];
   out.firmwareMajor = data[2];
@@ -89,6 +124,8 @@ bool decodeVersion(const uint8_t* data, size_t size, VersionReply& out) {
   out.firmwarePatch = data[4];
   out.flags = data[5];
   out.fullScaleCurrentMa = get16(data + 6);
+  // A 2.0 board plays one set-point per frame; a 2.1 board's 0 would mean the same.
+  out.maxSubSetPoints = size == kVersionSize ? std::max<uint8_t>(data[8], 1) : 1;
   return true;
 }
 

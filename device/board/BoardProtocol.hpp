@@ -17,8 +17,10 @@ constexpr uint16_t kVendorId = 0x1209;
 constexpr uint16_t kProductId = 0x0001;
 
 // 2.0: CLEAR_ERRORS became an IN request that answers what it cleared and what persists.
+// 2.1: the multi set-point frame (several drive levels per 1 ms frame, PROTOCOL.md 3.1) and the
+// version reply's field saying how many a board plays.
 constexpr uint8_t kProtocolMajor = 2;  // a host refuses a board of another major version
-constexpr uint8_t kProtocolMinor = 0;
+constexpr uint8_t kProtocolMinor = 1;
 
 constexpr int kInterfaceNumber = 0;
 constexpr uint8_t kInterfaceClass = 0xFF;     // vendor specific
@@ -27,6 +29,7 @@ constexpr uint8_t kInterfaceProtocol = 0x01;
 constexpr uint8_t kSetPointEndpoint = 0x01;  // interrupt OUT, bInterval 1 (1 ms, full speed)
 constexpr uint8_t kStatusEndpoint = 0x81;    // interrupt IN, bInterval 1
 constexpr double kBoardWatchdogS = 0.020;    // the board: no valid set-point this long -> off
+constexpr double kFramePeriodS = 0.001;      // one set-point frame per full-speed USB frame
 
 constexpr uint16_t kDriveFull = 65535;  // drive level: 0 = no current .. 65535 = full scale
 
@@ -58,14 +61,29 @@ constexpr uint16_t kLiveErrors = kErrOverTemperature | kErrOverCurrent | kErrSup
 
 constexpr size_t kSetPointSize = 8;
 constexpr size_t kStatusSize = 16;
-constexpr size_t kVersionSize = 8;
+constexpr size_t kVersionSize = 10;       // 2.1's reply; a 2.0 board answers the first 8 bytes
+constexpr size_t kVersionSizeMinor0 = 8;  // what a 2.0 board answers
 constexpr size_t kClearReplySize = 4;
 constexpr uint8_t kSetPointType = 0x01;
+constexpr uint8_t kMultiSetPointType = 0x02;  // 2.1
 constexpr uint8_t kStatusType = 0x81;
+
+// The multi set-point frame (2.1): `count` drive levels, each played for kFramePeriodS / count,
+// the first at once. 8 at full speed: 125 us steps, 8 kHz, in a 22-byte packet.
+constexpr int kMaxSubSetPoints = 8;
+constexpr size_t multiSetPointSize(int count) { return 6 + 2 * static_cast<size_t>(count); }
+constexpr size_t kMaxSetPointFrameSize = multiSetPointSize(kMaxSubSetPoints);
 
 struct SetPoint {
   uint16_t sequence = 0;  // +1 per frame, wraps; the board takes only newer ones
   uint16_t drive = 0;     // 0..kDriveFull
+};
+
+// A set-point frame of either type: a single set-point is a frame of count 1.
+struct MultiSetPoint {
+  uint16_t sequence = 0;
+  int count = 1;                           // 1..kMaxSubSetPoints
+  uint16_t drives[kMaxSubSetPoints] = {};  // oldest first
 };
 
 struct Status {
@@ -87,6 +105,7 @@ struct VersionReply {
   uint8_t firmwarePatch = 0;
   uint8_t flags = 0;                // bit 0: the board measures current (else currentDrive echoes)
   uint16_t fullScaleCurrentMa = 0;  // current at kDriveFull
+  uint8_t maxSubSetPoints = 1;      // 2.1: most drive levels per frame the board plays (2.0: 1)
 };
 
 // The answer to CLEAR_ERRORS: the flags as they were, and those still set after clearing (the
@@ -104,11 +123,19 @@ uint16_t crc16(const uint8_t* data, size_t size);
 void encodeSetPoint(const SetPoint& setPoint, uint8_t* out);  // kSetPointSize bytes
 // False when size, type or CRC is wrong.
 bool decodeSetPoint(const uint8_t* data, size_t size, SetPoint& out);
+// multiSetPointSize(frame.count) bytes; count must be 1..kMaxSubSetPoints.
+void encodeMultiSetPoint(const MultiSetPoint& frame, uint8_t* out);
+// Either type (a single set-point as count 1). False when the size does not match the type and
+// count, the count is not 1..kMaxSubSetPoints, or the CRC is wrong.
+bool decodeAnySetPoint(const uint8_t* data, size_t size, MultiSetPoint& out);
 
 void encodeStatus(const Status& status, uint8_t* out);  // kStatusSize bytes
 bool decodeStatus(const uint8_t* data, size_t size, Status& out);
 
-void encodeVersion(const VersionReply& version, uint8_t* out);  // kVersionSize bytes
+// versionReplySize(version) bytes: 8 for a 2.0 board (minor 0), kVersionSize from 2.1 on.
+size_t versionReplySize(const VersionReply& version);
+void encodeVersion(const VersionReply& version, uint8_t* out);
+// 8 bytes (2.0: maxSubSetPoints 1) or kVersionSize.
 bool decodeVersion(const uint8_t* data, size_t size, VersionReply& out);
 
 void encodeClearReply(const ClearReply& reply, uint8_t* out);  // kClearReplySize bytes

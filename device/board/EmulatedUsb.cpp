@@ -324,6 +324,10 @@ void EmulatedUsb::setProtocolMajor(uint8_t major) {
   std::lock_guard<std::mutex> lock(mutex_);
   board_.setProtocolMajor(major);
 }
+void EmulatedUsb::setProtocolMinor0() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  board_.setProtocolMinor0();
+}
 void EmulatedUsb::delayCallbacks(double seconds, uint8_t endpoint) {
   std::lock_guard<std::mutex> lock(mutex_);
   callbackDelayS_ = seconds;

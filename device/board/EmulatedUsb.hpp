@@ -36,7 +36,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void setDenyAccess(bool deny);
   void setRefuseArm(bool refuse);
   void timeOutNextOut(int count);   // these OUT transfers are never taken: kTimedOut
-  void partialNextOut(int count);   // only 4 of 8 bytes arrive (the board rejects them)
+  void partialNextOut(int count);   // only half the bytes arrive (the board rejects them)
   void failOut(bool fail);          // OUT transfers fail at once (kError), as to a device going away
   void partialNextIn(int count);    // short status transfers
   void stallOut();                  // EP 0x01 halts until the host clears it
@@ -45,6 +45,7 @@ class EmulatedUsb : public std::enable_shared_from_this<EmulatedUsb> {
   void overCurrent(bool persists);  // the board trips to fault; `persists`: CLEAR_ERRORS cannot clear it
   void setOverCurrent(bool present);
   void setProtocolMajor(uint8_t major);
+  void setProtocolMinor0();  // a 2.0 board: one set-point per frame, an 8-byte version reply
   // Every transfer's callback (completed, cancelled, unplugged) on `endpoint` (0: on every
   // endpoint) comes this much later than due: a host that frees or closes before its
   // callbacks ran is caught.

@@ -77,7 +77,7 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
     port_->close(0.0);
     return false;
   }
-  uint8_t reply[board::kVersionSize] = {};
+  uint8_t reply[board::kVersionSize] = {};  // a 2.0 board answers 8 bytes of it
   int moved = 0;
   result = control(kVendorIn, static_cast<uint8_t>(board::Request::kGetVersion), 0, reply, board::kVersionSize, &moved);
   board::VersionReply version;
@@ -89,9 +89,19 @@ bool UsbBoardBackend::connectLocked(std::string& error) {
             ".x: update the board's firmware (or KineticFriction) so that both speak " +
             std::to_string(board::kProtocolMajor) + ".x";
   } else {
+    // As many levels per frame as both can: the largest divisor of the device's count the board
+    // plays (a 2.0 board: one, the mean of the device's levels of that millisecond).
+    const int wanted = std::clamp(options_.subSetPoints, 1, board::kMaxSubSetPoints);
+    subSetPoints_ = std::min<int>(wanted, version.maxSubSetPoints);
+    while (wanted % subSetPoints_ != 0) --subSetPoints_;
+    levelsPerSubSetPoint_ = wanted / subSetPoints_;
+    const int frameSize =
+        static_cast<int>(subSetPoints_ > 1 ? board::multiSetPointSize(subSetPoints_) : board::kSetPointSize);
+    for (usb::Transfer& transfer : outTransfers_) transfer.length = frameSize;
     {
       std::lock_guard<PiMutex> lock(telemetryMutex_);
       telemetry_.version = version;
+      telemetry_.subSetPoints = subSetPoints_;
       telemetry_.serial = port_->openSerial();
       telemetry_.haveStatus = false;
     }
@@ -270,14 +280,26 @@ void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
   do {
     if (current & kRestartPending) return;
   } while (!latestDrive_.compare_exchange_weak(current, drive, std::memory_order_relaxed));
+  if (options_.subSetPoints <= 1) return;
+  const uint64_t index = written_.load(std::memory_order_relaxed);
+  ring_[index % kRingSize].store(static_cast<uint16_t>(drive), std::memory_order_relaxed);
+  written_.store(index + 1, std::memory_order_release);
 }
 
-void UsbBoardBackend::driveOff() { latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed); }
+void UsbBoardBackend::driveOff() {
+  latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed);
+  voidBefore_.store(written_.load(std::memory_order_acquire), std::memory_order_relaxed);
+  offs_.fetch_add(1, std::memory_order_release);
+}
 
 bool UsbBoardBackend::takeRestartFromOff() {
   uint32_t current = latestDrive_.load(std::memory_order_relaxed);
   while (current & kRestartPending)
-    if (latestDrive_.compare_exchange_weak(current, 0, std::memory_order_relaxed)) return true;
+    if (latestDrive_.compare_exchange_weak(current, 0, std::memory_order_relaxed)) {
+      voidBefore_.store(written_.load(std::memory_order_acquire), std::memory_order_relaxed);
+      offs_.fetch_add(1, std::memory_order_release);
+      return true;
+    }
   return false;
 }
 
@@ -299,10 +321,65 @@ void UsbBoardBackend::onTransfer(usb::Transfer& transfer) {
     self->onSetPoint(transfer);
 }
 
+bool UsbBoardBackend::nextSubSetPoints(board::MultiSetPoint& frame) {
+  if (options_.subSetPoints <= 1) return false;
+  const int per = levelsPerSubSetPoint_;
+  const uint64_t written = written_.load(std::memory_order_acquire);
+  const uint64_t offs = offs_.load(std::memory_order_acquire);
+  if (offs != seenOffs_) heldLevel_ = 0;  // an off or a restart since: nothing to hold
+  seenOffs_ = offs;
+  uint64_t from = std::max(taken_, voidBefore_.load(std::memory_order_relaxed));
+  // More than two frames' worth waiting (the device ran ahead of the bus): the oldest go, so
+  // the force is at most two frames behind.
+  const uint64_t waitingGroups = (written - from) / per;
+  if (waitingGroups > 2 * static_cast<uint64_t>(subSetPoints_)) {
+    const uint64_t dropped = waitingGroups - subSetPoints_;  // whole groups: the means stay aligned
+    from += dropped * per;
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
+    telemetry_.subStepsDropped += dropped;
+  }
+  const auto groups = static_cast<int>(std::min<uint64_t>((written - from) / per, subSetPoints_));
+  // A group not yet made holds the last level sent (a mean, to a 2.0 board, like the others).
+  uint16_t last = heldLevel_;
+  frame.count = subSetPoints_;
+  for (int g = 0; g < subSetPoints_; ++g) {
+    if (g < groups) {
+      uint32_t sum = 0;
+      for (int k = 0; k < per; ++k)
+        sum += ring_[(from + static_cast<uint64_t>(g * per + k)) % kRingSize].load(std::memory_order_relaxed);
+      last = static_cast<uint16_t>((sum + per / 2) / per);
+    }
+    frame.drives[g] = last;
+  }
+  // The writer went round the ring while it was read (never at 8 kHz: the ring holds 8 ms):
+  // those levels are lost, the last level sent holds.
+  if (written_.load(std::memory_order_acquire) > from + kRingSize)
+    std::fill(frame.drives, frame.drives + subSetPoints_, heldLevel_);
+  heldLevel_ = frame.drives[subSetPoints_ - 1];
+  taken_ = from + static_cast<uint64_t>(groups) * per;
+  if (groups < subSetPoints_) {
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
+    telemetry_.subStepsPadded += static_cast<uint64_t>(subSetPoints_ - groups);
+  }
+  return true;
+}
+
 void UsbBoardBackend::submitSetPoint(int slot) {
   usb::Transfer& transfer = outTransfers_[slot];
-  const uint16_t drive = armed_.load(std::memory_order_acquire) ? latestDrive() : 0;  // acquire: see arm()
-  board::encodeSetPoint({++sequence_, drive}, transfer.buffer);
+  const bool armed = armed_.load(std::memory_order_acquire);  // acquire: see arm()
+  board::MultiSetPoint frame;
+  const bool several = nextSubSetPoints(frame);
+  if (!armed || (latestDrive_.load(std::memory_order_relaxed) & kRestartPending))
+    std::fill(frame.drives, frame.drives + board::kMaxSubSetPoints, 0);
+  frame.sequence = ++sequence_;
+  uint16_t drive = armed ? latestDrive() : 0;
+  if (several && subSetPoints_ > 1) {
+    board::encodeMultiSetPoint(frame, transfer.buffer);
+    drive = frame.drives[frame.count - 1];
+  } else {
+    if (several) drive = frame.drives[0];  // a 2.0 board: the millisecond's mean
+    board::encodeSetPoint({frame.sequence, drive}, transfer.buffer);
+  }
   const usb::Result result = port_->submit(transfer);
   if (result == usb::Result::kOk) {
     outBusy_[slot] = true;

@@ -12,6 +12,9 @@
 // device thread, or the audio thread in lockstep); open, close, arm and disarm run on a
 // non-realtime thread, and once the event thread runs their control requests are sent by it
 // (a synchronous request runs transfer callbacks on the thread that sends it: UsbPort.hpp).
+// Force faster than 1 kHz (BoardOptions::subSetPoints > 1): the device's frames queue in a ring,
+// and each set-point transfer carries the next of them as a multi set-point frame (protocol 2.1)
+// when the board plays as many, else their mean as one set-point (a 2.0 board: 1 kHz).
 #pragma once
 
 #include <atomic>
@@ -47,6 +50,10 @@ struct BoardOptions {
   // commandForce (no drive given): the linear map of an uncalibrated board.
   double minForceN = 0.14;
   double maxForceN = 1.4;
+  // Drive levels the device makes per 1 ms frame (1 kHz force: 1; 8 kHz: 8). The board is sent
+  // as many per frame as it plays (the largest divisor of this up to its maxSubSetPoints), each
+  // the mean of the device's levels it stands for.
+  int subSetPoints = 1;
   ThreadRequest thread;  // the event thread (kf-usb-<slot>): the device's request
 };
 
@@ -60,9 +67,12 @@ struct BoardTelemetry {
   std::string lastError;
   uint16_t lastSequenceSent = 0;
   uint16_t lastDriveSent = 0;
-  uint64_t setPointsSent = 0;  // completed OUT transfers
-  uint64_t lateTransfers = 0;  // completed later than lateTransferS after the previous one
-  uint64_t lostTransfers = 0;  // timed out, partial or failed
+  int subSetPoints = 1;          // drive levels per frame sent to this board (2.1: up to 8)
+  uint64_t subStepsPadded = 0;   // levels sent again because the device's next had not come
+  uint64_t subStepsDropped = 0;  // levels never sent: more than two frames were waiting
+  uint64_t setPointsSent = 0;    // completed OUT transfers
+  uint64_t lateTransfers = 0;    // completed later than lateTransferS after the previous one
+  uint64_t lostTransfers = 0;    // timed out, partial or failed
   uint64_t timeouts = 0;
   uint64_t partials = 0;
   uint64_t stalls = 0;
@@ -100,6 +110,7 @@ class UsbBoardBackend : public ForceBackend {
 
  private:
   static constexpr int kMaxInFlight = 4;
+  static constexpr int kRingSize = 64;  // the device's drive levels waiting: 8 ms at 8 kHz
   // In latestDrive_ above the 16 drive bits: ARM happened and the device has not yet reset its
   // slew limiter; until it has, frames store drive 0 (they were computed before the reset).
   static constexpr uint32_t kRestartPending = 1u << 16;
@@ -129,6 +140,9 @@ class UsbBoardBackend : public ForceBackend {
   bool clearErrorsLocked(board::ClearReply& reply, std::string& error);
   void useEndpoints(const usb::InterfaceEndpoints& endpoints);  // the transfers' endpoints
   void submitSetPoint(int slot);
+  // The frame's drive levels when the device makes more than one per frame: the next groups of
+  // the ring, each group's mean one level; false when the single latest level is to go.
+  bool nextSubSetPoints(board::MultiSetPoint& frame);
   void submitStatus();
   void submitIdle();
   // After a transfer failed at once: no transfer is sent before retryAfterS_ (true: not now).
@@ -171,6 +185,18 @@ class UsbBoardBackend : public ForceBackend {
   double nextReopenS_ = 0.0;
 
   std::atomic<uint32_t> latestDrive_{0};  // drive bits, and kRestartPending
+  // The device's drive levels in order (subSetPoints > 1): one writer, the thread that commands
+  // (the device's, under its lock); read by the event thread. Levels before voidBefore_ are
+  // never sent (computed before an off or ARM's restart).
+  std::atomic<uint16_t> ring_[kRingSize] = {};
+  std::atomic<uint64_t> written_{0};
+  std::atomic<uint64_t> voidBefore_{0};
+  uint64_t taken_ = 0;             // event thread: the ring's levels up to here were sent
+  std::atomic<uint64_t> offs_{0};  // offs and restarts: a held level is forgotten
+  uint64_t seenOffs_ = 0;          // event thread: offs_ when last read
+  uint16_t heldLevel_ = 0;         // event thread: the last level sent from the ring
+  int subSetPoints_ = 1;           // event thread (and open): levels per frame this board is sent
+  int levelsPerSubSetPoint_ = 1;
   std::atomic<bool> armed_{false};
   std::atomic<bool> connected_{false};
   std::atomic<bool> stopping_{false};

@@ -88,7 +88,8 @@
 	boardStatusMsg { ^['/cmd', \kfBoardStatus, index] }
 	*boardStatusOf { |values|
 		var names = #[hasBoard, connected, armed, boardState, currentLevel, temperatureC, errors, setPointsSent,
-			late, lost, timeouts, partials, stalls, badStatus, unplugs, reopens, onePerPump, offsetP50S];
+			late, lost, timeouts, partials, stalls, badStatus, unplugs, reopens, onePerPump, offsetP50S,
+			forceRateHz, levelsPadded, levelsDropped];
 		var event = ();
 		names.do { |name, i| event[name] = values[i] };
 		#[hasBoard, connected, armed].do { |name| event[name] = event[name] == 1 };

@@ -245,3 +245,45 @@ TEST_CASE("ForceFramer: a jump in block time closes the frame in progress", "[fr
   CHECK(frames[1].timeS == Approx(0.010));
   CHECK(frames[1].forceN == 1.0f);
 }
+
+TEST_CASE("ForceFramer: its frequency response at 1 and 8 kHz frames is the design's, a boxcar of the held samples",
+          "[framer]") {
+  // The design: a frame is the mean of its M held samples (M = sample rate x frame period), so a
+  // sine of f in gives, at the frame rate, a sine of gain |sin(pi f M / fs) / (M sin(pi f / fs))|
+  // delayed by (M - 1) / 2 samples from the frame's start (its centre). The framer's rate is
+  // the device's force rate: 1 kHz (the paper's) or 8 kHz (a 2.1 board, PROTOCOL.md 3.1).
+  constexpr double kPi = 3.14159265358979323846;
+  for (const double frameHz : {1000.0, 8000.0}) {
+    for (const int64_t fs : {int64_t{48000}, int64_t{96000}, int64_t{192000}}) {
+      const double m = static_cast<double>(fs) / frameHz;
+      for (const double fraction : {0.05, 0.2, 0.35, 0.45}) {
+        const double f = fraction * frameHz;
+        ForceFramer framer(1.0 / frameHz, 0.0, 2.0);
+        const int64_t frames = 4000;
+        auto sine = [&](int64_t j) { return static_cast<float>(1.0 + 0.5 * std::sin(2 * kPi * f * j / fs)); };
+        const auto out = runFramer(framer, fs, static_cast<int64_t>(frames * m), 64, sine);
+        REQUIRE(out.size() >= static_cast<size_t>(frames - 1));
+        // Least squares of the frames against sin and cos at f, sampled at each frame's centre
+        // (its start plus (M - 1) / 2 samples): the gain and what phase is left.
+        double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0;
+        for (const Frame& frame : out) {
+          const double t = frame.timeS + (m - 1) / 2 / fs;
+          const double s = std::sin(2 * kPi * f * t), c = std::cos(2 * kPi * f * t), y = frame.forceN - 1.0;
+          ss += s * s;
+          sc += s * c;
+          cc += c * c;
+          ys += y * s;
+          yc += y * c;
+        }
+        const double det = ss * cc - sc * sc;
+        const double a = (ys * cc - yc * sc) / det, b = (yc * ss - ys * sc) / det;
+        const double design = std::fabs(std::sin(kPi * f * m / fs) / (m * std::sin(kPi * f / fs)));
+        INFO("frames at " << frameHz << " Hz, fs " << fs << ", f " << f << " Hz: gain " << 2 * std::hypot(a, b)
+                          << ", design " << design);
+        // float frames (2^-24 of 1.5 N) over 4000 of them: far under 1e-5 of the 0.5 N sine.
+        CHECK(2 * std::hypot(a, b) == Approx(design).margin(1e-5));
+        CHECK(2 * b == Approx(0.0).margin(1e-5));  // no delay beyond the frame's centre
+      }
+    }
+  }
+}

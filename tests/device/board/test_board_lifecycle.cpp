@@ -64,7 +64,7 @@ TEST_CASE("board version: a board of another protocol major is refused with what
   std::string error;
   CHECK_FALSE(backend.open(error));
   INFO(error);
-  CHECK(error.find("speaks protocol 1.0, this host 2.x") != std::string::npos);
+  CHECK(error.find("speaks protocol 1.1, this host 2.x") != std::string::npos);
   CHECK(error.find("firmware") != std::string::npos);
   CHECK_FALSE(bus->isOpen());
   CHECK(bus->interfaceReleases() == 1);

@@ -1,0 +1,259 @@
+// Texture fidelity against the force rate: a sinusoidal grating (0.14 .. 1.4 N, the paper's
+// range) crossed at constant speed, for periods 0.2 .. 5 mm and speeds 10 .. 400 mm/s (temporal
+// frequencies 2 Hz .. 2 kHz), rendered as the device does at 1 kHz (protocol 2.0: one set-point
+// per 1 ms USB frame) and at 8 kHz (2.1: eight per frame):
+//
+//   audio force at 48 kHz -> ForceFramer at the rate (the frame's mean) -> drive levels ->
+//   one set-point frame per 1 ms (the level just completed at 1 kHz; the eight completed since
+//   the last frame at 8 kHz, as UsbBoardBackend sends them) -> BoardEmulator (the firmware the
+//   gadget runs) -> the coil's target timeline, the force applied.
+//
+// Per case: the applied force's line at the grating's frequency against the ideal's (gain, in dB
+// and in Weber fractions of 0.11 for a friction change: Gueorguiev et al. 2017), and the largest
+// other line inside the touch band (10 Hz .. 1 kHz: what an alias folds into), relative to it.
+// Per rate: the latency from the audio's step to the applied force's half-way point (mean over
+// 64 phases of the step against the frames), and the CPU time per second of force of the
+// framing, encoding and firmware (thread CPU, the two rates interleaved in each round).
+// Prints one JSON object (bench/kfbench/texture_rate.py reads it).
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "ForceFramer.hpp"
+#include "board/BoardEmulator.hpp"
+
+namespace {
+
+using kf::board::BoardEmulator;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kSampleRate = 48000;
+constexpr int kBlock = 64;
+constexpr double kMinN = 0.14, kMaxN = 1.4;
+constexpr double kMeanN = 0.5 * (kMinN + kMaxN), kAmplitudeN = 0.5 * (kMaxN - kMinN);
+constexpr double kWeber = 0.11;
+constexpr double kUsbOffsetS = 0.37e-3;  // the USB frames' phase against the audio's frames
+
+double cpuS() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+uint16_t driveOf(double forceN) {
+  const double level = std::clamp((forceN - kMinN) / (kMaxN - kMinN), 0.0, 1.0);
+  return static_cast<uint16_t>(std::lround(level * kf::board::kDriveFull));
+}
+
+double forceOf(uint16_t drive) { return kMinN + (kMaxN - kMinN) * drive / kf::board::kDriveFull; }
+
+// The applied force: the coil's target on a grid of the rate's steps (every change falls on it).
+struct Applied {
+  double startS, stepS;
+  std::vector<double> forceN;
+};
+
+// Renders `audio(t)` (N) for durationS at `perFrame` levels per 1 ms frame (1 or 8).
+template <class Audio>
+std::vector<BoardEmulator::Change> render(Audio audio, double durationS, int perFrame) {
+  const double framePeriodS = kf::board::kFramePeriodS / perFrame;
+  kf::ForceFramer framer(framePeriodS, kMinN, kMaxN);
+  BoardEmulator board(0.0);
+  uint8_t scratch[kf::board::kClearReplySize];
+  int moved = 0;
+  board.control(0xC1, static_cast<uint8_t>(kf::board::Request::kClearErrors), 0, scratch, sizeof scratch, &moved, 0.0);
+  board.control(0x41, static_cast<uint8_t>(kf::board::Request::kArm), kf::board::kArmKey, nullptr, 0, nullptr, 0.0);
+
+  std::vector<uint16_t> levels;  // every completed frame's drive, in order
+  auto sink = [&](double, float forceN) { levels.push_back(driveOf(forceN)); };
+  size_t sent = 0;
+  uint16_t sequence = 0;
+  // One USB frame at usbS: what was completed before it, as UsbBoardBackend sends it.
+  auto sendFrame = [&](double usbS) {
+    if (levels.empty()) return;
+    uint8_t bytes[kf::board::kMaxSetPointFrameSize];
+    size_t size = kf::board::kSetPointSize;
+    if (perFrame == 1) {
+      kf::board::encodeSetPoint({++sequence, levels.back()}, bytes);
+    } else {
+      kf::board::MultiSetPoint frame;
+      frame.sequence = ++sequence;
+      frame.count = perFrame;
+      const uint16_t held = sent > 0 ? levels[sent - 1] : levels[0];
+      for (int k = 0; k < perFrame; ++k) frame.drives[k] = sent < levels.size() ? levels[sent++] : held;
+      kf::board::encodeMultiSetPoint(frame, bytes);
+      size = kf::board::multiSetPointSize(perFrame);
+    }
+    board.receiveSetPoint(bytes, size, usbS);
+  };
+  double nextUsbS = kUsbOffsetS;
+  std::vector<float> block(kBlock);
+  const auto samples = static_cast<int64_t>(durationS * kSampleRate);
+  for (int64_t start = 0; start < samples; start += kBlock) {
+    // The USB frames that fall in this block go out with what was completed before them: the
+    // block is split at each, so a frame sees only the levels of audio before its time.
+    int done = 0;
+    while (done < kBlock) {
+      if ((start + done) / kSampleRate >= nextUsbS - 1e-12) {
+        sendFrame(nextUsbS);
+        nextUsbS += kf::board::kFramePeriodS;
+        continue;
+      }
+      const int until = std::min<int>(kBlock, static_cast<int>(std::ceil(nextUsbS * kSampleRate - 1e-9) - start));
+      const int n = until - done;
+      for (int i = 0; i < n; ++i) block[i] = static_cast<float>(audio((start + done + i) / kSampleRate));
+      framer.process((start + done) / kSampleRate, 1.0 / kSampleRate, block.data(), n, nullptr, sink);
+      done += n;
+    }
+  }
+  board.advance(durationS);
+  return board.timeline();
+}
+
+// The coil's target on the grid of the rate's steps from the first USB frame on (every change
+// falls on the grid).
+Applied onGrid(const std::vector<BoardEmulator::Change>& timeline, double durationS, int perFrame) {
+  const double framePeriodS = kf::board::kFramePeriodS / perFrame;
+  Applied applied{kUsbOffsetS, framePeriodS, {}};
+  const auto steps = static_cast<size_t>((durationS - kUsbOffsetS) / framePeriodS);
+  applied.forceN.assign(steps, kMinN);
+  size_t c = 0;
+  uint16_t drive = 0;
+  for (size_t k = 0; k < steps; ++k) {
+    const double t = applied.startS + (k + 0.5) * framePeriodS;
+    while (c < timeline.size() && timeline[c].timeS <= t) drive = timeline[c++].drive;
+    applied.forceN[k] = forceOf(drive);
+  }
+  return applied;
+}
+
+// The applied force's complex amplitude at f over [fromS, fromS + spanS) (4-term Blackman-Harris
+// window: sidelobes under -92 dB, so that the grating's own line leaks nothing into the others),
+// exact for a force held over each step: the steps' sum times the step's own transform.
+std::complex<double> line(const Applied& a, double f, double fromS, double spanS) {
+  const double w = 2 * kPi * f;
+  const auto first = static_cast<size_t>(std::ceil((fromS - a.startS) / a.stepS));
+  const auto count = static_cast<size_t>(spanS / a.stepS);
+  const std::complex<double> hold =
+      w == 0 ? 1.0 : (1.0 - std::polar(1.0, -w * a.stepS)) / std::complex<double>(0, w * a.stepS);
+  const std::complex<double> turn = std::polar(1.0, -w * a.stepS);
+  std::complex<double> phasor = std::polar(1.0, -w * (a.startS + first * a.stepS));
+  std::complex<double> sum = 0;
+  double windowSum = 0;
+  for (size_t k = 0; k < count && first + k < a.forceN.size(); ++k, phasor *= turn) {
+    const double x = 2 * kPi * (k + 0.5) / count;
+    const double window = 0.35875 - 0.48829 * std::cos(x) + 0.14128 * std::cos(2 * x) - 0.01168 * std::cos(3 * x);
+    sum += window * (a.forceN[first + k] - kMeanN) * phasor;
+    windowSum += window;
+  }
+  return 2.0 * sum * hold / windowSum;
+}
+
+struct Case {
+  double periodMm, speedMmPerS, frequencyHz;
+  double gainDb[2], weber[2], spurDb[2];
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int rounds = argc > 1 ? std::atoi(argv[1]) : 5;
+  const double periods[] = {0.2, 0.5, 1.0, 2.0, 5.0};
+  const double speeds[] = {10, 25, 50, 100, 200, 400};
+  const int rates[] = {1, 8};
+  std::vector<Case> cases;
+  for (double p : periods)
+    for (double v : speeds) {
+      Case c{p, v, v / p, {}, {}, {}};
+      // At least 8 cycles and 0.5 s (bins of 2 Hz or finer), after 20 ms of start-up.
+      const double spanS = std::max(0.5, 8.0 / c.frequencyHz), fromS = 0.02;
+      for (int r = 0; r < 2; ++r) {
+        const double phase = 0.3;
+        auto audio = [&](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * c.frequencyHz * t + phase); };
+        const double durationS = fromS + spanS + 0.01;
+        const Applied a = onGrid(render(audio, durationS, rates[r]), durationS, rates[r]);
+        const double gain = std::abs(line(a, c.frequencyHz, fromS, spanS)) / kAmplitudeN;
+        // The largest other line in the touch band, 10 Hz .. 1 kHz, away from the grating's main
+        // lobe (+-4 bins of 1 / span; the ideal has no other line), relative to the grating's
+        // ideal amplitude.
+        double spur = 0;
+        for (double f = 10; f <= 1000; f += 1 / spanS) {
+          if (std::fabs(f - c.frequencyHz) < 5 / spanS) continue;
+          spur = std::max(spur, std::abs(line(a, f, fromS, spanS)));
+        }
+        c.weber[r] = std::fabs(gain - 1) / kWeber;
+        c.gainDb[r] = 20 * std::log10(std::max(gain, 1e-9));
+        c.spurDb[r] = 20 * std::log10(std::max(spur, 1e-9) / kAmplitudeN);
+      }
+      cases.push_back(c);
+    }
+
+  // The headline: the highest frequency whose line is within one Weber fraction, per rate, by
+  // bisection (below the rate's Nyquist frequency the gain falls as f rises).
+  double withinWeberHz[2] = {0, 0};
+  for (int r = 0; r < 2; ++r) {
+    double lo = 10, hi = 500.0 * rates[r];
+    while (hi - lo > 0.5) {
+      const double f = 0.5 * (lo + hi), spanS = std::max(0.5, 8.0 / f), fromS = 0.02;
+      const double durationS = fromS + spanS + 0.01;
+      const Applied a = onGrid(
+          render([&](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * f * t + 0.3); }, durationS, rates[r]),
+          durationS, rates[r]);
+      const double gain = std::abs(line(a, f, fromS, spanS)) / kAmplitudeN;
+      (std::fabs(gain - 1) <= kWeber ? lo : hi) = f;
+    }
+    withinWeberHz[r] = lo;
+  }
+
+  // Latency: an audio step from the minimum to the maximum at 64 phases within a frame.
+  double latencyMs[2] = {0, 0};
+  for (int r = 0; r < 2; ++r) {
+    const int phases = 64;
+    for (int i = 0; i < phases; ++i) {
+      const double stepS = 0.05 + i * (kf::board::kFramePeriodS / phases);
+      const Applied a =
+          onGrid(render([&](double t) { return t >= stepS ? kMaxN : kMinN; }, 0.06, rates[r]), 0.06, rates[r]);
+      for (size_t k = 0; k < a.forceN.size(); ++k)
+        if (a.forceN[k] >= kMeanN) {
+          latencyMs[r] += 1e3 * (a.startS + k * a.stepS - stepS) / phases;
+          break;
+        }
+    }
+  }
+
+  // CPU per second of force: a 100 Hz grating, the two rates interleaved in each round.
+  std::vector<double> cpu[2];
+  for (int round = 0; round < rounds; ++round)
+    for (int k = 0; k < 2; ++k) {
+      const int r = (round + k) % 2;
+      const double t0 = cpuS();
+      const auto timeline =
+          render([](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * 100 * t); }, 1.0, rates[r]);
+      cpu[r].push_back(cpuS() - t0);
+      if (timeline.empty()) return 1;
+    }
+
+  std::printf("{\"sampleRateHz\": %g, \"block\": %d, \"rounds\": %d, \"weber\": %g, \"rates\": [1000, 8000],\n",
+              kSampleRate, kBlock, rounds, kWeber);
+  std::printf(" \"withinWeberHz\": [%.1f, %.1f],\n", withinWeberHz[0], withinWeberHz[1]);
+  std::printf(" \"latencyMs\": [%.4f, %.4f],\n \"cpuS\": [[", latencyMs[0], latencyMs[1]);
+  for (int r = 0; r < 2; ++r)
+    for (size_t i = 0; i < cpu[r].size(); ++i)
+      std::printf("%.6f%s", cpu[r][i], i + 1 < cpu[r].size() ? ", " : (r == 0 ? "], [" : "]],\n"));
+  std::printf(" \"cases\": [\n");
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    std::printf(
+        "  {\"periodMm\": %g, \"speedMmPerS\": %g, \"frequencyHz\": %g, \"gainDb\": [%.4f, %.4f], \"weber\": [%.4f, "
+        "%.4f], \"spurDb\": [%.2f, %.2f]}%s\n",
+        c.periodMm, c.speedMmPerS, c.frequencyHz, c.gainDb[0], c.gainDb[1], c.weber[0], c.weber[1], c.spurDb[0],
+        c.spurDb[1], i + 1 < cases.size() ? "," : "");
+  }
+  std::printf(" ]}\n");
+  return 0;
+}
