@@ -1,7 +1,8 @@
 // FrictionPattern: a spatial friction pattern (dsp/patterns/FrictionPatternCore), position (mm) in, force
 // (N) out. Inputs: kind (fixed at init), position, loForce (N), hiForce (N), antialias (0/1),
 // p1, p2, p3 (by kind, dsp/patterns/FrictionPatternCore.hpp); for kind slope p1 is the height signal; the
-// 2D kinds (bumps2D, texture2D) have one more input, y (mm), read as position is (0 when absent).
+// 2D kinds (bumps2D, texture2D) read y (mm) as position is (0 for the others); then the force frame
+// period (s, fixed at init: the device's, 1 ms by default; absent in SynthDefs of earlier versions).
 // Position and height are read at audio rate as they are; at control rate they are interpolated
 // linearly across the block from the last block's value (as SC UGens do), since a value held per
 // block would make the travel, and every speed-based pattern, jump at block rate. Everything else
@@ -20,7 +21,7 @@ namespace {
 
 using kf::patterns::PatternKind;
 
-enum Input { kKind, kPositionMm, kLoForceN, kHiForceN, kAntialias, kP1, kP2, kP3, kYMm };
+enum Input { kKind, kPositionMm, kLoForceN, kHiForceN, kAntialias, kP1, kP2, kP3, kYMm, kFramePeriodS };
 
 // The kinds of bad input, each posted once per unit (FirstTimeOnly).
 enum BadInput { kBadKind, kBadLoForce, kBadHiForce, kBadP1, kBadP2, kBadP3 };
@@ -67,7 +68,18 @@ class FrictionPatternUGen : public SCUnit {
                          kf::sc::shownValue(in0(kKind)), kf::patterns::kPatternKinds - 1);
     }
     mKind = code >= 0 && code < kf::patterns::kPatternKinds ? code : 0;
-    mCore.emplace(static_cast<PatternKind>(mKind), sampleRate());
+    // The force frame the pattern is made for (its travel and band limit), fixed at init: the
+    // device's forceFramePeriodS; without the input (a SynthDef of an earlier version) the paper's.
+    double framePeriodS = kf::paper::device::forceFramePeriodS;
+    if (numInputs() > kFramePeriodS) {
+      const double wanted = in0(kFramePeriodS);
+      if (wanted >= 1e-4 && wanted <= 0.1)
+        framePeriodS = wanted;
+      else
+        kf::sc::postFromRt(mWorld, "FrictionPattern: forceFramePeriod %g is not 0.0001 to 0.1 s; %g is used.\n",
+                           kf::sc::shownValue(in0(kFramePeriodS)), framePeriodS);
+    }
+    mCore.emplace(static_cast<PatternKind>(mKind), sampleRate(), framePeriodS);
     mLastPositionMm = in0(kPositionMm);
     // The second signal beside the position: slope's height, the 2D kinds' y; none otherwise.
     if (mKind == static_cast<int>(PatternKind::Slope)) mSecond = kP1;

@@ -27,6 +27,8 @@ KINDS = [
 EXTRA = [
     ("fast", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02)"),
     ("fast raw", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02, antialias: 0)"),
+    # Made for a device framing force at 8 kHz (a board of protocol 2.1).
+    ("fast 8 kHz", "FrictionPattern.grating(Sweep.ar(0, 300), 0.2, 0.5, 0.02, forceFramePeriod: 0.000125)"),
     ("36 mm/s", "FrictionPattern.grating(Sweep.ar(0, 36), 0.2, 0.5, 0.02)"),
     ("60 mm/s duty 0.3", "FrictionPattern.grating(Sweep.ar(0, 60), 0.2, 0.3, 0.02)"),
     # With the force range by name, as LoudnessToFriction names it (loForce, hiForce).
@@ -135,6 +137,23 @@ def test_a_fine_grating_moved_fast_has_no_alias_in_its_frames():
         assert amplitude_at(frames, folded) < 1e-5, name
 
 
+def test_a_fine_grating_made_for_8_khz_frames_keeps_its_line_there():
+    # The same 1500 Hz grating made for 125 us frames: its band limit is 4 kHz there, so its line is
+    # in the device's 8 kHz frames (6 samples at 48 kHz), 0.095 N by the pattern's own spline taper
+    # (dsp test "anti-aliasing follows the force rate"); > 0.05 N, where the 1 ms pattern has none.
+    rate = 48000
+    data = render48k()
+    n = int(0.4 * rate) - 64
+    fast8k, fast = (column(data, name)[rate // 100:n] for name in ("fast 8 kHz", "fast"))
+    frames8k = fast8k[:len(fast8k) // 6 * 6].reshape(-1, 6).mean(axis=1)
+    i = np.arange(len(frames8k))
+    p = 2 * np.pi * i / len(frames8k)
+    w = 0.35875 - 0.48829 * np.cos(p) + 0.14128 * np.cos(2 * p) - 0.01168 * np.cos(3 * p)
+    line_n = 2 * abs(np.sum((frames8k - frames8k.mean()) * w * np.exp(-2j * np.pi * 1500 * i / 8000))) / w.sum()
+    assert line_n > 0.05, line_n
+    assert largest_alias_n(fast, rate) < 1e-6
+
+
 def test_control_rate_positions_and_period_changes_while_moving():
     rate = 48000
     data = render48k()
@@ -217,18 +236,22 @@ def test_texture2d_along_a_line_at_an_angle_is_its_definition():
     assert "FrictionPattern" not in log, log
 
 
-def test_texture2d_literal_arguments_are_checked_when_the_synthdef_is_built():
+def test_literal_arguments_are_checked_when_the_synthdef_is_built():
     out = sclang.run_script("""
         var errors = List.new;
         SynthDef(\\good, { Out.ar(0, FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, 3, 1)) }).add;
         [
             { FrictionPattern.texture2D(DC.ar(0)) },
             { FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0) },
-            { FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, inf) }
+            { FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, inf) },
+            { FrictionPattern.grating(DC.ar(0), forceFramePeriod: 0) },
+            { FrictionPattern.viscous(DC.ar(0), forceFramePeriod: DC.kr(0.001)) }
         ].do { |f| try { SynthDef(\\bad, f).add } { |e| errors.add(e.errorString) } };
         errors.do(_.postln);
     """)
     assert "y is required" in out
     assert "lo and hi must be finite numbers > 0 (cycles/mm), got 0 and 3" in out
     assert "lo and hi must be finite numbers > 0 (cycles/mm), got 0.5 and inf" in out
-    assert out.count("ERROR") == 3, out
+    assert "forceFramePeriod must be a number of seconds, 0.0001 to 0.1 (the device's forceFramePeriodS), got 0" in out
+    assert "forceFramePeriodS), got an OutputProxy" in out  # a UGen: it is fixed at init
+    assert out.count("ERROR") == 5, out

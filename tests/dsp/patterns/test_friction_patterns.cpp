@@ -143,6 +143,59 @@ TEST_CASE("anti-aliasing: 300 mm/s over a 0.2 mm grating has no alias in the for
   CHECK(*hi == Approx(kMaxN).margin(5e-4));
 }
 
+TEST_CASE("anti-aliasing follows the force rate: at 8 kHz frames a 1500 Hz grating is kept and a 6 kHz one removed") {
+  // A device framing force at 8 kHz (forceFramePeriodS 0.000125, a 2.1 board): the pattern's band
+  // limit moves with it (full up to 2 kHz, none from 4 kHz). Frames: 6 samples at 48 kHz.
+  const double framePeriodS = 0.000125;
+  auto framesOf = [](const std::vector<float>& f, size_t from, size_t perFrame) {
+    std::vector<double> out;
+    for (size_t i = from; i + perFrame <= f.size(); i += perFrame) {
+      double sum = 0;
+      for (size_t k = 0; k < perFrame; ++k) sum += f[i + k];
+      out.push_back(sum / perFrame);
+    }
+    return out;
+  };
+  auto at8k = [&](bool antialias) {  // a grating framed at 8 kHz
+    FrictionPatternCore c(PatternKind::Grating, 48000, framePeriodS);
+    c.setForceRange({kMinN, kMaxN});
+    c.setAntialias(antialias);
+    return c;
+  };
+  const auto fast = ramp(0.0, 300.0, 0.3, 48000);
+  // The pattern is made per frame: at 8 kHz frames and 48 kHz it is, sample for sample, the
+  // pattern at 1 kHz frames and 6 kHz moved 8 times slower (the same travel per sample and per
+  // frame). So its band limit is the 1 kHz one scaled by 8: 0.2 mm at 300 mm/s (1500 Hz) is
+  // rendered as the paper's frames render 37.5 mm/s (187.5 Hz).
+  auto on8k = at8k(true);
+  const auto force8k = run(on8k, fast, 0.2, 0.5, 0.02);
+  FrictionPatternCore slowCore(PatternKind::Grating, 6000, 0.001);
+  slowCore.setForceRange({kMinN, kMaxN});
+  const auto force1k = run(slowCore, ramp(0.0, 37.5, 0.3, 6000), 0.2, 0.5, 0.02);
+  double worst = 0;
+  for (size_t i = 0; i < std::min(force8k.size(), force1k.size()); ++i)
+    worst = std::max(worst, std::fabs(static_cast<double>(force8k[i]) - force1k[i]));
+  INFO("8 kHz frames at 300 mm/s against 1 kHz frames at 37.5 mm/s: largest difference " << worst << " N");
+  CHECK(worst < 1e-6);  // float positions and forces: their rounding only
+  // And it is there: the 1500 Hz line in the 8 kHz frames is most of the square wave's
+  // fundamental ((4 / pi) x 0.18 N = 0.23 N, less the pattern's own spline taper), where the
+  // paper's 1 ms pattern has removed it entirely (its frames are the grating's mean).
+  auto on1k = core(PatternKind::Grating);
+  const double kept = largestNonDcAmplitude(framesOf(force8k, 480, 6));
+  const double at1k = largestNonDcAmplitude(frames(run(on1k, fast, 0.2, 0.5, 0.02), 480));
+  INFO("1500 Hz line in the 8 kHz frames " << kept << " N, in the 1 ms frames " << at1k << " N");
+  CHECK(kept > 0.05);
+  CHECK(at1k < 1e-6);
+  // 0.05 mm at 300 mm/s: 6 kHz, over the 8 kHz frames' 4 kHz Nyquist frequency: removed with
+  // anti-aliasing (its mean; float rounding only), folded to 2 kHz without.
+  auto fineOn = at8k(true), fineOff = at8k(false);
+  const double aliasOn = largestNonDcAmplitude(framesOf(run(fineOn, fast, 0.05, 0.5, 0.005), 480, 6));
+  const double aliasOff = largestNonDcAmplitude(framesOf(run(fineOff, fast, 0.05, 0.5, 0.005), 480, 6));
+  INFO("6 kHz grating in the 8 kHz frames: alias with " << aliasOn << " N, without " << aliasOff << " N");
+  CHECK(aliasOn < 1e-6);
+  CHECK(aliasOff > 0.02);
+}
+
 // The amplitude (N) at frequencyHz of 1 ms frames (frame rate 1 kHz), by a DFT at that frequency
 // under a 4-term Blackman-Harris window (sidelobes below -92 dB: a 0.2 N line 8 Hz away or more
 // leaks < 5e-6 N into it at 1 s of frames).
