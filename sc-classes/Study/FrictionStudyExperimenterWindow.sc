@@ -6,7 +6,7 @@
 FrictionStudyExperimenterWindow {
 	classvar <coveredColor, <emptyColor, <metColor, <puckColor;
 	var <session, <window, <infoText, <cueText, <coverageView, <viewHolder, <liveView;
-	var <nextButton, <repeatButton, <pauseButton, <abortButton, task, dirty = false;
+	var <nextButton, <repeatButton, <pauseButton, <abortButton, task, dirty = false, <frozen = false;
 
 	*initClass {
 		// Distinct colours, so that a test finds the cells in a screenshot.
@@ -25,15 +25,25 @@ FrictionStudyExperimenterWindow {
 		viewHolder.layout.add(liveView.asView);
 		liveView.follow = false;
 		liveView.rangeMm = session.condition.areaMm + [-10, 10];
+		liveView.paused = frozen;
 		this.refresh;
 	}
 
 	// A monitor frame arrived (the map is redrawn at the window's own rate).
 	frame { dirty = true }
 
+	// true: nothing is redrawn (the texts, the map and the live view keep their last picture) until
+	// false again, as FrictionView.paused. For Image.fromWindow: it draws the window inside the
+	// interpreter, and a view with a redraw pending then calls back into it and sclang hangs.
+	frozen_ { |bool|
+		frozen = bool == true;
+		liveView !? { liveView.paused = frozen };
+		if(frozen.not) { this.refresh }
+	}
+
 	refresh {
 		var s = session, c = s.coverage, met;
-		if(window.isNil) { ^this };
+		if(window.isNil or: { frozen }) { ^this };
 		infoText.string = "participant %    condition % of %: %    %    % s%".format(s.participant, s.position + 1,
 			s.conditionCount, s.condition !? { s.condition.name } ? "-", s.state,
 			s.elapsedS.round(0.1), s.condition !? { " of " ++ s.condition.maxTimeS } ? "");

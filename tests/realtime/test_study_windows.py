@@ -69,7 +69,13 @@ session.experimenterWindow.refresh;
 	"KF-BOUNDS % % % %".format(b.left, b.top, b.width, b.height).postln
 };
 session.experimenterWindow.coverageView.refresh;
+// Frozen for the grab, as its help says: a redraw pending at Image.fromWindow hangs sclang (the
+// window's 0.1 s refresh and the live view's 30 Hz made one pending at times: seen in three fresh
+// runs and here beside two CPU hogs, sclang's main thread in QWidget::grab waiting for the lock
+// it held).
+session.experimenterWindow.frozen = true;
 shot.(\experimenter, session.experimenterWindow.window);
+session.experimenterWindow.frozen = false;
 "KF-COVERAGE % %".format(session.coverage.count, session.coverage.fraction).postln;
 shot.(\exploring, session.participantWindow.window);
 session.participantWindow.pressKey($ );
