@@ -70,6 +70,9 @@ class BoardFirmware {
     version_.maxSubSetPoints = 1;
   }
 
+  // When the next level of the frame in play is due (s); negative when none is: a transport
+  // that ticks slower than the levels wakes for it (the gadget's step timer).
+  double nextStepS() const { return subNext_ < subCount_ ? subStartS_ + subNext_ * (kFramePeriodS / subCount_) : -1.0; }
   uint16_t drive() const { return drive_; }
   BoardState state() const { return state_; }
   uint16_t errors() const { return errors_; }

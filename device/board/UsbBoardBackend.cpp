@@ -286,6 +286,9 @@ void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
   written_.store(index + 1, std::memory_order_release);
 }
 
+// driveOff runs in signal handlers too (ForceBackend::driveOffFromSignal): its atomics must not lock.
+static_assert(std::atomic<uint64_t>::is_always_lock_free && std::atomic<uint32_t>::is_always_lock_free);
+
 void UsbBoardBackend::driveOff() {
   latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed);
   voidBefore_.store(written_.load(std::memory_order_acquire), std::memory_order_relaxed);

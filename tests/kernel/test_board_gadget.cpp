@@ -302,6 +302,77 @@ TEST_CASE("board gadget: 10 s of set-points, each received once and in order", "
   host.backend->close();
 }
 
+TEST_CASE("board gadget 2.1: eight levels a frame reach the gadget in order, none lost but those the host counted",
+          "[gadget]") {
+  GadgetBoard gadget;
+  HostBoard host;
+  std::string error;
+  BoardOptions options;
+  options.subSetPoints = 8;  // a device framing force at 8 kHz
+  REQUIRE(host.open(GadgetBoard::kSerial, error, options));
+  REQUIRE(host.telemetry().subSetPoints == 8);  // the gadget said, through GET_VERSION, that it plays 8
+  host.arm();
+  // The window, as in the 10 s stream: each frame the host counts in it is one the gadget read.
+  gadget.command("reading off");
+  std::this_thread::sleep_for(30ms);
+  gadget.report();
+  const BoardTelemetry before = host.telemetry();
+  gadget.command("reading on");
+  // Distinct, rising levels, eight a millisecond, as the device thread commands them at 8 kHz.
+  constexpr int kLevels = 2 * 8000;
+  constexpr int64_t kStepNs = kTickNs / 8;
+  const int64_t startNs = nowNs();
+  for (int i = 0; i < kLevels; ++i) {
+    std::this_thread::sleep_until(
+        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(startNs + i * kStepNs)));
+    host.backend->commandDrive(0.0, 0.0f, static_cast<float>(1000 + i) / board::kDriveFull);
+  }
+  gadget.command("reading off");
+  std::this_thread::sleep_for(30ms);
+  const BoardTelemetry after = host.telemetry();
+  const GadgetReport report = gadget.report();
+  gadget.command("reading on");
+  const std::vector<GadgetFrame> applied = report.applied();
+  REQUIRE(applied.size() > 2);
+  std::vector<uint16_t> levels;  // every level of every frame, in the order the gadget read them
+  long singleFrames = 0;
+  for (const GadgetFrame& frame : applied) {
+    singleFrames += frame.levels.size() != 8;
+    levels.insert(levels.end(), frame.levels.begin(), frame.levels.end());
+  }
+  long backwards = 0, distinct = levels.empty() ? 0 : 1;
+  for (size_t i = 1; i < levels.size(); ++i) {
+    backwards += levels[i] < levels[i - 1];
+    distinct += levels[i] > levels[i - 1];  // a level held (the device's next had not come) is no new one
+  }
+  long played = 0;
+  for (const auto& target : report.targets) played += target.why == "set-point" && target.drive >= 1000;
+  const SequenceCheck sequences = checkSequences(applied);
+  const uint64_t lost = after.lostTransfers - before.lostTransfers;
+  const uint64_t dropped = after.subStepsDropped - before.subStepsDropped;
+  char figures[400];
+  std::snprintf(figures, sizeof figures,
+                "%zu frames of 8 levels: %ld distinct levels of %d pushed, %ld played as targets; host: %llu frames "
+                "sent, %llu lost, %llu levels dropped, %llu padded",
+                applied.size(), distinct, kLevels, played,
+                static_cast<unsigned long long>(after.setPointsSent - before.setPointsSent),
+                static_cast<unsigned long long>(lost), static_cast<unsigned long long>(dropped),
+                static_cast<unsigned long long>(after.subStepsPadded - before.subStepsPadded));
+  std::printf("8 kHz stream: %s\n", figures);
+  reportFigure("board gadget 8 kHz stream", figures);
+  CHECK(singleFrames == 0);
+  CHECK(backwards == 0);  // in order: nothing reordered on the way or in the frames
+  CHECK(sequences.duplicates == 0);
+  CHECK(sequences.missing <= static_cast<long>(lost));
+  // None lost but those counted: each pushed level reached the gadget, or was dropped by the host
+  // (more than two frames waited: dummy_hcd serves the endpoint when its timer runs, not once a
+  // millisecond), or went in a frame the host counted lost, or still waited when the window shut
+  // (at most two frames' worth: 16), or came before the window opened (at most 16 as well).
+  CHECK(distinct + static_cast<long>(dropped) + 8 * static_cast<long>(lost) + 32 >= kLevels);
+  CHECK(distinct <= kLevels);
+  host.backend->close();
+}
+
 TEST_CASE("board gadget: a halted endpoint is cleared by the host, and set-points and status go on", "[gadget]") {
   GadgetBoard gadget;
   HostBoard host;

@@ -34,7 +34,7 @@ FunctionFsBoard::FunctionFsBoard(std::string functionFsDir, BoardFirmware& firmw
 
 FunctionFsBoard::~FunctionFsBoard() {
   if (aio_ != nullptr) io_destroy(aio_);  // cancels and waits for what is still queued
-  for (int fd : {timer_, events_, in_, out_, ep0_})
+  for (int fd : {stepTimer_, timer_, events_, in_, out_, ep0_})
     if (fd >= 0) ::close(fd);
 }
 
@@ -67,11 +67,14 @@ bool FunctionFsBoard::open(std::string& error) {
   period.it_value.tv_sec = nextTickNs_ / 1000000000;
   period.it_value.tv_nsec = nextTickNs_ % 1000000000;
   if (::timerfd_settime(timer_, TFD_TIMER_ABSTIME, &period, nullptr) != 0) return fail("timerfd_settime");
+  stepTimer_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
+  if (stepTimer_ < 0) return fail("timerfd_create");
   return true;
 }
 
 void FunctionFsBoard::run(const std::vector<int>& extraFds, const std::function<bool(int fd)>& onReadable) {
-  std::vector<pollfd> fds{{ep0_, POLLIN, 0}, {events_, POLLIN, 0}, {timer_, POLLIN, 0}};
+  std::vector<pollfd> fds{{ep0_, POLLIN, 0}, {events_, POLLIN, 0}, {timer_, POLLIN, 0}, {stepTimer_, POLLIN, 0}};
+  constexpr size_t kFirstExtra = 4;
   for (int fd : extraFds) fds.push_back({fd, POLLIN, 0});
   for (;;) {
     if (::poll(fds.data(), fds.size(), -1) < 0) {
@@ -81,9 +84,10 @@ void FunctionFsBoard::run(const std::vector<int>& extraFds, const std::function<
     }
     // The tick first: the watchdog's moment is not held up by a burst of frames.
     if (fds[2].revents & POLLIN) onTick();
+    if (fds[3].revents & POLLIN) onStep();
     if (fds[1].revents & POLLIN) onCompletions();
     if (fds[0].revents & POLLIN) onEp0();
-    for (size_t i = 3; i < fds.size(); ++i)
+    for (size_t i = kFirstExtra; i < fds.size(); ++i)
       if ((fds[i].revents & (POLLIN | POLLHUP)) && !onReadable(fds[i].fd)) return;
   }
 }
@@ -159,7 +163,8 @@ void FunctionFsBoard::queueReads() {
   if (!enabled_ || !reading_) return;
   for (Read& read : reads_) {
     if (read.queued) continue;
-    io_prep_pread(&read.cb, out_, read.buffer, kSetPointSize, 0);  // one packet: one set-point
+    // One packet: a set-point, or a multi set-point frame of up to 8 levels (a short packet ends it).
+    io_prep_pread(&read.cb, out_, read.buffer, kMaxSetPointFrameSize, 0);
     io_set_eventfd(&read.cb, events_);
     iocb* one = &read.cb;
     const int result = io_submit(aio_, 1, &one);
@@ -221,12 +226,15 @@ void FunctionFsBoard::onRead(Read& read, long result) {
     const int64_t now = nowNs();
     const uint64_t validBefore = firmware_.validFrames();
     firmware_.receiveSetPoint(read.buffer, static_cast<size_t>(result), seconds(now));
-    SetPoint setPoint;
-    const bool decoded = decodeSetPoint(read.buffer, static_cast<size_t>(result), setPoint);
+    armStepTimer();
+    MultiSetPoint frame;
+    const bool decoded = decodeAnySetPoint(read.buffer, static_cast<size_t>(result), frame);
     const GadgetLog::Verdict verdict = firmware_.validFrames() > validBefore ? GadgetLog::Verdict::kApplied
                                        : decoded                             ? GadgetLog::Verdict::kStale
                                                                              : GadgetLog::Verdict::kBad;
-    log_.frame(now, static_cast<int>(result), setPoint.sequence, setPoint.drive, verdict, firmware_.validFrames());
+    log_.frame(now, static_cast<int>(result), frame.sequence, frame.drives[0], verdict, firmware_.validFrames());
+    if (decoded && read.buffer[0] == kMultiSetPointType)
+      for (int i = 0; i < frame.count; ++i) log_.level(now, i, frame.drives[i]);
     queueReads();  // not while reading is off or the endpoint disabled
   }
   // A read that failed (cancelled, the endpoint going away, halted) is queued again by the next
@@ -267,6 +275,24 @@ void FunctionFsBoard::onTick() {
     status_.cancelledNs = now;
     cancel(status_.cb);
   }
+}
+
+void FunctionFsBoard::armStepTimer() {
+  const double dueS = firmware_.nextStepS();
+  itimerspec when{};  // zero: disarmed
+  if (dueS >= 0.0) {
+    const auto dueNs = std::max<int64_t>(static_cast<int64_t>(dueS * 1e9), 1);
+    when.it_value.tv_sec = dueNs / 1000000000;
+    when.it_value.tv_nsec = dueNs % 1000000000;
+  }
+  (void)::timerfd_settime(stepTimer_, TFD_TIMER_ABSTIME, &when, nullptr);
+}
+
+void FunctionFsBoard::onStep() {
+  uint64_t expirations = 0;
+  if (::read(stepTimer_, &expirations, sizeof expirations) != sizeof expirations) return;
+  firmware_.advance(seconds(nowNs()));  // every level due by now, each at its own time in the log
+  armStepTimer();
 }
 
 // --- test hooks ----------------------------------------------------------------------------------

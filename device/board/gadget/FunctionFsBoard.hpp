@@ -71,6 +71,8 @@ class FunctionFsBoard {
   void onRead(Read& read, long result);
   void onStatus(long result);
   void onTick();
+  void onStep();        // the step timer: the frame's next level is due
+  void armStepTimer();  // for the firmware's next level, or disarmed when none is in play
   void queueReads();
   void submitStatus();
   void cancel(iocb& cb);
@@ -80,6 +82,7 @@ class FunctionFsBoard {
   BoardFirmware& firmware_;
   GadgetLog& log_;
   int ep0_ = -1, out_ = -1, in_ = -1, events_ = -1, timer_ = -1;
+  int stepTimer_ = -1;  // one-shot, at the next level of a multi set-point frame (125 us apart)
   io_context_t aio_ = nullptr;
   Read reads_[kQueuedReads];
   StatusWrite status_;

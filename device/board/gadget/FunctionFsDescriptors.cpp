@@ -13,9 +13,9 @@ namespace {
 
 constexpr char kInterfaceName[] = "Friction board";
 constexpr uint16_t kLanguageUsEnglish = 0x0409;
-constexpr uint8_t kFullSpeedInterval = 1;  // frames of 1 ms
-constexpr uint8_t kHighSpeedInterval = 4;  // 2^(4-1) microframes of 125 us: 1 ms
-constexpr uint16_t kSetPointPacket = kSetPointSize;
+constexpr uint8_t kFullSpeedInterval = 1;                    // frames of 1 ms
+constexpr uint8_t kHighSpeedInterval = 4;                    // 2^(4-1) microframes of 125 us: 1 ms
+constexpr uint16_t kSetPointPacket = kMaxSetPointFrameSize;  // 22 bytes: a frame of 8 levels (2.1)
 constexpr uint16_t kStatusPacket = kStatusSize;
 
 // Little-endian fields, whatever the board's processor.

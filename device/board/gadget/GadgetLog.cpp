@@ -21,6 +21,10 @@ void GadgetLog::frame(int64_t timeNs, int bytes, uint16_t sequence, uint16_t dri
        Kind::kFrame, static_cast<uint8_t>(verdict)});
 }
 
+void GadgetLog::level(int64_t timeNs, int index, uint16_t drive) {
+  add({timeNs, 0, nullptr, 0, drive, 0, static_cast<uint8_t>(index), Kind::kLevel, 0});
+}
+
 void GadgetLog::target(int64_t timeNs, uint16_t drive, const char* why) {
   add({timeNs, 0, why, 0, drive, 0, 0, Kind::kTarget, 0});
 }
@@ -57,6 +61,9 @@ long GadgetLog::report(const std::string& path) {
       case Kind::kFrame:
         std::fprintf(out, "frame %" PRId64 " %u %u %u %s %u\n", r.timeNs, r.c, r.a, r.b, kVerdicts[r.flag], r.count);
         ++frames;
+        break;
+      case Kind::kLevel:
+        std::fprintf(out, "level %" PRId64 " %u %u\n", r.timeNs, r.c, r.a);
         break;
       case Kind::kTarget:
         std::fprintf(out, "target %" PRId64 " %u %s\n", r.timeNs, r.a, r.text);

@@ -1,6 +1,7 @@
 // GadgetLog: what the gadget saw, timestamped on the board's side of the bus (CLOCK_MONOTONIC,
 // the clock the host's steady_clock reads on the same Linux): every set-point frame received
-// (its sequence, drive and what the firmware made of it), every change of the coil's target,
+// (its sequence, drive and what the firmware made of it; a multi set-point frame's every level),
+// every change of the coil's target,
 // every control request, every FunctionFS event, every status frame the host took, and the
 // lateness of the 1 ms tick. Bounded: room for a fixed number of records, made at start; what
 // does not fit is counted, never grown into. report() writes the records since the last report
@@ -29,6 +30,8 @@ class GadgetLog {
   explicit GadgetLog(size_t capacity = 1u << 18);
 
   void frame(int64_t timeNs, int bytes, uint16_t sequence, uint16_t drive, Verdict verdict, uint64_t validFrames);
+  // A multi set-point frame's levels (2.1), after its frame record: level `index` of the frame.
+  void level(int64_t timeNs, int index, uint16_t drive);
   void target(int64_t timeNs, uint16_t drive, const char* why);
   void control(int64_t timeNs, uint8_t request, uint16_t value, bool stalled);
   void event(int64_t timeNs, const char* name);
@@ -42,15 +45,15 @@ class GadgetLog {
   long report(const std::string& path);
 
  private:
-  enum class Kind : uint8_t { kFrame, kTarget, kControl, kEvent, kStatus };
+  enum class Kind : uint8_t { kFrame, kLevel, kTarget, kControl, kEvent, kStatus };
   struct Record {
     int64_t timeNs;
     int64_t otherNs;   // status: when the frame was built
     const char* text;  // target: why; event: its name (static strings)
     uint32_t count;    // frame: valid frames so far
-    uint16_t a;        // frame, status: sequence; target: drive; control: wValue
+    uint16_t a;        // frame, status: sequence; level, target: drive; control: wValue
     uint16_t b;        // frame: drive; status: frames received
-    uint8_t c;         // frame: bytes; control: bRequest
+    uint8_t c;         // frame: bytes; level: index; control: bRequest
     Kind kind;
     uint8_t flag;  // frame: Verdict; control: stalled
   };

@@ -137,8 +137,8 @@ int main(int argc, char** argv) {
   version.firmwareMajor = 1;
   version.flags = 0;  // no current sensor: the status's current is the target
   version.fullScaleCurrentMa = static_cast<uint16_t>(options.fullScaleMa);
-  // One set-point per frame: its tick is 1 ms, and its EP 0x01 packet 8 bytes (PROTOCOL.md 11).
-  version.maxSubSetPoints = 1;
+  // Up to 8 levels per frame (PROTOCOL.md 3.1): a step timer plays each at its own time.
+  version.maxSubSetPoints = kMaxSubSetPoints;
   BoardFirmware firmware(coil, version, FunctionFsBoard::nowNs() * 1e-9);
 
   GadgetConfigfs gadget(options.identity);

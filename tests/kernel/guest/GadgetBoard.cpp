@@ -170,6 +170,11 @@ GadgetReport GadgetBoard::report() {
       GadgetFrame f{};
       words >> f.timeNs >> f.bytes >> f.sequence >> f.drive >> f.verdict >> f.validFrames;
       report.frames.push_back(f);
+    } else if (kind == "level") {
+      int64_t timeNs = 0;
+      unsigned index = 0, drive = 0;
+      words >> timeNs >> index >> drive;
+      if (!report.frames.empty()) report.frames.back().levels.push_back(static_cast<uint16_t>(drive));
     } else if (kind == "target") {
       GadgetTarget t{};
       words >> t.timeNs >> t.drive >> t.why;

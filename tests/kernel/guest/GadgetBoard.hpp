@@ -21,6 +21,7 @@ struct GadgetFrame {
   uint16_t drive;
   std::string verdict;  // applied, stale, bad
   uint32_t validFrames;
+  std::vector<uint16_t> levels;  // a multi set-point frame's (2.1), in order; empty for a single one
 };
 struct GadgetTarget {
   int64_t timeNs;
