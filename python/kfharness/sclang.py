@@ -172,13 +172,14 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 
 
 def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None,
-                    server_options=None, booted=None):
+                    server_options=None, booted=None, server_left_s=5.0):
     """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync` and
     GUI work) with `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang
     processes are gone when it returns, whatever happened. `env`: extra environment variables;
     `server_options`: ServerOptions to set over the defaults, e.g. {"memSize": 524288};
     `booted`: a threading.Event, set once the server is up or the run is over (so that runs side
-    by side can boot one after another)."""
+    by side can boot one after another); `server_left_s`: how long a server left running after
+    sclang ended may take to go before it is stopped."""
     assert jack.alive(), "jackd is not running"
     port = port or procs.free_udp_port()
     key, code_path = _script_files(code, name)
@@ -222,7 +223,7 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
                 known_children.add(scsynth_pid)
             # scsynth quits on /quit; give it a moment, then stop whatever is left, by pid.
             for pid in sorted(known_children):
-                if not procs.wait_pid_gone(pid, 5.0):
+                if not procs.wait_pid_gone(pid, server_left_s):
                     procs.stop_pid(pid)
             # A server that did not quit (a signal, a crash, killed here) leaves its shared memory
             # behind, 8 MB a server; nothing uses it once the server is gone.
@@ -250,25 +251,41 @@ def pids_file(name):
     return paths.work_dir() / f"{name}-pids.txt"
 
 
-def run_and_kill(code, jack, ready, name="killed", timeout=120, server_options=None, wait_s=90):
+def run_and_kill(code, jack, ready, name="killed", timeout=120, server_options=None, wait_s=90, orphaned=None):
     """Runs `code` with a server (run_with_server) in a thread of its own and kills sclang and
     scsynth with SIGKILL, by pid, once ready() is true (a crash mid-session). `code` must write
     "<sclang pid> <scsynth pid>" to pids_file(name). Returns the run; an AssertionError if
-    ready() did not come within wait_s."""
+    ready() did not come within wait_s. With `orphaned`, only sclang is killed, and
+    orphaned(scsynth_pid, quit) is called at once: the server plays on without its client until
+    quit() (an orderly /quit, which closes its open files), or is stopped by pid 60 s later."""
     import signal
     import threading
     pids = pids_file(name)
     pids.unlink(missing_ok=True)
+    port = procs.free_udp_port()
     result = {}
     thread = threading.Thread(target=lambda: result.update(run=run_with_server(
-        code, jack, timeout=timeout, name=name, server_options=server_options)))
+        code, jack, timeout=timeout, name=name, port=port, server_options=server_options,
+        server_left_s=5.0 if orphaned is None else 60.0)))
     thread.start()
     deadline = time.monotonic() + wait_s
     while time.monotonic() < deadline and not (pids.exists() and ready()):
         time.sleep(0.02)
     assert pids.exists() and ready(), f"{name}: what the kill waits for never came"
     sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
-    os.kill(scsynth_pid, signal.SIGKILL)
+    if orphaned is None:
+        os.kill(scsynth_pid, signal.SIGKILL)
     os.kill(sclang_pid, signal.SIGKILL)
-    thread.join(60)
+    try:
+        if orphaned is not None:
+            orphaned(scsynth_pid, lambda: _send_quit(port))
+    finally:
+        thread.join(90)
     return result["run"]
+
+
+def _send_quit(port):
+    """/quit to the server on `port` (UDP, as sclang sends it)."""
+    import socket
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.sendto(b"/quit\0\0\0,\0\0\0", ("127.0.0.1", port))

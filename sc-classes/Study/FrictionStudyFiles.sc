@@ -138,38 +138,6 @@ FrictionStudyFiles {
 		^cut
 	}
 
-	// Ends a Recorder's file (in a Routine), all of it, and frees its buffer before its number is free.
-	// Recorder.stopRecording frees its DiskOut and closes the file in one go, but DiskOut's last part
-	// (up to half its buffer, 0.68 s at 48 kHz) reaches the file from scsynth's disk thread after the
-	// free: a close that came first lost it (a 0.4 s condition left 0 frames). So the DiskOut goes
-	// first, without the Recorder's own stop on its /n_end, and the file is closed once its size has
-	// stopped growing, at most 2 s later. And stopRecording frees the buffer as the close's completion
-	// but gives its number back to sclang at once: a recording started meanwhile (the next condition,
-	// another session) got that number and the late free emptied its buffer, leaving its file 0 bytes
-	// (7 of 10 back to back; once in a study job of five sessions). So: close, wait, then free.
-	*closeRecorder { |recorder, server|
-		var path = recorder.path, node, buffer, size = -1, stableSince = Main.elapsedTime, t0 = Main.elapsedTime;
-		if(path.isNil) { ^this };  // closed already
-		if(#[recordNode, recordBuf].every { |name| Recorder.instVarNames.includes(name) }.not) {
-			^recorder.stopRecording
-		};
-		node = recorder.instVarAt(\recordNode);
-		if(recorder.isRecording) {
-			node.releaseDependants;
-			node.free;
-			server.sync;
-			while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
-				var now = File.fileSize(path);
-				if(now != size) { size = now; stableSince = Main.elapsedTime };
-				0.01.wait
-			};
-		};
-		buffer = recorder.instVarAt(\recordBuf);
-		recorder.instVarPut(\recordBuf, nil);  // its stopRecording leaves the buffer alone
-		recorder.stopRecording;
-		buffer !? { buffer.close; server.sync; buffer.free };
-	}
-
 	// Local date and time, ISO 8601 (seconds).
 	*now { ^Date.getDate.format("%Y-%m-%dT%H:%M:%S") }
 

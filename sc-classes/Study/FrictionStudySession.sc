@@ -299,16 +299,14 @@ FrictionStudySession {
 		^\end
 	}
 
-	// Ends the condition's audio.wav, all of it (FrictionStudyFiles.closeRecorder says why not stopRecording).
-	prStopAudio { recorder !? { FrictionStudyFiles.closeRecorder(recorder, server) } }
+	// Ends the condition's audio.wav, all of it.
+	prStopAudio { recorder !? { recorder.close; recorder = nil } }
 
-	// The participant's output pair into the condition's audio.wav; the report places its first
-	// sample at the recordAudio line.
+	// The participant's output pair into the condition's audio.wav, which stops with the devices'
+	// force when sclang falls silent (clientTimeoutS); the report places its first sample at the
+	// recordAudio line.
 	prRecordAudio {
-		recorder = Recorder(server).recHeaderFormat_("wav").recSampleFormat_("float");
-		recorder.record(conditionDir +/+ "audio.wav", participantOut, 2);
-		server.sync;
-		while { recorder.isRecording.not } { 0.01.wait };
+		recorder = FrictionStudyAudio(server, conditionDir +/+ "audio.wav", participantOut, clientTimeoutS);
 		this.log(\recordAudio);
 		coverage = study.coverageFor(condition);
 	}

@@ -1,7 +1,7 @@
-"""A condition's audio.wav closed and the next one started at once (FrictionStudyFiles.closeRecorder,
-what FrictionStudySession does between conditions, five sessions at a time in the study job):
-every file is a whole WAV with the seconds recorded. Recorder.stopRecording in its place: take2 had
-no frame; a probe of the same pattern left 7 of 10 files 0 bytes ("could not be opened: Format not
+"""A condition's audio.wav closed and the next one started at once (FrictionStudyAudio.close, what
+FrictionStudySession does between conditions, five sessions at a time in the study job): every
+file is a whole WAV with the seconds recorded. Recorder.stopRecording in its place: take2 had no
+frame; a probe of the same pattern left 7 of 10 files 0 bytes ("could not be opened: Format not
 recognised"), as one condition's audio.wav was in a fresh clone's study job. The closed buffer's
 number went back to sclang before the server freed it, and that late free emptied the next
 recording's buffer."""
@@ -23,12 +23,9 @@ def test_back_to_back_recordings_each_keep_their_file(jack):
         var recorder;
         {{ Out.ar(0, SinOsc.ar([220, 330]) * 0.1) }}.play;
         {RECORDINGS}.do {{ |i|
-            recorder = Recorder(s).recHeaderFormat_("wav").recSampleFormat_("float");
-            recorder.record({sclang.sc_string(str(folder))} +/+ "take" ++ i ++ ".wav", 0, 2);
-            s.sync;
-            while {{ recorder.isRecording.not }} {{ 0.01.wait }};
+            recorder = FrictionStudyAudio(s, {sclang.sc_string(str(folder))} +/+ "take" ++ i ++ ".wav", 0, 2);
             {SECONDS}.wait;
-            FrictionStudyFiles.closeRecorder(recorder, s);
+            recorder.close;
         }};
         s.sync;
     """, jack, name="recorder-close"))

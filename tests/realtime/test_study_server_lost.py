@@ -1,16 +1,19 @@
 """A study session whose instrument is gone mid-threshold-condition fails at once: its server dies
 (kill -9 of scsynth, or of jackd: the server's audio stops), its device's slot is closed under it,
 its device recording stops (a file size limit: as a full disk), or sclang itself stands still
-(stopped by SIGSTOP for 5 s, as a computer that slept), or the device's thread fails. Checked: the
-session's state, its reason in session.csv and the condition's events, and no trial stored after
-the death (FrictionStudySession's watch: a /sync every 0.25 s, lost after lostAfterS; the device's
-status each tick; the watch's own tick late by more than lostAfterS)."""
+(stopped by SIGSTOP for 5 s, as a computer that slept), or the device's thread fails. Checked: the session's state, its reason in
+session.csv and the condition's events, and no trial stored after the death (FrictionStudySession's
+watch: a /sync every 0.25 s, lost after lostAfterS; the device's status each tick; the watch's own
+tick late by more than lostAfterS). And sclang killed, its server playing on: the server stops the
+force and the recordings by itself."""
 import shutil
+import time
 
 import numpy as np
 import pytest
+import soundfile
 
-from kfharness import paths, sclang
+from kfharness import paths, procs, sclang
 from kfstudy import readers
 from kfstudy.session_folder import read_csv
 
@@ -183,3 +186,64 @@ def test_a_silent_client_turns_the_force_off(jack):
     quiet_s = (after.min() if len(after) else np.inf) - off_s
     print(f"KF-FIGURE study_silent_client_quiet_s {quiet_s:.3f}")
     assert quiet_s >= stopped_s - timeout_s - 0.05, quiet_s
+
+
+ORPHANED = r"""
+var study, session, path = @ROOT@ +/+ "K1/trials.csv";
+var rows = { if(File.exists(path)) { File.readAllString(path).split($\n).reject(_.isEmpty).size - 1 } { 0 } };
+FrictionStudySession.clientTimeoutS = @TIMEOUT@;
+study = FrictionStudy("orphaned", [
+	FrictionStudyCondition.threshold(\forceStep, {
+		FrictionThreshold.force(FrictionConstantStimuli([0.3, 0.5], 20, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
+session = study.run("K1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
+while { rows.value < 2 } { 0.01.wait };
+File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
+120.wait;
+"KF-NOT-KILLED".postln;
+"""
+ORPHAN_TIMEOUT_S = 1.0
+
+
+def test_a_killed_client_leaves_a_server_that_stops_the_force_and_the_recordings(jack):
+    """kill -9 of sclang mid-threshold-condition, its server left running (as after a crash of the
+    client alone): once no heartbeat has come for clientTimeoutS the magnet is off (cause "client"),
+    and neither the device recording nor the condition's audio.wav grows any more (SC's Recorder
+    went on writing audio.wav for as long as the server ran: 21 s). An orderly /quit of the server
+    then leaves audio.wav a whole WAV holding what was recorded up to the silence."""
+    root = paths.work_dir() / "study-orphaned"
+    shutil.rmtree(root, ignore_errors=True)
+    condition = root / "K1" / "01-forceStep"
+    files = [condition / "audio.wav", condition / "device.kfsession"]
+    sizes = {}
+
+    def orphaned(scsynth_pid, quit):
+        killed_s = time.monotonic()
+        # The silence is seen within the timeout plus a heartbeat period (timeout / 4) after the
+        # kill; the audio's last half buffer (0.68 s at 48 kHz) was written by the disk thread
+        # before the pause could hold it. 1.5 s more is room for both.
+        time.sleep(max(0.0, killed_s + ORPHAN_TIMEOUT_S * 1.25 + 1.5 - time.monotonic()))
+        sizes["silent"] = [f.stat().st_size for f in files]
+        # 2.5 s later: a recording still running would have grown by 3 of DiskOut's half buffers
+        # and by 100 kB of device recording.
+        time.sleep(2.5)
+        sizes["later"] = [f.stat().st_size for f in files]
+        sizes["alive"] = procs.pid_alive(scsynth_pid)
+        quit()
+        sizes["quit"] = procs.wait_pid_gone(scsynth_pid, 10.0)
+
+    code = sclang.fill(ORPHANED, ROOT=sclang.sc_string(str(root)), TIMEOUT=ORPHAN_TIMEOUT_S,
+                       PIDS=sclang.sc_string(str(sclang.pids_file("study-orphaned"))))
+    run = sclang.run_and_kill(code, jack, lambda: True, name="study-orphaned", orphaned=orphaned,
+                              server_options={"numOutputBusChannels": 4})
+    assert "KF-NOT-KILLED" not in run.output
+    assert sizes["alive"] and sizes["quit"], sizes  # the server played on, then quit when told
+    print(f"KF-FIGURE study_orphaned_sizes {sizes}")
+    assert sizes["later"] == sizes["silent"], sizes
+    recording = readers.Session(files[1])
+    assert "client" in recording.off_causes, recording.off_causes
+    off_s = recording.offs[recording.off_causes.index("client")]
+    frames, reports = recording.frames, recording.reports
+    assert not len(frames[frames[:, 0] > off_s]) and not len(reports[reports[:, 0] > off_s]), off_s
+    audio, rate = soundfile.read(str(files[0]), always_2d=True)
+    assert audio.shape[1] == 2 and audio.shape[0] > 0 and np.isfinite(audio).all(), audio.shape
