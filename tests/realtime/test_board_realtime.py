@@ -7,8 +7,8 @@ import pytest
 
 from kfharness import paths, sclang
 
-BOARD_LINE = re.compile(r"^kfStatus 5: board (\S+) (connected|NOT CONNECTED), (armed|disarmed); board state (\w+), "
-                        r"current ([0-9.]+) of full scale")
+BOARD_LINE = re.compile(r"^kfStatus 5: board (\S+) (connected|NOT CONNECTED), (armed|disarmed), force at 1 kHz; "
+                        r"board state (\w+), current ([0-9.]+) of full scale")
 COUNTS_LINE = re.compile(r"^kfStatus 5: board set-points sent .*, resets (\d+)")
 TIMING_LINE = re.compile(r"^kfStatus 5: frames per 1 ms pump 0/1/2/3\+: ([0-9.]+)/([0-9.]+)/([0-9.]+)/([0-9.]+)")
 
@@ -34,7 +34,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         phase.(\\armed);
         dev.boardStatus {{ |e|
             ("KF-BOARD-STATUS " ++ [e.hasBoard, e.connected, e.armed, e.boardState, e.currentLevel.round(0.001),
-                                    e.setPointsSent > 100]).postln
+                                    e.setPointsSent > 100, e.forceRateHz.asInteger]).postln
         }};
         0.2.wait;
         FrictionCalibration([[0, 0.14], [0.25, 0.77], [1, 1.4]], "KF-EMU-0001").write({sclang.sc_string(table)});
@@ -54,7 +54,10 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         s.sync;
     """, jack, name="board"))
     lines = run.output.splitlines()
-    assert any(re.match(r"^kfBoardOpen 5 board KF-EMU-0001 \(emulated\) \(protocol 2\.0", l) for l in lines), \
+    # The paper's device frames force at 1 kHz: a 2.1 board is sent one level a frame.
+    opened = re.compile(r"^kfBoardOpen 5 board KF-EMU-0001 \(emulated\) \(protocol 2\.1, .*, force at 1 kHz\) "
+                        r"is disarmed")
+    assert any(opened.match(l) for l in lines), \
         run.output[-3000:]
     assert "kfBoardArm 5 board armed" in run.output
     assert any(l.startswith("kfBoardArm: no device is open at index 6") for l in lines)
@@ -87,7 +90,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
     replies = [l for l in lines if l.startswith("KF-BOARD-STATUS ")]
     assert len(replies) == 1, run.output[-3000:]
     assert replies[0].startswith("KF-BOARD-STATUS [ true, true, true, armed, "), replies
-    assert replies[0].endswith(", true ]") and " 0.5," in replies[0], replies
+    assert replies[0].endswith(", true, 1000 ]") and " 0.5," in replies[0], replies
     # The emulated board's power-on reset is reported once: acknowledged by the CLEAR_ERRORS of
     # the open, not counted again by the one before ARM, nor by any status frame after.
     resets = [int(COUNTS_LINE.match(l).group(1)) for l in lines if COUNTS_LINE.match(l)]
