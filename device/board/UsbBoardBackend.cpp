@@ -289,18 +289,21 @@ void UsbBoardBackend::commandDrive(double, float, float driveLevel) {
 // driveOff runs in signal handlers too (ForceBackend::driveOffFromSignal): its atomics must not lock.
 static_assert(std::atomic<uint64_t>::is_always_lock_free && std::atomic<uint32_t>::is_always_lock_free);
 
-void UsbBoardBackend::driveOff() {
-  latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed);
+void UsbBoardBackend::voidQueuedLevels() {
   voidBefore_.store(written_.load(std::memory_order_acquire), std::memory_order_relaxed);
   offs_.fetch_add(1, std::memory_order_release);
+}
+
+void UsbBoardBackend::driveOff() {
+  latestDrive_.fetch_and(kRestartPending, std::memory_order_relaxed);
+  voidQueuedLevels();
 }
 
 bool UsbBoardBackend::takeRestartFromOff() {
   uint32_t current = latestDrive_.load(std::memory_order_relaxed);
   while (current & kRestartPending)
     if (latestDrive_.compare_exchange_weak(current, 0, std::memory_order_relaxed)) {
-      voidBefore_.store(written_.load(std::memory_order_acquire), std::memory_order_relaxed);
-      offs_.fetch_add(1, std::memory_order_release);
+      voidQueuedLevels();
       return true;
     }
   return false;

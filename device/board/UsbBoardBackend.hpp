@@ -143,6 +143,8 @@ class UsbBoardBackend : public ForceBackend {
   // The frame's drive levels when the device makes more than one per frame: the next groups of
   // the ring, each group's mean one level; false when the single latest level is to go.
   bool nextSubSetPoints(board::MultiSetPoint& frame);
+  // The levels queued so far are never sent (an off, ARM's restart): any thread, signal-safe.
+  void voidQueuedLevels();
   void submitStatus();
   void submitIdle();
   // After a transfer failed at once: no transfer is sent before retryAfterS_ (true: not now).

@@ -125,6 +125,30 @@ std::string describeCounts(const CountingPort::Counts& c) {
          std::to_string(c.inFlightAtClose);
 }
 
+// What the host counted and the gadget read over one stream: the window runs from a moment the
+// board reads nothing to the next, so that each set-point the host counts as sent in it is one the
+// gadget read in it.
+struct StreamWindow {
+  BoardTelemetry before, after;
+  GadgetReport report;
+};
+template <class Stream>
+StreamWindow streamInWindow(GadgetBoard& gadget, HostBoard& host, Stream stream) {
+  StreamWindow window;
+  gadget.command("reading off");
+  std::this_thread::sleep_for(30ms);  // the host's callbacks of what the board read have run
+  gadget.report();
+  window.before = host.telemetry();
+  gadget.command("reading on");
+  stream();
+  gadget.command("reading off");
+  std::this_thread::sleep_for(30ms);
+  window.after = host.telemetry();
+  window.report = gadget.report();
+  gadget.command("reading on");
+  return window;
+}
+
 }  // namespace
 
 TEST_CASE("board gadget: opened through libusb by its identity and serial, never another serial's", "[gadget]") {
@@ -231,27 +255,20 @@ TEST_CASE("board gadget: 10 s of set-points, each received once and in order", "
   std::string error;
   REQUIRE(host.open(GadgetBoard::kSerial, error));
   host.arm();
-  // The window: from a moment the board reads nothing to the next, so that each set-point the
-  // host counts as sent in it is one the gadget read in it.
-  gadget.command("reading off");
-  std::this_thread::sleep_for(30ms);  // the host's callbacks of what the board read have run
-  gadget.report();
-  const BoardTelemetry before = host.telemetry();
-  gadget.command("reading on");
   // A rising drive, one level a millisecond, as the device thread commands it: the order the
   // board applies them in shows through.
   constexpr int kStreamMs = 10000;
-  const int64_t startNs = nowNs();
-  for (int ms = 1; ms <= kStreamMs; ++ms) {
-    host.backend->commandDrive(0.0, 0.0f, static_cast<float>(ms) / kStreamMs);
-    std::this_thread::sleep_until(
-        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(startNs + ms * kTickNs)));
-  }
-  gadget.command("reading off");
-  std::this_thread::sleep_for(30ms);
-  const BoardTelemetry after = host.telemetry();
-  const GadgetReport report = gadget.report();
-  gadget.command("reading on");
+  const StreamWindow window = streamInWindow(gadget, host, [&] {
+    const int64_t startNs = nowNs();
+    for (int ms = 1; ms <= kStreamMs; ++ms) {
+      host.backend->commandDrive(0.0, 0.0f, static_cast<float>(ms) / kStreamMs);
+      std::this_thread::sleep_until(
+          std::chrono::steady_clock::time_point(std::chrono::nanoseconds(startNs + ms * kTickNs)));
+    }
+  });
+  const BoardTelemetry& before = window.before;
+  const BoardTelemetry& after = window.after;
+  const GadgetReport& report = window.report;
   const std::vector<GadgetFrame> applied = report.applied();
   REQUIRE(applied.size() > 2);
   const SequenceCheck sequences = checkSequences(applied);
@@ -312,26 +329,20 @@ TEST_CASE("board gadget 2.1: eight levels a frame reach the gadget in order, non
   REQUIRE(host.open(GadgetBoard::kSerial, error, options));
   REQUIRE(host.telemetry().subSetPoints == 8);  // the gadget said, through GET_VERSION, that it plays 8
   host.arm();
-  // The window, as in the 10 s stream: each frame the host counts in it is one the gadget read.
-  gadget.command("reading off");
-  std::this_thread::sleep_for(30ms);
-  gadget.report();
-  const BoardTelemetry before = host.telemetry();
-  gadget.command("reading on");
   // Distinct, rising levels, eight a millisecond, as the device thread commands them at 8 kHz.
   constexpr int kLevels = 2 * 8000;
   constexpr int64_t kStepNs = kTickNs / 8;
-  const int64_t startNs = nowNs();
-  for (int i = 0; i < kLevels; ++i) {
-    std::this_thread::sleep_until(
-        std::chrono::steady_clock::time_point(std::chrono::nanoseconds(startNs + i * kStepNs)));
-    host.backend->commandDrive(0.0, 0.0f, static_cast<float>(1000 + i) / board::kDriveFull);
-  }
-  gadget.command("reading off");
-  std::this_thread::sleep_for(30ms);
-  const BoardTelemetry after = host.telemetry();
-  const GadgetReport report = gadget.report();
-  gadget.command("reading on");
+  const StreamWindow window = streamInWindow(gadget, host, [&] {
+    const int64_t startNs = nowNs();
+    for (int i = 0; i < kLevels; ++i) {
+      std::this_thread::sleep_until(
+          std::chrono::steady_clock::time_point(std::chrono::nanoseconds(startNs + i * kStepNs)));
+      host.backend->commandDrive(0.0, 0.0f, static_cast<float>(1000 + i) / board::kDriveFull);
+    }
+  });
+  const BoardTelemetry& before = window.before;
+  const BoardTelemetry& after = window.after;
+  const GadgetReport& report = window.report;
   const std::vector<GadgetFrame> applied = report.applied();
   REQUIRE(applied.size() > 2);
   std::vector<uint16_t> levels;  // every level of every frame, in the order the gadget read them
