@@ -19,7 +19,7 @@ from . import session_folder
 
 # conditions.csv's columns, in order.
 CONDITION_COLUMNS = ["participant", "position", "condition", "threshold", "mapping", "friction", "audio", "duration_s",
-                     "ended_by", "coverage_live", "coverage_recording", "median_speed_inside", "mean_speed_inside",
+                     "ended_by", "coverage_live", "coverage_recording", "coverage_cells_apart", "median_speed_inside", "mean_speed_inside",
                      "time_inside_s", "attempts", "figure3"]
 SAMPLE_COLUMNS = ["participant", "position", "condition", "mapping", "friction", "t_s", "x_mm", "v_mm_s", "force_n",
                   "inside"]
@@ -73,10 +73,13 @@ def _condition_row(session, c, m):
         # Trials, not exploration: its fit is the psychometric stage's; its speeds are no exploring's.
         return base
     live = c.event_detail("coverage")
+    live_cells = c.live_cells()
     speeds = m["speeds_inside"]
     return dict(base, mapping=str(c.settings["mapping"]), friction=bool(c.settings["friction"]),
                 audio=bool(c.settings["audio"]), coverage_live=float(live) if live else float("nan"),
                 coverage_recording=m["coverage"],
+                # The cells covered in one map and not in the other; -1: no map logged (older sessions).
+                coverage_cells_apart=-1 if live_cells is None else int((live_cells != m["cells"]).sum()),
                 median_speed_inside=float(np.median(speeds)) if len(speeds) else float("nan"),
                 mean_speed_inside=float(np.mean(speeds)) if len(speeds) else float("nan"),
                 time_inside_s=m["time_inside_s"], area_from_mm=float(c.area_mm[0]), area_to_mm=float(c.area_mm[1]))
@@ -119,6 +122,8 @@ def load(root):
         answers += a
         measured += m
     conditions = pd.DataFrame(rows, columns=CONDITION_COLUMNS + ["area_from_mm", "area_to_mm"])
+    # A count, blank for the threshold conditions (not 0.0 and NaN, as a float column would be).
+    conditions["coverage_cells_apart"] = conditions["coverage_cells_apart"].astype("Int64")
     return Tables(sessions=sessions, unreadable=unreadable, conditions=conditions,
                   samples=pd.concat(samples, ignore_index=True) if samples else pd.DataFrame(columns=SAMPLE_COLUMNS),
                   answers=pd.DataFrame(answers), failed=failed, measured=measured)

@@ -27,7 +27,7 @@ SPEED_REPORTS = 5
 # with (tests/scenes/test_session_events.py holds the two lists together).
 CONDITION_EVENTS = ("prepare", "recordDevice", "recordAudio", "experiment", "observer", "continue", "start",
                     "pause", "resume", "trial", "done", "maxTime", "repeat", "abort", "lost", "coverage",
-                    "estimate", "answer", "end")
+                    "coverageMap", "estimate", "answer", "end")
 SESSION_EVENTS = ("start", "resume", "finish", "abort", "error")
 
 
@@ -85,6 +85,14 @@ class Condition:
     @property
     def ended_by(self):
         return self.event_detail("done") or ("time" if self.event_time("maxTime") is not None else None)
+
+    def live_cells(self):
+        """The coverage map the experimenter saw (its coverageMap event), shaped as coverage()'s
+        (positionBins x speedBins, True where covered), or None before it was logged."""
+        detail = self.event_detail("coverageMap")
+        if not detail:
+            return None
+        return np.array([[c == "1" for c in row] for row in detail.split("/")], dtype=bool).T
 
     @functools.cached_property
     def recording(self):

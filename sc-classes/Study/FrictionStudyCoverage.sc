@@ -3,7 +3,7 @@
 // scale: the paper's "from quite slow to fast"). A cell is covered once the puck has been seen in
 // it, or has passed through it between two positions seen (a frame every 10 ms misses parts of
 // 0.6 mm at mapping 1's speeds otherwise); the criterion is met when the fraction covered reaches
-// criterion. The report (python/kfharness/study_session.py, coverage) computes the same map from
+// criterion. The report (python/kfstudy/session_folder.py, coverage) computes the same map from
 // the device recording.
 FrictionStudyCoverage {
 	var <areaMm, <slowMmPerS, <fastMmPerS, <positionBins, <speedBins, <criterion;
@@ -50,6 +50,10 @@ FrictionStudyCoverage {
 	// The fraction of the area's parts and of the speed range's parts visited at all.
 	areaFraction { ^cells.count { |row| row.includes(true) } / positionBins }
 	speedFraction { ^(0 .. speedBins - 1).count { |v| cells.any { |row| row[v] } } / speedBins }
+
+	// The cells as text: a row of positionBins 0s and 1s (1: covered) per speed part, slowest first,
+	// joined by "/" (the session's coverageMap event; kfstudy.session_folder reads it).
+	mapString { ^(0 .. speedBins - 1).collect { |v| cells.collect { |row| if(row[v]) { $1 } { $0 } }.join }.join("/") }
 
 	reset { cells = Array.fill(positionBins, { Array.fill(speedBins, false) }); count = 0 }
 

@@ -28,8 +28,8 @@ FrictionStudySession {
 	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
-	var lastPositionMm, ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
-	var buttonsSynth, buttonsResponder;
+	var ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
+	var buttonsSynth, buttonsResponder, recentFrames, lastMiddleMm;
 	var routine, lastAnswerT, watchTickT, watchId, experiment, sessionTimeOffsetS = 0, deviceTimeoutBefore;
 
 	*initClass {
@@ -38,7 +38,7 @@ FrictionStudySession {
 		// What events.csv and session.csv may hold (log refuses anything else: a misspelt event
 		// would be lost on the report): the same names as kfstudy.session_folder's.
 		conditionEvents = #[prepare, recordDevice, recordAudio, experiment, observer, continue, start, pause, resume,
-			trial, done, maxTime, repeat, abort, lost, coverage, estimate, answer, end];
+			trial, done, maxTime, repeat, abort, lost, coverage, coverageMap, estimate, answer, end];
 		sessionEvents = #[start, resume, finish, abort, error];
 		trialsHeader = #[participant, position, condition, attempt, trial, level, target, answer, correct, startS,
 			interval1S, interval2S, answerS, wallTime];
@@ -232,7 +232,7 @@ FrictionStudySession {
 		this.prRecordAudio;
 		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: s[\friction], audio: s[\audio]);
 		// 50 frames a second; the cells between two frames are covered too (FrictionStudyCoverage).
-		lastPositionMm = nil;
+		recentFrames = [];
 		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m, resumed| this.prFrame(m, resumed) });
 		participantWindow !? { participantWindow.showInstruction(condition.instruction) };
 		experimenterWindow !? { experimenterWindow.showCondition };
@@ -248,7 +248,12 @@ FrictionStudySession {
 		};
 		state = \stopping;
 		this.log(ending, endedBy ? "");
+		// The frames the server sent before the end and sclang has not yet taken (a busy machine:
+		// beside two CPU hogs a stretch 0.26 s before the end was missing, four cells) come in
+		// before this sync's answer, so the map logged is the condition's up to its end.
+		server.sync;
 		this.log(\coverage, coverage.fraction.round(0.001));
+		this.log(\coverageMap, coverage.mapString);
 		this.prStopAudio;
 		monitor.free;
 		listenSynth.free;
@@ -313,15 +318,30 @@ FrictionStudySession {
 
 	prFrame { |m, resumed|
 		var area = condition.areaMm;
-		if(resumed == true) { lastPositionMm = nil };
-		coverage.add(lastPositionMm ? m.positionMm, m.positionMm, m.speedMmPerS);
-		lastPositionMm = m.positionMm;
+		if(resumed == true) { recentFrames = [] };
+		this.prCover(m.timeS, m.positionMm);
 		if(m.positionMm >= area[0] and: { m.positionMm < area[1] }) {
 			stats[\speedSum] = stats[\speedSum] + m.speedMmPerS.abs;
 			stats[\speedCount] = stats[\speedCount] + 1;
 		};
 		m.commandedForceN !? { |f| stats[\maxForceN] = max(stats[\maxForceN], f) };
 		experimenterWindow !? { experimenterWindow.frame };
+	}
+
+	// The coverage map as the report computes it from the recording (python/kfstudy/session_folder.py,
+	// track and coverage): the speed over two frames (40 ms, as over the report's SPEED_REPORTS of
+	// 8 ms) at the middle of its two ends, the columns between two such positions covered at it.
+	// The frame's own speed (one mouse report's) is not used: it jumps with the counts and at
+	// reversals.
+	prCover { |timeS, positionMm|
+		var first, middleMm, speedMmPerS;
+		recentFrames = recentFrames.add([timeS, positionMm]).keep(-3);
+		if(recentFrames.size < 3) { lastMiddleMm = nil; ^this };
+		first = recentFrames[0];
+		middleMm = (first[1] + positionMm) / 2;
+		speedMmPerS = (positionMm - first[1]) / max(timeS - first[0], 1e-6);
+		coverage.add(lastMiddleMm ? middleMm, middleMm, speedMmPerS);
+		lastMiddleMm = middleMm;
 	}
 
 	prStats {

@@ -194,6 +194,10 @@ FrictionView {
 	// Cmd-. also drops what was deferred or forked: a pending refresh or buffer fetch.
 	cmdPeriod { fetching = false; refreshPending = false }
 
+	// Force frames per second the device plays (1000, the paper's; 8000 on a 2.1 board), nil for
+	// a slot index (its device unknown here).
+	forceRateHz { ^if(device.isKindOf(FrictionDevice)) { (1 / device.specs[\forceFramePeriodS]).round(1e-6) } }
+
 	printOn { |stream| stream << this.class.name << "(" << (pilot ? device) << ")" }
 
 	// ---- private ----

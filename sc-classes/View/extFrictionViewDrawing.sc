@@ -25,7 +25,7 @@
 			surfaceRect: lay[\surface], speedRect: lay[\speed], forceRect: lay[\force],
 			forceRangeN: forceRangeN.copy);
 		Pen.smoothing = false;
-		this.prDrawHeader(lay[\header], font);
+		drawn[\header] = this.prDrawHeader(lay[\header], font);
 		this.prDrawSurface(lay[\surface], small);
 		this.prDrawStrip(lay[\speed], small, \speed, rows);
 		this.prDrawStrip(lay[\force], small, \force, rows);
@@ -37,10 +37,16 @@
 			this.prFormat(this.speedMmPerS, 1));
 		if(forceN.notNil) { text = text ++ "   force % N requested".format(this.prFormat(forceN, 3)) };
 		if(commandedForceN.notNil) { text = text ++ ", % N commanded".format(this.prFormat(commandedForceN, 3)) };
+		// The rate the device plays force at: the force's part above half of it never reaches the puck.
+		this.forceRateHz !? { |hz|
+			text = text ++ if(forceN.notNil) { " at" } { "   force at" };
+			text = text ++ " % kHz".format(this.prFormat(hz / 1000, if(hz % 1000 == 0) { 0 } { 3 }))
+		};
 		if(pilot.notNil and: { monitor.running.not }) { text = text ++ "   (the pilot is not playing)" };
 		text = text ++ "   % samples/mm, origin % mm".format(this.prFormat(spm, if(spm.frac == 0) { 0 } { 3 }),
 			this.prFormat(this.origin, 2));
 		Pen.stringInRect(text, r, font, Color.black, \left);
+		^text
 	}
 
 	prDrawSurface { |r, font|

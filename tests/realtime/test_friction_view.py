@@ -303,6 +303,7 @@ t0 = Main.elapsedTime;
 while { v.frameCount < 45 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
 "KF-BEFORE % % % % % %".format(v.frameCount, v.forceN, v.commandedForceN, v.signalFrames, v.timeS, v.fragmentMm).postln;
 v.history.do { |row| "KF-ROW % %".format(row[1], row[2]).postln };
+"KF-HEADER %".format(v.drawn !? { |d| d[\header] }).postln;
 ~kfPostStatus.(dev, "KF-STATUS");  // its watchdog trips so far
 // A second view on the user's position bus (audio rate): it shows the user's position.
 w2 = Window().front;
@@ -354,6 +355,13 @@ s.sync;
 "KF-QUERIES % % %".format(info.size, info.includes(queried), v.isFree).postln;
 "KF-WINDOWS %".format(Window.allWindows.size).postln;
 dev.close; buf.free; bus.free; posBus.free;
+// A device that plays force at 8 kHz (a 2.1 board's rate): the view says so.
+dev = FrictionDevice.sim(s, 3, FrictionHand.path([[0, 0], [1, 5]]), (forceFramePeriodS: 0.000125));
+v = FrictionView(dev);
+t0 = Main.elapsedTime;
+while { v.drawn.isNil and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
+"KF-RATE % %".format(v.forceRateHz, v.drawn !? { |d| d[\header] }).postln;
+v.close; dev.close;
 """
 
 
@@ -405,3 +413,8 @@ def test_any_device_and_player_cmd_period_and_close(jack):
     # The monitor answered /n_query before close and not after; the window is gone.
     assert run.lines("KF-QUERIES ")[0] == ["1", "true", "true"]
     assert run.lines("KF-WINDOWS ")[0] == ["0"]
+    # The header says the rate the device plays force at: the paper's 1 kHz, a 2.1 board's 8 kHz.
+    header = " ".join(run.lines("KF-HEADER ")[0])
+    assert "N requested, " in header and "N commanded at 1 kHz " in header, header
+    rate = run.lines("KF-RATE ")[0]
+    assert float(rate[0]) == 8000 and "force at 8 kHz " in " ".join(rate[1:]), rate

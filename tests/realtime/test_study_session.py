@@ -246,7 +246,7 @@ def test_done_from_a_puck_button_and_the_experimenters_abort(jack):
     assert [(r["event"], r["detail"]) for r in log] == [("start", ""), ("abort", "second")], log
     assert events_of(session / "01-first")[-1] == "end"
     second = events_of(session / "02-second")
-    assert second[second.index("start"):] == ["start", "abort", "coverage"], second
+    assert second[second.index("start"):] == ["start", "abort", "coverage", "coverageMap"], second
     assert [(r["condition"], r["question"]) for r in read_csv(session / "answers.csv")] == [("first", "say")]
     # The aborted condition's recordings are kept: the device's (0.5 s and more of reports at
     # 125 Hz: 62, less a margin), the audio as long as the condition ran (0.5 s and more of the

@@ -155,10 +155,11 @@ def test_the_windows_driven_as_people_would(jack, display):
         ("say", 'sticky, like "syrup"', "participant"), ("hold", "4", "participant"),
         ("which", "touch", "participant")]
     first = [e["event"] for e in read_csv(folder / "01-explore" / "events.csv")]
-    assert first == ["prepare", "recordDevice", "recordAudio", "start", "pause", "resume", "repeat", "coverage"], first
+    assert first == ["prepare", "recordDevice", "recordAudio", "start", "pause", "resume", "repeat", "coverage",
+                     "coverageMap"], first
     events = [(e["event"], e["detail"]) for e in read_csv(folder / "01-explore-attempt2" / "events.csv")]
-    assert [e for e, _ in events] == ["prepare", "recordDevice", "recordAudio", "start", "done", "coverage", "answer",
-                                      "answer", "answer", "end"], events
+    assert [e for e, _ in events] == ["prepare", "recordDevice", "recordAudio", "start", "done", "coverage",
+                                      "coverageMap", "answer", "answer", "answer", "end"], events
     assert ("done", "key") in events and all(a["attempt"] == "2" for a in answers)
 
     # The experimenter hears the participant: its pair carries the same audio as heard, over both

@@ -3,6 +3,8 @@ conditionEvents and sessionEvents (its log refuses any other name) are kfstudy.s
 CONDITION_EVENTS and SESSION_EVENTS, and every name the Python side looks up is one of them."""
 import re
 
+import numpy as np
+
 from kfharness import paths, sclang
 from kfstudy import session_folder
 
@@ -34,3 +36,22 @@ def test_every_event_named_in_the_code_is_in_the_vocabulary():
     assert logged <= set(session_folder.CONDITION_EVENTS), logged - set(session_folder.CONDITION_EVENTS)
     assert session <= set(session_folder.SESSION_EVENTS), session - set(session_folder.SESSION_EVENTS)
     assert looked_up <= set(session_folder.CONDITION_EVENTS), looked_up - set(session_folder.CONDITION_EVENTS)
+
+
+def test_the_coverage_map_logged_reads_back_as_the_cells_covered():
+    # FrictionStudyCoverage.mapString, the coverageMap event's detail, read by Condition.live_cells.
+    out = sclang.run_script(r"""
+var c = FrictionStudyCoverage([0, 6], 5, 300, 10, 6, 0.5);
+c.add(0, 2.9, 20); c.add(4.5, 6, 250); c.add(7, 9, 20);
+"KF-MAP %".format(c.mapString).postln;
+c.cells.do { |row, p| row.do { |covered, v| if(covered) { "KF-CELL % %".format(p, v).postln } } };
+""", name="coverage-map")
+    detail = next(line.split()[1] for line in out.splitlines() if line.startswith("KF-MAP"))
+    covered = {tuple(map(int, line.split()[1:])) for line in out.splitlines() if line.startswith("KF-CELL")}
+    # 20 mm/s is the third speed part of six from 5 to 300 mm/s (log), 250 mm/s the sixth; the
+    # columns are 0.6 mm: 0..2.9 mm covers 0..4, 4.5..6 mm 7..9, 7..9 mm none (outside the area).
+    assert covered == {(p, 2) for p in range(5)} | {(p, 5) for p in range(7, 10)}, out[-2000:]
+    condition = session_folder.Condition(1, "c", paths.REPO_DIR, {}, (0, 6),
+                                         events=[{"timeS": "1", "event": "coverageMap", "detail": detail}])
+    cells = condition.live_cells()
+    assert cells.shape == (10, 6) and {tuple(i) for i in np.argwhere(cells)} == covered
