@@ -44,6 +44,11 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                the file (in Platform.defaultTempDir unless absolute) is written
                                during the run; a WAV file has n channels and lasts d s (both
                                optional)
+  // sound on the outputs      the speakers (outputs 0 and 1) get sound from this piece on,
+                               until the block's end
+  // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
+                               time (until the next piece; the last one's until the block's end)
+                               (a line holding only a comment goes with the next piece)
 
 Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
 A block's output is what is posted from its start to the end of its file: an NRT render or a
@@ -93,7 +98,7 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
-var runPiece, pieceStack;
+var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -108,18 +113,24 @@ piecesOf = { |code|
 		if(comment.notNil) { trimmed = trimmed.keep(comment).stripWhiteSpace };
 		trimmed
 	};
+	// A line holding only a comment says what the piece after it does: it goes with that piece
+	// (with the last one at the block's end).
+	var pending = "", add = { |piece| pieces.add(pending ++ piece); pending = "" };
 	while { i < lines.size } {
 		var line = lines[i], j;
 		if(headOf.(line) == "(") {
 			j = i + 1;
 			while { j < lines.size and: { lines[j].beginsWith(")").not } } { j = j + 1 };
-			pieces.add(lines.copyRange(i, j.min(lines.size - 1)).join($\n));
+			add.(lines.copyRange(i, j.min(lines.size - 1)).join($\n));
 			i = j + 1;
 		} {
-			if(headOf.(line).notEmpty) { pieces.add(line) };
+			case
+			{ headOf.(line).notEmpty } { add.(line) }
+			{ line.find("//").notNil } { pending = pending ++ line ++ "\n" };
 			i = i + 1;
 		};
 	};
+	if(pending.notEmpty) { if(pieces.isEmpty) { pieces.add(pending) } { pieces[pieces.size - 1] = pieces.last ++ "\n" ++ pending } };
 	if(pieces.any { |p| p.compile.isNil }) {
 		"KF-HELP-NOTE a piece does not compile alone; the block runs as a whole".postln;
 		pieces = [code];
@@ -222,7 +233,31 @@ nodesBesidesDefault = {
 	s.sendMsg('/g_queryTree', 0, 0);
 	s.sync;
 	reply.free;
-	nodes.reject { |n| n[0] == 0 or: { s.defaultGroups.any { |g| g.nodeID == n[0] } } }
+	nodes.reject { |n| n[0] == 0 or: { n[1] == \kfHelpMeter } or: { s.defaultGroups.any { |g| g.nodeID == n[0] } } }
+};
+
+// What the speakers get (outputs 0 and 1), 20 times a second: what a listener hears (the RMS above
+// 20 Hz over about 25 ms) and the largest sample over about the last 50 ms, a DC included. At the
+// root node's tail, started again after every boot, Cmd-. and freeAll (ServerTree).
+startMeter = {
+	var def = SynthDef(\kfHelpMeter, {
+		var in = In.ar(0, 2), trig = Impulse.kr(20);
+		var heard = A2K.kr(HPF.ar(HPF.ar(in, 20), 20).squared.lag(0.025).sqrt);
+		var peak = A2K.kr(LagUD.ar(in.abs, 0, 0.05));
+		SendReply.kr(trig, '/kfHelpMeter', [heard.reduce(\max), peak.reduce(\max)]);
+	}), synth = Synth.basicNew(\kfHelpMeter, s);
+	s.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(s), [], \addToTail));
+};
+OSCFunc({ |msg| meterLevels.add([Main.elapsedTime, msg[3], msg[4]]) }, '/kfHelpMeter', s.addr).permanent = true;
+ServerTree.add(startMeter, s);
+if(s.serverRunning) { startMeter.() };
+// The levels since a piece started at t: the loudest heard from t + 0.1 s (before, what the piece
+// before played still sounds on the meter: its 25 ms lag is 60 dB), and the largest sample in
+// the last 0.15 s (a sound freed is under -80 dBFS on the meter 70 ms later: a 50 ms release).
+levelsSince = { |t|
+	var now = Main.elapsedTime;
+	[meterLevels.select { |l| l[0] >= (t + 0.1) }.collect(_[1]).maxItem ? 0,
+		meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? 0]
 };
 
 "KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
@@ -240,11 +275,10 @@ files.do { |path, f|
 			if(code.stripWhiteSpace.beginsWith("// needs ")) {
 				"KF-HELP-SKIPPED %% %% (needs hardware)".format(path, b).postln;
 				pieces = [];
-			} {
-				lines.do { |line| line.find("//") !? { |at| ("KF-HELP-COMMENT " ++ line.drop(at + 2)).postln } };
 			};
 			pieces.do { |piece, p|
-				var fn = piece.compile, run;
+				var fn = piece.compile, run, pieceStart = Main.elapsedTime;
+				piece.split($\n).do { |line| line.find("//") !? { |at| "KF-HELP-COMMENT %% %%".format(p, line.drop(at + 2)).postln } };
 				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
 				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%".format(path, b, p).postln } {
 					run = runPiece.(fn);
@@ -258,8 +292,12 @@ files.do { |path, f|
 					};
 				};
 				waitLikeAPerson.(known, path, b, run !? { run[\value] });
+				// The last piece's time runs to the block's end.
+				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
+				"KF-HELP-LEVELS %% %% %% %% %%".format(path, b, p, *levelsSince.(pieceStart)).postln;
+				// (In place: the meter's responder holds this List.)
+				while { meterLevels.notEmpty and: { meterLevels[0][0] < (Main.elapsedTime - 1) } } { meterLevels.removeAt(0) };
 			};
-			if(pieces.notEmpty) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 			"KF-HELP-BLOCK-END %% %%".format(path, b).postln;
 			if(serverAlive.().not) { restart.() } {
 				if(hasDefaultGroup.().not) { "KF-HELP-NO-DEFAULT-GROUP %% %%".format(path, b).postln };
@@ -339,14 +377,23 @@ FAILURES = [
 # In a guide: a synth reading or writing a slot with no device, one its example did not free.
 CLOSED_DEVICE = re.compile(r"no device is open")
 NOTES = [re.compile(p) for p in (r"^WARNING", r"^KF-HELP-NOTE", r"no device is open", r"^kf\w+: ")]
-COMMENT = re.compile(r"^KF-HELP-COMMENT (.*)$")
+COMMENT = re.compile(r"^KF-HELP-COMMENT (\d+) (.*)$")
 # What a comment says the example does (the text after "//").
 ANNOTATIONS = [
     ("->", re.compile(r"^\s*-> (.*?)\s*$")),
     ("posts", re.compile(r'\bposts "(.*)"')),
     ("fails with", re.compile(r'\bfails with "(.*)"')),
     ("writes", re.compile(r"\bwrites (\S+\.\w+(?: \([^)]*\))?)")),
+    ("sound", re.compile(r"\b(sound) on the outputs\b")),
+    ("silence", re.compile(r"\b(silence) on the outputs\b")),
 ]
+# The outputs' levels (KF-HELP-LEVELS, the runner's meter on outputs 0 and 1): "sound on the
+# outputs" is heard (RMS above 20 Hz) above -60 dBFS; "silence on the outputs" is every sample, a
+# DC included, under -80 dBFS in the last 0.15 s. The meter read 0 exactly where nothing played;
+# the quietest sound a guide claims (the Patterns guide's grating clicks) measured -43 dBFS, and
+# a sound freed reads under 1e-6 after 0.1 s.
+HEARD_ABOVE = 1e-3
+SILENT_BELOW = 1e-4
 OLD_MARKER = re.compile(r"^\s*(posts|expect error|writes):")
 NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 
@@ -375,9 +422,10 @@ class Example:
 
     def __init__(self, path, block, first_line):
         self.path, self.block, self.first_line = path, block, first_line
-        self.expects = []  # (kind, text)
+        self.expects = []  # (kind, text, piece)
         self.output = []
         self.failures = []  # (piece, what, line)
+        self.levels = {}  # piece: (loudest heard, largest sample at its end), the runner's meter
 
     def __str__(self):
         return f"{self.path} block {self.block} ({self.first_line})"
@@ -468,13 +516,16 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
             where = "piece -"
             continue
         if m := COMMENT.match(line):
-            if OLD_MARKER.match(m[1]):
-                problems.append(f"{current}: a test marker of an earlier version, not read: //{m[1]} "
+            piece, comment = int(m[1]), m[2]
+            if OLD_MARKER.match(comment):
+                problems.append(f"{current}: a test marker of an earlier version, not read: //{comment} "
                                 "(write // posts \"...\", // fails with \"...\", // writes <file>)")
             for kind, annotation in ANNOTATIONS:
-                if found := annotation.search(m[1]):
-                    current.expects.append((kind, found[1]))
+                if found := annotation.search(comment):
+                    current.expects.append((kind, found[1], piece))
             continue
+        if line.startswith("KF-HELP-LEVELS ") and current is not None:
+            current.levels[int(line.split()[-3])] = tuple(float(v) for v in line.split()[-2:])
         if line.startswith("KF-HELP-PIECE "):
             where = "piece " + line.split()[-1]
         if line.startswith("KF-HELP-CLEANED-UP "):
@@ -503,7 +554,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
         problems.append(f"the run {why} while running {current} {where}; log {run.log_path}")
 
     for example in examples:
-        expected_errors = [text for kind, text in example.expects if kind == "fails with"]
+        expected_errors = [text for kind, text, _ in example.expects if kind == "fails with"]
         seen, reported = set(), set()
         for piece, what, line in example.failures:
             shown = [text for text in expected_errors if text in line]
@@ -511,13 +562,24 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
             if not shown and (piece, what) not in reported:  # one line of each kind a piece: no call stacks
                 reported.add((piece, what))
                 problems.append(f"{example} {piece}: {what}: {line}")
-        for kind, text in example.expects:
+        for kind, text, piece in example.expects:
             if kind == "fails with":
                 ok = text in seen
             elif kind == "->":
                 ok = any(map(matcher("-> " + text, whole_line=True), example.output))
             elif kind == "posts":
                 ok = any(map(matcher(text), example.output))
+            elif kind in ("sound", "silence"):
+                # Sound: heard from the piece on, until the block's end (a pilot sounds once its puck
+                # reaches the fragment, after the next line maybe); silence: at the end of the
+                # piece's own time, before the next piece.
+                later = [levels for p, levels in example.levels.items() if p >= piece]
+                heard = max((h for h, _ in later), default=0.0)
+                last_peak = example.levels.get(piece, (0.0, float("inf")))[1]
+                if not (heard > HEARD_ABOVE if kind == "sound" else last_peak < SILENT_BELOW):
+                    problems.append(f"{example} piece {piece}: // {kind} on the outputs: the loudest heard {heard:.2g}, "
+                                    f"the largest sample at its end {last_peak:.2g}")
+                continue
             else:
                 why = check_written(text, temp_dir, since)
                 if why:
@@ -690,6 +752,28 @@ s.reboot;
 ::
 
 code::
+~kfDc = { DC.ar(0.2) ! 2 }.play;  // silence on the outputs (but a DC is no silence)
+::
+
+code::
+// sound on the outputs: a sine instead of the DC
+(~kfDc.free; ~kfSine = { SinOsc.ar(440, 0, 0.1) ! 2 }.play;)
+::
+
+code::
+~kfSine.free;  // silence on the outputs
+::
+
+code::
+1 + 1;  // sound on the outputs (but nothing plays)
+::
+
+code::
+~kfSine = { SinOsc.ar(440, 0, 0.1) ! 2 }.play;  // sound on the outputs
+~kfSine.free;  // sound on the outputs (but the piece before played it)
+::
+
+code::
 (
 fork {
 	~kfDev = FrictionDevice.sim(s, 9, replace: true);
@@ -713,8 +797,11 @@ BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found")
           ("BrokenExamples", 5, "a test marker of an earlier version, not read: // posts: 2"),
           ("BrokenExamples", 6, "left slots on its thread's stack"),
           ("BrokenExamples", 7, "the server has no default group"),
-          ("BrokenGuide", 3, "a slot with no device"), ("BrokenGuide", 3, "a node left running")]
-GOOD = [("BrokenExamples", 4), ("BrokenGuide", 0), ("BrokenGuide", 1), ("BrokenGuide", 2)]
+          ("BrokenGuide", 2, "// silence on the outputs: the loudest heard"),
+          ("BrokenGuide", 5, "piece 0: // sound on the outputs: the loudest heard"),
+          ("BrokenGuide", 6, "piece 1: // sound on the outputs: the loudest heard"),
+          ("BrokenGuide", 8, "a slot with no device"), ("BrokenGuide", 8, "a node left running")]
+GOOD = [("BrokenExamples", 4)] + [("BrokenGuide", b) for b in (0, 1, 3, 4, 7)]
 
 
 def test_broken_examples_are_reported(tmp_path):
@@ -727,10 +814,12 @@ def test_broken_examples_are_reported(tmp_path):
         run, examples, problems, notes = run_examples(help_files, jack, timeout=120)
     print("\n".join(problems))
     assert run.ok and [(Path(e.path).stem, e.block) for e in examples] == \
-        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(4)], run.output[-3000:]
+        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(9)], run.output[-3000:]
     named = {path.stem: path for path in help_files}
     for name, block, what in BROKEN:
         assert any(p.startswith(f"{named[name]} block {block} ") and what in p for p in problems), \
             f"broken block {block} of {name} not reported as '{what}':\n" + "\n".join(problems)
     for name, block in GOOD:
         assert not [p for p in problems if p.startswith(f"{named[name]} block {block} ")], problems
+    # Block 6's first piece sounds as it says: only its second is reported.
+    assert not [p for p in problems if p.startswith(f"{named['BrokenGuide']} block 6 ") and "piece 0" in p], problems
