@@ -44,6 +44,9 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                the file (in Platform.defaultTempDir unless absolute) is written
                                during the run; a WAV file has n channels and lasts d s (both
                                optional)
+  // the force reaches <N> N   device slot 0 commands that force (or more) at some time in the
+                               piece's time (polled 20 times a second, from 0.1 s after it starts)
+  // the force stays at <N> N  ... and only that force, throughout
   // sound on the outputs      the speakers (outputs 0 and 1) get sound from this piece on,
                                until the block's end
   // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
@@ -98,7 +101,7 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
-var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince;
+var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince, pollForce;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -260,6 +263,20 @@ levelsSince = { |t|
 		meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? 0]
 };
 
+// The force slot 0 commands (its status' lastForceN), 20 times a second, while a piece that says
+// what force it commands runs: [readings as [time, N], the polling Routine].
+pollForce = {
+	var forces = List.new, routine = Routine {
+		loop {
+			FrictionDevice.at(s, 0) !? { |d|
+				if(d.isOpen) { d.statusValues { |v| forces.add([Main.elapsedTime, v[\lastForceN]]) } }
+			};
+			0.05.wait
+		}
+	}.play(SystemClock);
+	[forces, routine]
+};
+
 "KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
 pieceStack = runPiece.({ nil })[\stack];
 files.do { |path, f|
@@ -277,7 +294,11 @@ files.do { |path, f|
 				pieces = [];
 			};
 			pieces.do { |piece, p|
-				var fn = piece.compile, run, pieceStart = Main.elapsedTime;
+				var fn = piece.compile, run, pieceStart = Main.elapsedTime, polled;
+				if(piece.find("the force reaches").notNil or: { piece.find("the force stays at").notNil }) {
+					polled = pollForce.();
+					known.add(polled[1]);  // not one of the piece's routines, to wait for
+				};
 				piece.split($\n).do { |line| line.find("//") !? { |at| "KF-HELP-COMMENT %% %%".format(p, line.drop(at + 2)).postln } };
 				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
 				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%".format(path, b, p).postln } {
@@ -295,6 +316,11 @@ files.do { |path, f|
 				// The last piece's time runs to the block's end.
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 				"KF-HELP-LEVELS %% %% %% %% %%".format(path, b, p, *levelsSince.(pieceStart)).postln;
+				polled !? {
+					var forces = polled[0].select { |f| f[0] >= (pieceStart + 0.1) }.collect(_[1]);
+					polled[1].stop;
+					"KF-HELP-FORCE %% %% %% %% %% %%".format(path, b, p, forces.size, forces.minItem, forces.maxItem).postln;
+				};
 				// (In place: the meter's responder holds this List.)
 				while { meterLevels.notEmpty and: { meterLevels[0][0] < (Main.elapsedTime - 1) } } { meterLevels.removeAt(0) };
 			};
@@ -384,6 +410,8 @@ ANNOTATIONS = [
     ("posts", re.compile(r'\bposts "(.*)"')),
     ("fails with", re.compile(r'\bfails with "(.*)"')),
     ("writes", re.compile(r"\bwrites (\S+\.\w+(?: \([^)]*\))?)")),
+    ("force reaches", re.compile(r"\bthe force reaches ([-+]?\d+(?:\.\d+)?) N\b")),
+    ("force stays at", re.compile(r"\bthe force stays at ([-+]?\d+(?:\.\d+)?) N\b")),
     ("sound", re.compile(r"\b(sound) on the outputs\b")),
     ("silence", re.compile(r"\b(silence) on the outputs\b")),
 ]
@@ -426,6 +454,7 @@ class Example:
         self.output = []
         self.failures = []  # (piece, what, line)
         self.levels = {}  # piece: (loudest heard, largest sample at its end), the runner's meter
+        self.forces = {}  # piece: (readings, least, most) of slot 0's commanded force (N)
 
     def __str__(self):
         return f"{self.path} block {self.block} ({self.first_line})"
@@ -526,6 +555,9 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
             continue
         if line.startswith("KF-HELP-LEVELS ") and current is not None:
             current.levels[int(line.split()[-3])] = tuple(float(v) for v in line.split()[-2:])
+        if line.startswith("KF-HELP-FORCE ") and current is not None:
+            count, least, most = line.split()[-3:]
+            current.forces[int(line.split()[-4])] = (int(count), float(least), float(most)) if int(count) else (0, 0, 0)
         if line.startswith("KF-HELP-PIECE "):
             where = "piece " + line.split()[-1]
         if line.startswith("KF-HELP-CLEANED-UP "):
@@ -569,6 +601,17 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                 ok = any(map(matcher("-> " + text, whole_line=True), example.output))
             elif kind == "posts":
                 ok = any(map(matcher(text), example.output))
+            elif kind.startswith("force"):
+                # Slot 0's commanded force over the piece's time (from 0.1 s after it starts), to the
+                # precision the number is written with.
+                count, least, most = example.forces.get(piece, (0, 0, 0))
+                wanted, tolerance = float(text), 0.5 * 10.0 ** -len((text.split(".") + [""])[1])
+                ok = count > 0 and (most >= wanted - tolerance if kind == "force reaches" else
+                                    wanted - tolerance <= least and most <= wanted + tolerance)
+                if not ok:
+                    problems.append(f"{example} piece {piece}: // the {kind} {text} N: slot 0 commanded "
+                                    f"{least:g} to {most:g} N ({count} readings)")
+                continue
             elif kind in ("sound", "silence"):
                 # Sound: heard from the piece on, until the block's end (a pilot sounds once its puck
                 # reaches the fragment, after the next line maybe); silence: at the end of the
@@ -776,6 +819,21 @@ code::
 code::
 (
 fork {
+	~kfForce = FrictionDevice.sim(s, 0, replace: true);
+	s.sync;
+	~kfPush = { FrictionOut.ar(0, DC.ar(0.3)); Silent.ar }.play;
+};
+)
+// the force reaches 0.3 N
+1 + 1;
+// the force stays at 0.5 N (but it is 0.3 N)
+2 + 2;
+(~kfPush.free; ~kfForce.close;)
+::
+
+code::
+(
+fork {
 	~kfDev = FrictionDevice.sim(s, 9, replace: true);
 	~kfReader = { FrictionMouseIn.kr(9)[0]; Silent.ar }.play;
 };
@@ -800,8 +858,9 @@ BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found")
           ("BrokenGuide", 2, "// silence on the outputs: the loudest heard"),
           ("BrokenGuide", 5, "piece 0: // sound on the outputs: the loudest heard"),
           ("BrokenGuide", 6, "piece 1: // sound on the outputs: the loudest heard"),
-          ("BrokenGuide", 8, "a slot with no device"), ("BrokenGuide", 8, "a node left running")]
-GOOD = [("BrokenExamples", 4)] + [("BrokenGuide", b) for b in (0, 1, 3, 4, 7)]
+          ("BrokenGuide", 7, "piece 2: // the force stays at 0.5 N: slot 0 commanded 0.3 to 0.3 N"),
+          ("BrokenGuide", 9, "a slot with no device"), ("BrokenGuide", 9, "a node left running")]
+GOOD = [("BrokenExamples", 4)] + [("BrokenGuide", b) for b in (0, 1, 3, 4, 8)]
 
 
 def test_broken_examples_are_reported(tmp_path):
@@ -814,12 +873,15 @@ def test_broken_examples_are_reported(tmp_path):
         run, examples, problems, notes = run_examples(help_files, jack, timeout=120)
     print("\n".join(problems))
     assert run.ok and [(Path(e.path).stem, e.block) for e in examples] == \
-        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(9)], run.output[-3000:]
+        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(10)], run.output[-3000:]
     named = {path.stem: path for path in help_files}
     for name, block, what in BROKEN:
         assert any(p.startswith(f"{named[name]} block {block} ") and what in p for p in problems), \
             f"broken block {block} of {name} not reported as '{what}':\n" + "\n".join(problems)
     for name, block in GOOD:
         assert not [p for p in problems if p.startswith(f"{named[name]} block {block} ")], problems
-    # Block 6's first piece sounds as it says: only its second is reported.
-    assert not [p for p in problems if p.startswith(f"{named['BrokenGuide']} block 6 ") and "piece 0" in p], problems
+    # Block 6's first piece sounds as it says, block 7's second commands the force it says: only
+    # the piece after each is reported.
+    for block, piece in ((6, 0), (7, 1)):
+        assert not [p for p in problems if p.startswith(f"{named['BrokenGuide']} block {block} ") and
+                    f"piece {piece}" in p], problems
