@@ -47,6 +47,9 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
   // the force reaches <N> N   device slot 0 commands that force (or more) at some time in the
                                piece's time (polled 20 times a second, from 0.1 s after it starts)
   // the force stays at <N> N  ... and only that force, throughout
+  // no jump in the sound      the speakers' sound has no step between two samples in the piece's
+                               time from 0.3 s after it starts (its second difference stays under
+                               3/4 of its first): a claim for a piece with that time, a last one
   // sound on the outputs      the speakers (outputs 0 and 1) get sound from this piece on,
                                until the block's end
   // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
@@ -247,20 +250,29 @@ startMeter = {
 		var in = In.ar(0, 2), trig = Impulse.kr(20);
 		var heard = A2K.kr(HPF.ar(HPF.ar(in, 20), 20).squared.lag(0.025).sqrt);
 		var peak = A2K.kr(LagUD.ar(in.abs, 0, 0.05));
-		SendReply.kr(trig, '/kfHelpMeter', [heard.reduce(\max), peak.reduce(\max)]);
+		// A jump (a step between two samples) makes the second difference as large as the first;
+		// a smooth sound of frequency f keeps it 2 pi f / fs of it. Both held 0.2 s (60 dB).
+		var d1 = in - Delay1.ar(in), d2 = d1 - Delay1.ar(d1);
+		var held1 = A2K.kr(LagUD.ar(d1.abs, 0, 0.2)), held2 = A2K.kr(LagUD.ar(d2.abs, 0, 0.2));
+		var jump = (held2 / held1.max(1e-9)) * (held1 > 1e-4);
+		SendReply.kr(trig, '/kfHelpMeter', [heard.reduce(\max), peak.reduce(\max), jump.reduce(\max)]);
 	}), synth = Synth.basicNew(\kfHelpMeter, s);
 	s.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(s), [], \addToTail));
 };
-OSCFunc({ |msg| meterLevels.add([Main.elapsedTime, msg[3], msg[4]]) }, '/kfHelpMeter', s.addr).permanent = true;
+OSCFunc({ |msg| meterLevels.add([Main.elapsedTime, msg[3], msg[4], msg[5]]) }, '/kfHelpMeter', s.addr).permanent = true;
 ServerTree.add(startMeter, s);
 if(s.serverRunning) { startMeter.() };
 // The levels since a piece started at t: the loudest heard from t + 0.1 s (before, what the piece
-// before played still sounds on the meter: its 25 ms lag is 60 dB), and the largest sample in
-// the last 0.15 s (a sound freed is under -80 dBFS on the meter 70 ms later: a 50 ms release).
+// before played still sounds on the meter: its 25 ms lag is 60 dB), the largest sample in the
+// last 0.15 s (a sound freed is under -80 dBFS on the meter 70 ms later: a 50 ms release), and
+// the largest jump from t + 0.3 s.
 levelsSince = { |t|
 	var now = Main.elapsedTime;
-	[meterLevels.select { |l| l[0] >= (t + 0.1) }.collect(_[1]).maxItem ? 0,
-		meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? 0]
+	var after = meterLevels.select { |l| l[0] >= (t + 0.1) };
+	[after.collect(_[1]).maxItem ? 0, meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? 0,
+		// A sound the piece starts (or stops) makes a step: held 0.2 s, it is 45 dB down at 0.3 s.
+		// -1: no reading that late (a piece followed by another 0.3 s later).
+		meterLevels.select { |l| l[0] >= (t + 0.3) }.collect(_[3]).maxItem ? -1]
 };
 
 // The force slot 0 commands (its status' lastForceN), 20 times a second, while a piece that says
@@ -315,7 +327,7 @@ files.do { |path, f|
 				waitLikeAPerson.(known, path, b, run !? { run[\value] });
 				// The last piece's time runs to the block's end.
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
-				"KF-HELP-LEVELS %% %% %% %% %%".format(path, b, p, *levelsSince.(pieceStart)).postln;
+				"KF-HELP-LEVELS %% %% %% %% %% %%".format(path, b, p, *levelsSince.(pieceStart)).postln;
 				polled !? {
 					var forces = polled[0].select { |f| f[0] >= (pieceStart + 0.1) }.collect(_[1]);
 					polled[1].stop;
@@ -412,6 +424,7 @@ ANNOTATIONS = [
     ("writes", re.compile(r"\bwrites (\S+\.\w+(?: \([^)]*\))?)")),
     ("force reaches", re.compile(r"\bthe force reaches ([-+]?\d+(?:\.\d+)?) N\b")),
     ("force stays at", re.compile(r"\bthe force stays at ([-+]?\d+(?:\.\d+)?) N\b")),
+    ("no jump", re.compile(r"\b(no jump) in the sound\b")),
     ("sound", re.compile(r"\b(sound) on the outputs\b")),
     ("silence", re.compile(r"\b(silence) on the outputs\b")),
 ]
@@ -422,6 +435,12 @@ ANNOTATIONS = [
 # a sound freed reads under 1e-6 after 0.1 s.
 HEARD_ABOVE = 1e-3
 SILENT_BELOW = 1e-4
+# "no jump in the sound": a step between two samples larger than a sample's change makes the
+# second difference about as large as the first (the broken example's pulse: 0.93); a smooth sound
+# of frequency f keeps it at 2 pi f / fs (a 300 Hz sine: 0.039 measured, 0.039 in theory), a kink
+# where the rate at which a sound is read doubles or halves (a zoom about the puck) at 0.5. Only
+# for sounds without much above a few kHz (0.75 is 5.7 kHz at 48 kHz).
+JUMP_BELOW = 0.75
 OLD_MARKER = re.compile(r"^\s*(posts|expect error|writes):")
 NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 
@@ -554,7 +573,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                     current.expects.append((kind, found[1], piece))
             continue
         if line.startswith("KF-HELP-LEVELS ") and current is not None:
-            current.levels[int(line.split()[-3])] = tuple(float(v) for v in line.split()[-2:])
+            current.levels[int(line.split()[-4])] = tuple(float(v) for v in line.split()[-3:])
         if line.startswith("KF-HELP-FORCE ") and current is not None:
             count, least, most = line.split()[-3:]
             current.forces[int(line.split()[-4])] = (int(count), float(least), float(most)) if int(count) else (0, 0, 0)
@@ -612,13 +631,21 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                     problems.append(f"{example} piece {piece}: // the {kind} {text} N: slot 0 commanded "
                                     f"{least:g} to {most:g} N ({count} readings)")
                 continue
+            elif kind == "no jump":
+                # The largest second difference against the first over the piece's time, the
+                # block's end for the last piece: under JUMP_BELOW, and a sound to judge.
+                heard, _, jump = example.levels.get(piece, (0.0, 0.0, -1.0))
+                if not (heard > HEARD_ABOVE and 0 <= jump < JUMP_BELOW):
+                    problems.append(f"{example} piece {piece}: // no jump in the sound: its second difference "
+                                    f"reached {jump:.2g} of its first (a jump: about 1), heard {heard:.2g}")
+                continue
             elif kind in ("sound", "silence"):
                 # Sound: heard from the piece on, until the block's end (a pilot sounds once its puck
                 # reaches the fragment, after the next line maybe); silence: at the end of the
                 # piece's own time, before the next piece.
                 later = [levels for p, levels in example.levels.items() if p >= piece]
-                heard = max((h for h, _ in later), default=0.0)
-                last_peak = example.levels.get(piece, (0.0, float("inf")))[1]
+                heard = max((h for h, _, _ in later), default=0.0)
+                last_peak = example.levels.get(piece, (0.0, float("inf"), 0.0))[1]
                 if not (heard > HEARD_ABOVE if kind == "sound" else last_peak < SILENT_BELOW):
                     problems.append(f"{example} piece {piece}: // {kind} on the outputs: the loudest heard {heard:.2g}, "
                                     f"the largest sample at its end {last_peak:.2g}")
@@ -817,6 +844,18 @@ code::
 ::
 
 code::
+~kfSmooth = { SinOsc.ar(300, 0, 0.1) ! 2 }.play;  // no jump in the sound
+::
+
+code::
+(~kfSmooth.free; ~kfJumpy = { (SinOsc.ar(300) + LFPulse.ar(4)) * 0.1 ! 2 }.play;)  // no jump in the sound (but a pulse)
+::
+
+code::
+~kfJumpy.free;
+::
+
+code::
 (
 fork {
 	~kfForce = FrictionDevice.sim(s, 0, replace: true);
@@ -858,9 +897,10 @@ BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found")
           ("BrokenGuide", 2, "// silence on the outputs: the loudest heard"),
           ("BrokenGuide", 5, "piece 0: // sound on the outputs: the loudest heard"),
           ("BrokenGuide", 6, "piece 1: // sound on the outputs: the loudest heard"),
-          ("BrokenGuide", 7, "piece 2: // the force stays at 0.5 N: slot 0 commanded 0.3 to 0.3 N"),
-          ("BrokenGuide", 9, "a slot with no device"), ("BrokenGuide", 9, "a node left running")]
-GOOD = [("BrokenExamples", 4)] + [("BrokenGuide", b) for b in (0, 1, 3, 4, 8)]
+          ("BrokenGuide", 8, "piece 0: // no jump in the sound: its second difference"),
+          ("BrokenGuide", 10, "piece 2: // the force stays at 0.5 N: slot 0 commanded 0.3 to 0.3 N"),
+          ("BrokenGuide", 12, "a slot with no device"), ("BrokenGuide", 12, "a node left running")]
+GOOD = [("BrokenExamples", 4)] + [("BrokenGuide", b) for b in (0, 1, 3, 4, 7, 9, 11)]
 
 
 def test_broken_examples_are_reported(tmp_path):
@@ -873,15 +913,15 @@ def test_broken_examples_are_reported(tmp_path):
         run, examples, problems, notes = run_examples(help_files, jack, timeout=120)
     print("\n".join(problems))
     assert run.ok and [(Path(e.path).stem, e.block) for e in examples] == \
-        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(10)], run.output[-3000:]
+        [("BrokenExamples", b) for b in range(8)] + [("BrokenGuide", b) for b in range(13)], run.output[-3000:]
     named = {path.stem: path for path in help_files}
     for name, block, what in BROKEN:
         assert any(p.startswith(f"{named[name]} block {block} ") and what in p for p in problems), \
             f"broken block {block} of {name} not reported as '{what}':\n" + "\n".join(problems)
     for name, block in GOOD:
         assert not [p for p in problems if p.startswith(f"{named[name]} block {block} ")], problems
-    # Block 6's first piece sounds as it says, block 7's second commands the force it says: only
+    # Block 6's first piece sounds as it says, block 10's second commands the force it says: only
     # the piece after each is reported.
-    for block, piece in ((6, 0), (7, 1)):
+    for block, piece in ((6, 0), (10, 1)):
         assert not [p for p in problems if p.startswith(f"{named['BrokenGuide']} block {block} ") and
                     f"piece {piece}" in p], problems
