@@ -48,10 +48,11 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                piece's time (polled 20 times a second, from 0.1 s after it starts)
   // the force stays at <N> N  ... and only that force, throughout
   // no jump in the sound      the speakers' sound has no step between two samples in the piece's
-                               time from 0.3 s after it starts (its second difference stays under
-                               3/4 of its first): a claim for a piece with that time, a last one
-  // sound on the outputs      the speakers (outputs 0 and 1) get sound from this piece on,
-                               until the block's end
+                               time from 0.5 s after it starts (its second difference stays under
+                               3/4 of its first): a claim for a block's last piece, whose time runs
+                               to the block's end
+  // sound on the outputs      the speakers (outputs 0 and 1) are heard at some time from this
+                               piece on, until the block's end
   // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
                                time (until the next piece; the last one's until the block's end)
                                (a line holding only a comment goes with the next piece)
@@ -254,7 +255,7 @@ startMeter = {
 		// a smooth sound of frequency f keeps it 2 pi f / fs of it. Both held 0.2 s (60 dB).
 		var d1 = in - Delay1.ar(in), d2 = d1 - Delay1.ar(d1);
 		var held1 = A2K.kr(LagUD.ar(d1.abs, 0, 0.2)), held2 = A2K.kr(LagUD.ar(d2.abs, 0, 0.2));
-		var jump = (held2 / held1.max(1e-9)) * (held1 > 1e-4);
+		var jump = (held2 / held1.max(1e-12)) * (held1 > 1e-7);
 		SendReply.kr(trig, '/kfHelpMeter', [heard.reduce(\max), peak.reduce(\max), jump.reduce(\max)]);
 	}), synth = Synth.basicNew(\kfHelpMeter, s);
 	s.sendMsg('/d_recv', def.asBytes, synth.newMsg(RootNode(s), [], \addToTail));
@@ -262,17 +263,18 @@ startMeter = {
 OSCFunc({ |msg| meterLevels.add([Main.elapsedTime, msg[3], msg[4], msg[5]]) }, '/kfHelpMeter', s.addr).permanent = true;
 ServerTree.add(startMeter, s);
 if(s.serverRunning) { startMeter.() };
-// The levels since a piece started at t: the loudest heard from t + 0.1 s (before, what the piece
-// before played still sounds on the meter: its 25 ms lag is 60 dB), the largest sample in the
-// last 0.15 s (a sound freed is under -80 dBFS on the meter 70 ms later: a 50 ms release), and
-// the largest jump from t + 0.3 s.
+// The levels since a piece started at t (the readings sent before it are in: s.sync at its
+// start): the loudest heard from t + 0.1 s (before, what the piece before played still sounds on
+// the meter: its 25 ms lag is 60 dB), the largest sample in the last 0.15 s (a sound freed is
+// under -80 dBFS on the meter 70 ms later: a 50 ms release), and the largest jump from t + 0.5 s.
+// A sound the piece starts or stops is a step (a pattern's first note s.latency, 0.2 s, after
+// it), held in both differences until it falls under the sound's own first difference: a 0.1
+// step over a 0.0016 one (the LiveCoding guide's Pmono) in 0.12 s at 60 dB per 0.2 s. -1: no
+// reading in the time (a peak or a jump with nothing to judge).
 levelsSince = { |t|
-	var now = Main.elapsedTime;
-	var after = meterLevels.select { |l| l[0] >= (t + 0.1) };
-	[after.collect(_[1]).maxItem ? 0, meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? 0,
-		// A sound the piece starts (or stops) makes a step: held 0.2 s, it is 45 dB down at 0.3 s.
-		// -1: no reading that late (a piece followed by another 0.3 s later).
-		meterLevels.select { |l| l[0] >= (t + 0.3) }.collect(_[3]).maxItem ? -1]
+	var now = Main.elapsedTime, after = meterLevels.select { |l| l[0] >= (t + 0.1) };
+	[after.collect(_[1]).maxItem ? 0, meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? -1,
+		meterLevels.select { |l| l[0] >= (t + 0.5) }.collect(_[3]).maxItem ? -1]
 };
 
 // The force slot 0 commands (its status' lastForceN), 20 times a second, while a piece that says
@@ -306,7 +308,10 @@ files.do { |path, f|
 				pieces = [];
 			};
 			pieces.do { |piece, p|
-				var fn = piece.compile, run, pieceStart = Main.elapsedTime, polled;
+				var fn = piece.compile, run, pieceStart, polled;
+				// The meter's readings sent before the piece are in before its time starts.
+				if(s.serverRunning) { s.sync };
+				pieceStart = Main.elapsedTime;
 				if(piece.find("the force reaches").notNil or: { piece.find("the force stays at").notNil }) {
 					polled = pollForce.();
 					known.add(polled[1]);  // not one of the piece's routines, to wait for
@@ -425,7 +430,7 @@ ANNOTATIONS = [
     ("force reaches", re.compile(r"\bthe force reaches ([-+]?\d+(?:\.\d+)?) N\b")),
     ("force stays at", re.compile(r"\bthe force stays at ([-+]?\d+(?:\.\d+)?) N\b")),
     ("no jump", re.compile(r"\b(no jump) in the sound\b")),
-    ("sound", re.compile(r"\b(sound) on the outputs\b")),
+    ("sound", re.compile(r"(?<!\bno )\b(sound) on the outputs\b")),
     ("silence", re.compile(r"\b(silence) on the outputs\b")),
 ]
 # The outputs' levels (KF-HELP-LEVELS, the runner's meter on outputs 0 and 1): "sound on the
@@ -472,7 +477,7 @@ class Example:
         self.expects = []  # (kind, text, piece)
         self.output = []
         self.failures = []  # (piece, what, line)
-        self.levels = {}  # piece: (loudest heard, largest sample at its end), the runner's meter
+        self.levels = {}  # piece: (loudest heard, largest sample at its end, largest jump), the meter's
         self.forces = {}  # piece: (readings, least, most) of slot 0's commanded force (N)
 
     def __str__(self):
@@ -645,8 +650,8 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                 # piece's own time, before the next piece.
                 later = [levels for p, levels in example.levels.items() if p >= piece]
                 heard = max((h for h, _, _ in later), default=0.0)
-                last_peak = example.levels.get(piece, (0.0, float("inf"), 0.0))[1]
-                if not (heard > HEARD_ABOVE if kind == "sound" else last_peak < SILENT_BELOW):
+                last_peak = example.levels.get(piece, (0.0, -1.0, -1.0))[1]  # -1: no reading
+                if not (heard > HEARD_ABOVE if kind == "sound" else 0 <= last_peak < SILENT_BELOW):
                     problems.append(f"{example} piece {piece}: // {kind} on the outputs: the loudest heard {heard:.2g}, "
                                     f"the largest sample at its end {last_peak:.2g}")
                 continue
@@ -852,7 +857,7 @@ code::
 ::
 
 code::
-~kfJumpy.free;
+~kfJumpy.free;  // no sound on the outputs from here (a comment that claims no sound)
 ::
 
 code::
