@@ -19,8 +19,8 @@ from . import session_folder
 
 # conditions.csv's columns, in order.
 CONDITION_COLUMNS = ["participant", "position", "condition", "threshold", "mapping", "friction", "audio", "duration_s",
-                     "ended_by", "coverage_live", "coverage_recording", "coverage_cells_apart", "median_speed_inside", "mean_speed_inside",
-                     "time_inside_s", "attempts", "figure3"]
+                     "ended_by", "coverage_live", "coverage_recording", "coverage_cells_apart", "median_speed_inside",
+                     "mean_speed_inside", "time_inside_s", "attempts", "figure3"]
 SAMPLE_COLUMNS = ["participant", "position", "condition", "mapping", "friction", "t_s", "x_mm", "v_mm_s", "force_n",
                   "inside"]
 # Errors a session's damaged or missing files raise while it is read.

@@ -320,7 +320,7 @@ files.do { |path, f|
 			pieces.do { |piece, p|
 				var fn = piece.compile, run, pieceStart, polled;
 				// The meter's readings sent before the piece are in before its time starts.
-				if(s.serverRunning) { s.sync };
+				if(%(meter)s and: { s.serverRunning }) { s.sync };
 				pieceStart = Main.elapsedTime;
 				if(piece.find("the force reaches").notNil or: { piece.find("the force stays at").notNil }) {
 					polled = pollForce.();
@@ -494,15 +494,20 @@ class Example:
         return f"{self.path} block {self.block} ({self.first_line})"
 
 
+def precision(number):
+    """Half a unit of the last digit a number is written with: "0.56" -> 0.005, "1e-3" -> 0.0005."""
+    decimals = len(number.split(".")[1].split("e")[0].split("E")[0]) if "." in number else 0
+    exponent = int(re.split("[eE]", number)[1]) if re.search("[eE]", number) else 0
+    return 0.5 * 10.0 ** (exponent - decimals)
+
+
 def matcher(text, whole_line=False):
     """A function telling whether a posted line holds `text`, its numbers to the precision written."""
     parts = re.split(f"(?<![\\w.])({NUMBER})(?![\\d.])", text.strip())
     pattern, wanted = "", []
     for i, part in enumerate(parts):
         if i % 2:
-            decimals = len(part.split(".")[1].split("e")[0].split("E")[0]) if "." in part else 0
-            exponent = int(re.split("[eE]", part)[1]) if re.search("[eE]", part) else 0
-            wanted.append((float(part), 0.5 * 10.0 ** (exponent - decimals)))
+            wanted.append((float(part), precision(part)))
             pattern += f"(?<![\\w.])({NUMBER})(?![\\d.])"
         else:
             pattern += r"\s+".join(re.escape(word) for word in part.split(" ")) if part.strip() else re.escape(part)
@@ -641,7 +646,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                 # Slot 0's commanded force over the piece's time (from 0.1 s after it starts), to the
                 # precision the number is written with.
                 count, least, most = example.forces.get(piece, (0, 0, 0))
-                wanted, tolerance = float(text), 0.5 * 10.0 ** -len((text.split(".") + [""])[1])
+                wanted, tolerance = float(text), precision(text)
                 ok = count > 0 and (most >= wanted - tolerance if kind == "force reaches" else
                                     wanted - tolerance <= least and most <= wanted + tolerance)
                 if not ok:
