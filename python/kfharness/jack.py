@@ -71,9 +71,9 @@ class JackServer:
             reclaim(self.name)
         self.proc = None
 
-    def log(self):
+    def log(self, tail_chars=3000):
         try:
-            return self.log_path.read_text(errors="replace")[-3000:]
+            return self.log_path.read_text(errors="replace")[-tail_chars:]
         except OSError:
             return ""
 

@@ -9,6 +9,7 @@ import subprocess
 import time
 
 from . import paths, procs
+from .jack_registry import registered_servers
 
 
 def sc_string(text):
@@ -228,6 +229,12 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             # A server that did not quit (a signal, a crash, killed here) leaves its shared memory
             # behind, 8 MB a server; nothing uses it once the server is gone.
             pathlib.Path(f"/dev/shm/SuperColliderServer_{port}").unlink(missing_ok=True)
+    if "could not initialize audio" in output:
+        # The server's JACK client was refused (seen twice in fresh clones, under the sanitizers,
+        # cause unknown): what JACK itself said is the evidence.
+        said = [line for line in jack.log(100000).splitlines() if "XRun" not in line][-30:]
+        output += f"\nKF-HARNESS: jackd {jack.name}'s log, its xruns left out:\n" + "\n".join(said)
+        output += f"\nJACK's server registry: {registered_servers()}\n"
     if os.environ.get("KF_RT_KEEP_LOGS"):
         print(f"sclang log: {log_path}")
     return SclangRun(output, proc.returncode if proc else None, scsynth_pid, log_path)

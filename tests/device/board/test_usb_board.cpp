@@ -1,6 +1,7 @@
 // The board driver (UsbBoardBackend) against the emulated board (EmulatedUsb: PROTOCOL.md at
 // the transfer level) and the real libusb. Times are the bus clock's; bounds are loose for a
 // loaded machine, the exact ones come from the board emulator's own timeline.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <thread>
@@ -295,10 +296,13 @@ TEST_CASE("a device with the board: frames drive it, the watchdog and close turn
   // watchdog trip, allowed for as test_frame_timing allows for it.
   const double startS = device->nowS();
   int lateFrames = 0;
+  double mostLateS = 0.0;  // a frame's push after its start, as the device's jitter buffer counts it
   for (int i = 0; i < 200; ++i) {
     const double frameS = startS + i * 0.001;
     while (device->nowS() < frameS + 0.001) std::this_thread::sleep_for(100us);
-    if (device->nowS() > frameS + 0.001 + 0.005) ++lateFrames;
+    const double pushS = device->nowS();
+    if (pushS > frameS + 0.001 + 0.005) ++lateFrames;
+    mostLateS = std::max(mostLateS, pushS - frameS);
     device->pushForceFrame({frameS, 1.4f, frameS + 0.001});
   }
   const double lastPushBusS = bus->nowS();
@@ -311,14 +315,19 @@ TEST_CASE("a device with the board: frames drive it, the watchdog and close turn
   const double offS = bus->timeline().back().timeS;
   std::printf(
       "device + board: current off %.2f ms after the last frame was pushed (%s), machine stalled %.2f ms, "
-      "%d late frames\n",
-      (offS - lastPushBusS) * 1e3, timeline.back().why, stalledS * 1e3, lateFrames);
+      "%d late frames, the latest %.2f ms after its start\n",
+      (offS - lastPushBusS) * 1e3, timeline.back().why, stalledS * 1e3, lateFrames, mostLateS * 1e3);
   CHECK(std::string(timeline.back().why) == "set-point");  // a zero set-point, not the board's watchdog
   // The 10 ms watchdog from the last frame's play time, then the pump's and the board thread's
   // 1 ms periods: 13.2-19.4 ms in 53 runs, alone, beside two CPU hogs and beside a test run. 25 ms
   // leaves 5 ms of scheduling slack and stays under the 10 + 20 ms the board's own watchdog would
   // take; a stall holds the chain up by at most its length. A 25 ms device watchdog fails it.
-  CHECK(offS - lastPushBusS < 0.025 + stalledS);
+  // Frames pushed late (this thread held up: 104 of them in a fresh clone's TSan run, the current
+  // off after 105 ms) raise the device's jitter buffer to their lateness, capped at 100 ms
+  // (DeviceOptions::maxForceLatencyS), and the last frame plays that much later than its start:
+  // beyond the 1 ms an on-time push has, that hold is the device's design, not a slow watchdog.
+  const double heldS = std::min(mostLateS, DeviceOptions{}.maxForceLatencyS) - spec.forceFramePeriodS;
+  CHECK(offS - lastPushBusS < 0.025 + stalledS + std::max(heldS, 0.0));
   CHECK(device->telemetry().watchdogTrips >= 1);
   CHECK(device->telemetry().watchdogTrips <= 1 + static_cast<uint64_t>(lateFrames));
   // Close: the board is driven off, disarmed, released when the device lets go of it.
