@@ -1,9 +1,10 @@
 // Texture fidelity against the force rate: a sinusoidal grating (0.14 .. 1.4 N, the paper's
 // range) crossed at constant speed, for periods 0.2 .. 5 mm and speeds 10 .. 400 mm/s (temporal
 // frequencies 2 Hz .. 2 kHz), rendered as the device does at 1 kHz (protocol 2.0: one set-point
-// per 1 ms USB frame) and at 8 kHz (2.1: eight per frame):
+// per 1 ms USB frame) and at 8 kHz (2.1: eight per frame), each frame the mean of its samples, and
+// at 8 kHz also through the anti-alias filter the device uses there (FrameFilter.hpp):
 //
-//   audio force at 48 kHz -> ForceFramer at the rate (the frame's mean) -> drive levels ->
+//   audio force at 48 kHz -> ForceFramer at the rate (mean or filter) -> drive levels ->
 //   one set-point frame per 1 ms (the level just completed at 1 kHz; the eight completed since
 //   the last frame at 8 kHz, as UsbBoardBackend sends them) -> BoardEmulator (the firmware the
 //   gadget runs) -> the coil's target timeline, the force applied.
@@ -11,9 +12,9 @@
 // Per case: the applied force's line at the grating's frequency against the ideal's (gain, in dB
 // and in Weber fractions of 0.11 for a friction change: Gueorguiev et al. 2017), and the largest
 // other line inside the touch band (10 Hz .. 1 kHz: what an alias folds into), relative to it.
-// Per rate: the latency from the audio's step to the applied force's half-way point (mean over
+// Per variant: the latency from the audio's step to the applied force's half-way point (mean over
 // 64 phases of the step against the frames), and the CPU time per second of force of the
-// framing, encoding and firmware (thread CPU, the two rates interleaved in each round).
+// framing, encoding and firmware (thread CPU, the variants interleaved in each round).
 // Prints one JSON object (bench/kfbench/texture_rate.py reads it).
 #include <time.h>
 
@@ -58,11 +59,23 @@ struct Applied {
   std::vector<double> forceN;
 };
 
-// Renders `audio(t)` (N) for durationS at `perFrame` levels per 1 ms frame (1 or 8).
+// A way to render force: levels per 1 ms USB frame (1 or 8), and how the frames are taken.
+struct Variant {
+  const char* name;
+  int perFrame;
+  kf::FrameFilter filter;
+};
+const Variant kVariants[] = {{"1 kHz", 1, kf::FrameFilter::kMean},
+                             {"8 kHz", 8, kf::FrameFilter::kMean},
+                             {"8 kHz, anti-alias filter", 8, kf::FrameFilter::kAntiAlias}};
+constexpr int kNumVariants = sizeof kVariants / sizeof kVariants[0];
+
+// Renders `audio(t)` (N) for durationS as `variant` does.
 template <class Audio>
-std::vector<BoardEmulator::Change> render(Audio audio, double durationS, int perFrame) {
+std::vector<BoardEmulator::Change> render(Audio audio, double durationS, const Variant& variant) {
+  const int perFrame = variant.perFrame;
   const double framePeriodS = kf::board::kFramePeriodS / perFrame;
-  kf::ForceFramer framer(framePeriodS, kMinN, kMaxN);
+  kf::ForceFramer framer(framePeriodS, kMinN, kMaxN, variant.filter);
   BoardEmulator board(0.0);
   uint8_t scratch[kf::board::kClearReplySize];
   int moved = 0;
@@ -156,7 +169,7 @@ std::complex<double> line(const Applied& a, double f, double fromS, double spanS
 
 struct Case {
   double periodMm, speedMmPerS, frequencyHz;
-  double gainDb[2], weber[2], spurDb[2];
+  double gainDb[kNumVariants], weber[kNumVariants], spurDb[kNumVariants];
 };
 
 }  // namespace
@@ -165,18 +178,17 @@ int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 5;
   const double periods[] = {0.2, 0.5, 1.0, 2.0, 5.0};
   const double speeds[] = {10, 25, 50, 100, 200, 400};
-  const int rates[] = {1, 8};
   std::vector<Case> cases;
   for (double p : periods)
     for (double v : speeds) {
       Case c{p, v, v / p, {}, {}, {}};
       // At least 8 cycles and 0.5 s (bins of 2 Hz or finer), after 20 ms of start-up.
       const double spanS = std::max(0.5, 8.0 / c.frequencyHz), fromS = 0.02;
-      for (int r = 0; r < 2; ++r) {
+      for (int r = 0; r < kNumVariants; ++r) {
         const double phase = 0.3;
         auto audio = [&](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * c.frequencyHz * t + phase); };
         const double durationS = fromS + spanS + 0.01;
-        const Applied a = onGrid(render(audio, durationS, rates[r]), durationS, rates[r]);
+        const Applied a = onGrid(render(audio, durationS, kVariants[r]), durationS, kVariants[r].perFrame);
         const double gain = std::abs(line(a, c.frequencyHz, fromS, spanS)) / kAmplitudeN;
         // The largest other line in the touch band, 10 Hz .. 1 kHz, away from the grating's main
         // lobe (+-4 bins of 1 / span; the ideal has no other line), relative to the grating's
@@ -193,17 +205,17 @@ int main(int argc, char** argv) {
       cases.push_back(c);
     }
 
-  // The headline: the highest frequency whose line is within one Weber fraction, per rate, by
-  // bisection (below the rate's Nyquist frequency the gain falls as f rises).
-  double withinWeberHz[2] = {0, 0};
-  for (int r = 0; r < 2; ++r) {
-    double lo = 10, hi = 500.0 * rates[r];
+  // The headline: the highest frequency whose line is within one Weber fraction, per variant, by
+  // bisection (below the rate's Nyquist frequency the gain leaves 1 once, for good, as f rises).
+  double withinWeberHz[kNumVariants] = {};
+  for (int r = 0; r < kNumVariants; ++r) {
+    double lo = 10, hi = 500.0 * kVariants[r].perFrame;
     while (hi - lo > 0.5) {
       const double f = 0.5 * (lo + hi), spanS = std::max(0.5, 8.0 / f), fromS = 0.02;
       const double durationS = fromS + spanS + 0.01;
-      const Applied a = onGrid(
-          render([&](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * f * t + 0.3); }, durationS, rates[r]),
-          durationS, rates[r]);
+      const Applied a = onGrid(render([&](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * f * t + 0.3); },
+                                      durationS, kVariants[r]),
+                               durationS, kVariants[r].perFrame);
       const double gain = std::abs(line(a, f, fromS, spanS)) / kAmplitudeN;
       (std::fabs(gain - 1) <= kWeber ? lo : hi) = f;
     }
@@ -211,13 +223,13 @@ int main(int argc, char** argv) {
   }
 
   // Latency: an audio step from the minimum to the maximum at 64 phases within a frame.
-  double latencyMs[2] = {0, 0};
-  for (int r = 0; r < 2; ++r) {
+  double latencyMs[kNumVariants] = {};
+  for (int r = 0; r < kNumVariants; ++r) {
     const int phases = 64;
     for (int i = 0; i < phases; ++i) {
       const double stepS = 0.05 + i * (kf::board::kFramePeriodS / phases);
-      const Applied a =
-          onGrid(render([&](double t) { return t >= stepS ? kMaxN : kMinN; }, 0.06, rates[r]), 0.06, rates[r]);
+      const Applied a = onGrid(render([&](double t) { return t >= stepS ? kMaxN : kMinN; }, 0.06, kVariants[r]), 0.06,
+                               kVariants[r].perFrame);
       for (size_t k = 0; k < a.forceN.size(); ++k)
         if (a.forceN[k] >= kMeanN) {
           latencyMs[r] += 1e3 * (a.startS + k * a.stepS - stepS) / phases;
@@ -226,33 +238,51 @@ int main(int argc, char** argv) {
     }
   }
 
-  // CPU per second of force: a 100 Hz grating, the two rates interleaved in each round.
-  std::vector<double> cpu[2];
+  // CPU per second of force: a 100 Hz grating, the variants interleaved in each round.
+  std::vector<double> cpu[kNumVariants];
   for (int round = 0; round < rounds; ++round)
-    for (int k = 0; k < 2; ++k) {
-      const int r = (round + k) % 2;
+    for (int k = 0; k < kNumVariants; ++k) {
+      const int r = (round + k) % kNumVariants;
       const double t0 = cpuS();
       const auto timeline =
-          render([](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * 100 * t); }, 1.0, rates[r]);
+          render([](double t) { return kMeanN + kAmplitudeN * std::sin(2 * kPi * 100 * t); }, 1.0, kVariants[r]);
       cpu[r].push_back(cpuS() - t0);
       if (timeline.empty()) return 1;
     }
 
-  std::printf("{\"sampleRateHz\": %g, \"block\": %d, \"rounds\": %d, \"weber\": %g, \"rates\": [1000, 8000],\n",
-              kSampleRate, kBlock, rounds, kWeber);
-  std::printf(" \"withinWeberHz\": [%.1f, %.1f],\n", withinWeberHz[0], withinWeberHz[1]);
-  std::printf(" \"latencyMs\": [%.4f, %.4f],\n \"cpuS\": [[", latencyMs[0], latencyMs[1]);
-  for (int r = 0; r < 2; ++r)
-    for (size_t i = 0; i < cpu[r].size(); ++i)
-      std::printf("%.6f%s", cpu[r][i], i + 1 < cpu[r].size() ? ", " : (r == 0 ? "], [" : "]],\n"));
+  // Prints values as a JSON list, by default one per variant.
+  auto list = [](const double* values, const char* format, size_t count = kNumVariants) {
+    std::printf("[");
+    for (size_t i = 0; i < count; ++i) {
+      std::printf(format, values[i]);
+      std::printf(i + 1 < count ? ", " : "]");
+    }
+  };
+  std::printf("{\"sampleRateHz\": %g, \"block\": %d, \"rounds\": %d, \"weber\": %g,\n \"variants\": [", kSampleRate,
+              kBlock, rounds, kWeber);
+  for (int r = 0; r < kNumVariants; ++r)
+    std::printf("{\"name\": \"%s\", \"rateHz\": %d}%s", kVariants[r].name, 1000 * kVariants[r].perFrame,
+                r + 1 < kNumVariants ? ", " : "],\n");
+  std::printf(" \"withinWeberHz\": ");
+  list(withinWeberHz, "%.1f");
+  std::printf(",\n \"latencyMs\": ");
+  list(latencyMs, "%.4f");
+  std::printf(",\n \"cpuS\": [");
+  for (int r = 0; r < kNumVariants; ++r) {
+    list(cpu[r].data(), "%.6f", cpu[r].size());
+    std::printf(r + 1 < kNumVariants ? ", " : "],\n");
+  }
   std::printf(" \"cases\": [\n");
   for (size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
-    std::printf(
-        "  {\"periodMm\": %g, \"speedMmPerS\": %g, \"frequencyHz\": %g, \"gainDb\": [%.4f, %.4f], \"weber\": [%.4f, "
-        "%.4f], \"spurDb\": [%.2f, %.2f]}%s\n",
-        c.periodMm, c.speedMmPerS, c.frequencyHz, c.gainDb[0], c.gainDb[1], c.weber[0], c.weber[1], c.spurDb[0],
-        c.spurDb[1], i + 1 < cases.size() ? "," : "");
+    std::printf("  {\"periodMm\": %g, \"speedMmPerS\": %g, \"frequencyHz\": %g, \"gainDb\": ", c.periodMm,
+                c.speedMmPerS, c.frequencyHz);
+    list(c.gainDb, "%.4f");
+    std::printf(", \"weber\": ");
+    list(c.weber, "%.4f");
+    std::printf(", \"spurDb\": ");
+    list(c.spurDb, "%.2f");
+    std::printf("}%s\n", i + 1 < cases.size() ? "," : "");
   }
   std::printf(" ]}\n");
   return 0;

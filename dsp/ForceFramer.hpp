@@ -1,19 +1,21 @@
-// ForceFramer: audio-rate force (N) -> one mean force per frame (1 ms by default), the unit in
-// which the paper's system programs friction ("durations down to 1 ms").
+// ForceFramer: audio-rate force (N) -> one force per frame (1 ms by default), the unit in which
+// the paper's system programs friction ("durations down to 1 ms"): the frame's mean, or an
+// anti-alias filter over the last four frames (FrameFilter.hpp says when and what it costs).
 //
-// Frames are aligned on audio time: frame k covers [k * P, (k + 1) * P). Each sample is
-// taken as constant over its own duration [t, t + sampleDur) and weighted by the part of that
-// duration inside the frame, so a frame's value is the exact mean of the held signal even
-// when a frame is not a whole number of samples (44.1 samples at 44.1 kHz). Boundaries are
-// computed from the caller's block start time and k * P in double, never by accumulating P,
-// so nothing drifts over long runs.
+// Frames are aligned on audio time: frame k covers [k * P, (k + 1) * P), and is cut into bins
+// (one for the mean, four quarter frames for the filter). Each sample is taken as constant over
+// its own duration [t, t + sampleDur) and weighted by the part of that duration inside the bin,
+// so a bin's value is the exact mean of the held signal even when a bin is not a whole number of
+// samples (44.1 samples at 44.1 kHz). Boundaries are computed from the caller's block start
+// time and k * P in double, never by accumulating P, so nothing drifts over long runs.
 //
-// NaN/Inf samples count as minForceN (magnet off is the safe value); each frame's mean is
+// NaN/Inf samples count as minForceN (magnet off is the safe value); each frame's value is
 // clamped to [minForceN, maxForceN]. Nothing here allocates.
 #pragma once
 
 #include <cstdint>
 
+#include "FrameFilter.hpp"
 #include "PaperProfile.hpp"
 
 namespace kf {
@@ -24,13 +26,15 @@ class ForceFramer {
   using FrameSink = void (*)(void* context, double frameTimeS, float forceN);
 
   ForceFramer(double framePeriodS = paper::device::forceFramePeriodS, double minForceN = paper::device::minForceN,
-              double maxForceN = paper::device::maxForceN);
+              double maxForceN = paper::device::maxForceN, FrameFilter filter = FrameFilter::kMean);
 
   void setForceRange(double minForceN, double maxForceN);
-  // Forgets the frame in progress and the last commanded value (back to minForceN).
+  // Forgets the frame in progress, the filter's past and the last commanded value (back to
+  // minForceN).
   void reset();
-  // Forgets the frame in progress (its samples are never sent), keeping the last commanded
-  // value and the count of frames; the next block opens the frame of its own first sample.
+  // Forgets the frame in progress (its samples are never sent) and the filter's past, keeping the
+  // last commanded value and the count of frames; the next block opens the frame of its own first
+  // sample, the filter starting as if the force had always been that sample's first bin's mean.
   void dropFrameInProgress();
 
   // One block: sample i starts at blockStartTimeS + i * sampleDurS. commandedN (may be null)
@@ -52,6 +56,7 @@ class ForceFramer {
   void showCommanded(float forceN) { lastCommandedN_ = forceN; }
 
   double framePeriodS() const { return framePeriodS_; }
+  FrameFilter filter() const { return filter_; }
   float lastCommandedN() const { return lastCommandedN_; }
   int64_t framesEmitted() const { return framesEmitted_; }
   int64_t nonFiniteSamples() const { return nonFiniteSamples_; }
@@ -62,21 +67,36 @@ class ForceFramer {
     (*static_cast<Sink*>(context))(frameTimeS, forceN);
   }
 
-  float sanitize(float forceN);
-  // Adds the part [fromSample, toSample) (in samples from the block start) to the frame.
+  // A non-finite sample is the minimum; `count` it in nonFiniteSamples (once per sample).
+  float sanitize(float forceN, bool count = true);
+  // Adds the part [fromSample, toSample) (in samples from the block start) to the bin.
   void accumulate(const float* forceN, double fromSample, double toSample);
-  // Emits the frame in progress if it holds any samples, and moves on to the next one.
+  // Ends the bin in progress and moves on to the next one; at a frame's last bin, emits the frame
+  // if any of its bins held samples. Returns whether it emitted.
+  bool closeBin(FrameSink sink, void* context);
+  // Ends the frame in progress with what it has (its missing bins hold the last bin's mean).
   bool closeFrame(FrameSink sink, void* context);
+  // The frame's value from the bins' means: their mean's last, or the filter over the history.
+  double frameValue() const;
+  bool atFrameEnd() const;
+  void forgetPast();
 
   double framePeriodS_;
   double minForceN_;
   double maxForceN_;
+  FrameFilter filter_;
+  int binsPerFrame_;
 
   bool started_ = false;
   double nextBlockStartS_ = 0.0;
-  int64_t frameIndex_ = 0;
-  double weightedSum_ = 0.0;  // sum of force * (fraction of a sample inside the frame)
+  int64_t binIndex_ = 0;
+  double weightedSum_ = 0.0;  // sum of force * (fraction of a sample inside the bin)
   double weight_ = 0.0;       // in samples
+  bool frameHasSamples_ = false;
+  double lastBinMeanN_ = 0.0;
+  bool historySeeded_ = false;
+  double history_[frame_filter::kTaps] = {};  // the last bins' means, a ring
+  int historyNext_ = 0;                       // where the next bin's mean goes: the oldest
   float lastCommandedN_;
   int64_t framesEmitted_ = 0;
   int64_t nonFiniteSamples_ = 0;

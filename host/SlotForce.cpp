@@ -4,7 +4,8 @@ namespace kf::sc {
 
 void SlotForce::reset(const DeviceSpec& spec) {
   minForceN_ = spec.minForceN;
-  framer_ = ForceFramer(spec.forceFramePeriodS, spec.minForceN, spec.maxForceN);
+  framer_ = ForceFramer(spec.forceFramePeriodS, spec.minForceN, spec.maxForceN,
+                        frame_filter::forPeriod(spec.forceFramePeriodS));
   arrived_ = 0;
   open_ = false;
   framedBlock_ = -1;

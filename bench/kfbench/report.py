@@ -180,9 +180,9 @@ def texture_rate_section(tr, build_dir):
     return render("texture_rate", cmd=CMD, exe=f"{build_dir}/bench/kf_texture_rate_bench", rounds=tr["rounds"],
                   rate_khz=tr["sample_rate_hz"] // 1000, block=tr["block"], weber=tr["weber"],
                   within_1k=tr["within_weber_hz"][0], within_8k=tr["within_weber_hz"][1],
-                  latency_1k=tr["latency_ms"][0], latency_8k=tr["latency_ms"][1], cpu_1k=tr["cpu_ms_per_s"][0],
-                  cpu_8k=tr["cpu_ms_per_s"][1], cpu_ratio=tr["cpu_ratio"], cpu_lo=tr["cpu_ratio_range"][0],
-                  cpu_hi=tr["cpu_ratio_range"][1], fidelity=texture_rate.fidelity_table(tr, table))
+                  within_8k_filter=tr["within_weber_hz"][2], latency_1k=tr["latency_ms"][0],
+                  latency_8k=tr["latency_ms"][1], latency_8k_filter=tr["latency_ms"][2],
+                  variants=texture_rate.variants_table(tr, table), fidelity=texture_rate.fidelity_table(tr, table))
 
 
 def thresholds_section(th):

@@ -1,7 +1,9 @@
 // ForceFramer: exact 1 ms means of the held signal at integer and non-integer samples per
-// frame, NaN/Inf and clamping, the commanded output, and no drift over 10^7 frames.
+// frame, NaN/Inf and clamping, the commanded output, and no drift over 10^7 frames; the
+// anti-alias filter's frames against its design, exactly, and its response, step and edges.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -11,6 +13,8 @@
 #include "ForceFramer.hpp"
 
 using kf::ForceFramer;
+using kf::FrameFilter;
+namespace frame_filter = kf::frame_filter;
 
 namespace {
 
@@ -167,11 +171,12 @@ TEST_CASE("ForceFramer: block sizes 1..1024 give the same frames", "[framer]") {
   std::vector<float> noise(44100 / 4);
   for (float& v : noise) v = uni(rng);
   auto signal = [&](int64_t j) { return noise[static_cast<size_t>(j)]; };
-  ForceFramer reference;
+  const FrameFilter filter = GENERATE(FrameFilter::kMean, FrameFilter::kAntiAlias);
+  ForceFramer reference(0.001, 0.14, 1.4, filter);
   auto expected = runFramer(reference, 44100, noise.size(), 1, signal);
   REQUIRE(expected.size() == 250);  // 11025 samples = 250 frames, the last ends on the last one
   for (int blockSize : {2, 5, 63, 64, 100, 512, 1023, 1024}) {
-    ForceFramer framer;
+    ForceFramer framer(0.001, 0.14, 1.4, filter);
     auto frames = runFramer(framer, 44100, noise.size(), blockSize, signal);
     INFO("block " << blockSize);
     REQUIRE(frames.size() == expected.size());
@@ -183,7 +188,7 @@ TEST_CASE("ForceFramer: block sizes 1..1024 give the same frames", "[framer]") {
     CHECK(worst < 1e-6);
   }
   // Irregular block sizes, as a host with varying buffers would give.
-  ForceFramer framer;
+  ForceFramer framer(0.001, 0.14, 1.4, filter);
   std::vector<Frame> frames;
   Collect sink{&frames};
   std::uniform_int_distribution<int> sizes(1, 1024);
@@ -231,7 +236,8 @@ TEST_CASE("ForceFramer: no drift over 10^7 frames", "[framer][long]") {
 }
 
 TEST_CASE("ForceFramer: a jump in block time closes the frame in progress", "[framer]") {
-  ForceFramer framer;
+  const FrameFilter filter = GENERATE(FrameFilter::kMean, FrameFilter::kAntiAlias);
+  ForceFramer framer(0.001, 0.14, 1.4, filter);
   std::vector<Frame> frames;
   Collect sink{&frames};
   std::vector<float> ones(24, 1.0f);
@@ -286,4 +292,145 @@ TEST_CASE("ForceFramer: its frequency response at 1 and 8 kHz frames is the desi
       }
     }
   }
+}
+
+namespace {
+
+// The anti-alias filter's frame k from the exact means of the held signal over quarter frames,
+// each clamped to the range (FrameFilter.hpp), the bins before the first taken as the first's.
+template <class Signal>
+double referenceFiltered(const Rate& rate, int64_t k, Signal signal, double minN, double maxN) {
+  const Rate bins{rate.hz, rate.num, rate.den * frame_filter::kBinsPerFrame};
+  double sum = 0.0;
+  for (int j = 0; j < frame_filter::kTaps; ++j) {
+    const int64_t bin =
+        std::max<int64_t>(0, k * frame_filter::kBinsPerFrame + frame_filter::kBinsPerFrame - frame_filter::kTaps + j);
+    sum += frame_filter::tap(j) * std::clamp(referenceMean(bins, bin, signal), minN, maxN);
+  }
+  return std::clamp(sum, minN, maxN);
+}
+
+}  // namespace
+
+TEST_CASE("ForceFramer's anti-alias filter: the frames are the design's FIR over exact quarter-frame means",
+          "[framer][antialias]") {
+  // Every rate, 44.1 kHz's 11.025 samples per quarter frame included; a square that every bin
+  // boundary cuts and noise. The taps themselves sum to 1 (a constant keeps its value).
+  double tapSum = 0.0;
+  for (int j = 0; j < frame_filter::kTaps; ++j) tapSum += frame_filter::tap(j);
+  CHECK(tapSum == Approx(1.0).margin(1e-9));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uni(0.0f, 1.6f);
+  std::vector<float> noise(192 * 300);
+  for (float& v : noise) v = uni(rng);
+  for (const Rate& rate : kRates) {
+    auto square = [&](int64_t j) { return (j * rate.den * 3) % rate.num * 2 < rate.num ? 1.2f : 0.2f; };
+    auto random = [&](int64_t j) { return noise[static_cast<size_t>(j)]; };
+    for (int blockSize : {1, 64, 1024}) {
+      INFO("rate " << rate.hz << " block " << blockSize);
+      ForceFramer onSquare(0.001, 0.14, 1.4, FrameFilter::kAntiAlias);
+      ForceFramer onNoise(0.001, 0.14, 1.4, FrameFilter::kAntiAlias);
+      const auto squareFrames = runFramer(onSquare, rate.hz, 200 * rate.num / rate.den, blockSize, square);
+      const auto noiseFrames = runFramer(onNoise, rate.hz, 200 * rate.num / rate.den, blockSize, random);
+      REQUIRE(squareFrames.size() == 200);
+      REQUIRE(noiseFrames.size() == 200);
+      double worst = 0.0;
+      for (size_t k = 0; k < 200; ++k) {
+        CHECK(squareFrames[k].timeS == static_cast<double>(k) * 0.001);
+        worst = std::max(worst, std::fabs(squareFrames[k].forceN - referenceFiltered(rate, k, square, 0.14, 1.4)));
+        worst = std::max(worst, std::fabs(noiseFrames[k].forceN - referenceFiltered(rate, k, random, 0.14, 1.4)));
+      }
+      CHECK(worst < 1e-6);
+    }
+  }
+}
+
+TEST_CASE("ForceFramer's anti-alias filter: its response at 1 and 8 kHz frames, aliases included, is the design's",
+          "[framer][antialias]") {
+  // Quarter frames of L whole samples: a sine of f in gives, at the frame rate, a sine of (signed)
+  // gain  sum_j tap(j) cos(2 pi f (j - 7.5) L / fs) * sin(pi f L / fs) / (L sin(pi f / fs))  centred
+  // 2 frames and half a sample before the frame's end (1.5 frames before the mean's centre). A line
+  // above half the frame rate is seen at its alias, the same fit. Then the design's claims: with the
+  // board's hold within one Weber fraction (0.11) up to 0.3 F, and -30 dB from 0.7 F up.
+  constexpr double kPi = 3.14159265358979323846;
+  const struct {
+    double frameHz;
+    int64_t fs;
+  } cases[] = {{1000, 48000}, {1000, 96000}, {8000, 96000}, {8000, 192000}};
+  for (const auto& c : cases) {
+    const double m = static_cast<double>(c.fs) / c.frameHz, l = m / frame_filter::kBinsPerFrame;
+    for (const double fraction : {0.05, 0.2, 0.3, 0.45, 0.7, 0.75, 0.9, 1.3}) {
+      const double f = fraction * c.frameHz;
+      ForceFramer framer(1.0 / c.frameHz, 0.0, 2.0, FrameFilter::kAntiAlias);
+      auto sine = [&](int64_t j) { return static_cast<float>(1.0 + 0.5 * std::sin(2 * kPi * f * j / c.fs)); };
+      const auto out = runFramer(framer, c.fs, static_cast<int64_t>(4000 * m), 64, sine);
+      REQUIRE(out.size() == 4000);
+      double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0;
+      for (size_t k = 4; k < out.size(); ++k) {  // after the filter's start
+        // the frame's end, less the group delay of 2 frames and the held samples' half sample
+        const double t = out[k].timeS + 1.0 / c.frameHz - 2.0 / c.frameHz - 0.5 / c.fs;
+        const double s = std::sin(2 * kPi * f * t), co = std::cos(2 * kPi * f * t), y = out[k].forceN - 1.0;
+        ss += s * s;
+        sc += s * co;
+        cc += co * co;
+        ys += y * s;
+        yc += y * co;
+      }
+      const double det = ss * cc - sc * sc;
+      const double a = (ys * cc - yc * sc) / det, b = (yc * ss - ys * sc) / det;
+      double design = 0.0;
+      for (int j = 0; j < frame_filter::kTaps; ++j)
+        design += frame_filter::tap(j) * std::cos(2 * kPi * f * (j - 7.5) * l / c.fs);
+      design *= std::sin(kPi * f * l / c.fs) / (l * std::sin(kPi * f / c.fs));
+      INFO("frames at " << c.frameHz << " Hz, fs " << c.fs << ", f " << f << " Hz: gain " << 2 * a << " (phase left "
+                        << 2 * b << "), design " << design);
+      // float frames (2^-24 of 1.5 N) over 4000 of them: far under 1e-5 of the 0.5 N sine.
+      CHECK(2 * a == Approx(design).margin(1e-5));
+      CHECK(2 * b == Approx(0.0).margin(1e-5));
+      const double held = std::fabs(2 * a) * std::sin(kPi * fraction) / (kPi * fraction);
+      if (fraction <= 0.3) CHECK(std::fabs(held - 1.0) < 0.11);
+      if (fraction >= 0.7) CHECK(std::fabs(2 * a) < std::pow(10.0, -30.0 / 20));
+    }
+  }
+}
+
+TEST_CASE("ForceFramer's anti-alias filter: a step rings by 10.3 % at most, settles in 4 frames, stays in range",
+          "[framer][antialias]") {
+  // The taps' running sums (the step response) reach -0.1029 and 1.1029: a step of height h is
+  // undershot, then overshot, by at most 0.103 h, and the 4th frame after it is exact.
+  const int64_t fs = 96000;  // 8 kHz frames of 12 samples, the step on a frame's start
+  for (const float to : {1.0f, 1.4f}) {
+    ForceFramer framer(1.0 / 8000, 0.14, 1.4, FrameFilter::kAntiAlias);
+    const auto out = runFramer(framer, fs, 12 * 60, 64, [&](int64_t j) { return j < 12 * 20 ? 0.3f : to; });
+    REQUIRE(out.size() == 60);
+    const double ring = 0.1030 * (to - 0.3);
+    for (size_t k = 0; k < out.size(); ++k) {
+      INFO("frame " << k << ": " << out[k].forceN);
+      CHECK(out[k].forceN >= 0.3 - ring);
+      CHECK(out[k].forceN <= std::min(to + ring, 1.4));
+      if (k < 20) CHECK(out[k].forceN == Approx(0.3).margin(1e-6));
+      if (k >= 23) CHECK(out[k].forceN == Approx(to).margin(1e-6));
+    }
+    float most = 0.0f;
+    for (const Frame& frame : out) most = std::max(most, frame.forceN);
+    CHECK(most > (to < 1.4f ? to + 0.1 * (to - 0.3) : 1.39));  // it does ring, or meets the limit
+  }
+}
+
+TEST_CASE("ForceFramer's anti-alias filter: NaN and Inf count as the minimum, silence stays at it, no denormals",
+          "[framer][antialias]") {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  ForceFramer framer(1.0 / 8000, 0.14, 1.4, FrameFilter::kAntiAlias);
+  // 10 frames of NaN, 10 of +-Inf, 10 of denormals, 10 of 0: every frame at the minimum, exactly.
+  auto signal = [&](int64_t j) -> float {
+    if (j < 60) return nan;
+    if (j < 120) return j % 2 ? inf : -inf;
+    if (j < 180) return 1e-40f;
+    return 0.0f;
+  };
+  const auto out = runFramer(framer, 48000, 240, 64, signal);
+  REQUIRE(out.size() == 40);
+  for (const Frame& frame : out) CHECK(frame.forceN == 0.14f);
+  CHECK(framer.nonFiniteSamples() == 120);
 }

@@ -58,6 +58,41 @@ def test_force_frames_reach_the_simulated_magnet_and_it_turns_off_at_close(tmp_p
     assert set(np.unique(out_force[SR // 100: SR - 100])) <= square
 
 
+def frame_line(frames, frequency_hz):
+    """The amplitude of the commanded frames' line at frequency_hz (its alias, above half the frame
+    rate), fitted by least squares to the frames after the first 10 ms."""
+    t, force = frames[:, 1], frames[:, 3]
+    keep = t > 0.01
+    basis = np.column_stack([np.sin(2 * np.pi * frequency_hz * t[keep]), np.cos(2 * np.pi * frequency_hz * t[keep]),
+                             np.ones(keep.sum())])
+    (a, b, _), *_ = np.linalg.lstsq(basis, force[keep], rcond=None)
+    return np.hypot(a, b)
+
+
+def test_at_8_khz_the_frames_keep_a_2_khz_texture_and_leave_out_a_6_khz_one(tmp_path=paths.work_dir()):
+    # A device whose force rate is 8 kHz frames FrictionOut through the anti-alias filter
+    # (dsp/FrameFilter.hpp; its response is tested exactly in tests/dsp/test_force_framer.cpp):
+    # here, end to end through the plugin, what the device records, against the design's claims.
+    # A 0.1 N sine about 0.77 N at 2 kHz (0.25 of the frame rate): with the board's hold
+    # (sinc(0.25) = 0.900) within one Weber fraction (0.11) of its height; frame means would give
+    # 0.90 x 0.90 = 0.81 and fail. At 6 kHz (0.75 of the rate, folding to 2 kHz): under -30 dB;
+    # frame means would pass 0.30 (-10 dB). 0.1 N, because the device's slew limit (2000 N/s) holds
+    # a 2 kHz line to 2000 / (2 pi 2000) = 0.16 N: under it the commanded force is the framed one.
+    lines = {}
+    for hz in (2000, 6000):
+        rec = tmp_path / f"frames-8k-{hz}.kfs"
+        render_device(f"frames8k{hz}", "FrictionDevice.describeSim(0, profile: (forceFramePeriodS: 0.000125))", 0.5,
+                      force=f"SinOsc.ar({hz}, 0, 0.1, 0.77)", extra_events=f"[0.0, dev.recordMsg(\"{rec}\")],")
+        frames = readers.Session(rec).frames.astype(np.float64)
+        period = np.median(np.diff(frames[:, 1]))
+        assert abs(period - 0.000125) < 1e-9, f"frames {period * 1e6:.1f} us apart"
+        settled = frames[:, 1] > 0.01  # the slew up from the minimum at the start takes 3 frames
+        np.testing.assert_allclose(frames[settled, 3], frames[settled, 2], atol=1e-6, err_msg="commanded as framed")
+        lines[hz] = frame_line(frames, hz) / 0.1
+    assert abs(lines[2000] * np.sinc(0.25) - 1) < 0.11, lines
+    assert lines[6000] < 10 ** (-30 / 20), lines
+
+
 def test_friction_slows_the_puck_as_the_simulation_says():
     slow, _ = render_device("heavy", "FrictionDevice.describeSim(0, FrictionHand.path([[0, 0], [1, 40]]))", 1.0,
                             force="DC.ar(1.4)")
