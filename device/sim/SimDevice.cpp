@@ -89,7 +89,10 @@ int SimDevice::pollReports(double untilTimeS, MouseReport* out, int capacity) {
 
 void SimDevice::commandForce(double timeS, float forceN) {
   advanceTo(timeS);
-  magnet_.command(forceN);
+  // Where in the step it falls (frames at 8 kHz are 1.25 steps apart); a nanosecond or less is
+  // the step's start, as float rounding puts 1 kHz frames there.
+  const double intoStepS = timeS - this->timeS();
+  magnet_.command(forceN, intoStepS > 1e-9 ? intoStepS : 0.0);
 }
 
 void SimDevice::driveOff() { magnet_.command(spec_.minForceN); }
