@@ -3,7 +3,9 @@
 # build-fuzz/ and runs each for a bounded time on seeds made from the real recordings.
 # Usage: scripts/fuzz.sh [seconds per target, default 20] [target...]
 # Exit status 1 if any target found a crash, leak, timeout or out-of-memory; its input is left
-# in build-fuzz/artifacts/<target>/ (make it a regression test).
+# in build-fuzz/artifacts/<target>/ (make it a regression test). The targets run as many at a
+# time as there are cores, each on one. KF_FUZZ_STEPS=build or run: only that half
+# (scripts/test.sh builds while other tests run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET="${1:-20}"
@@ -16,11 +18,15 @@ TARGETS=("$@")
 source scripts/packages.sh
 kf_install_missing clang libclang-rt-dev
 BUILD=build-fuzz
-echo "== configuring and building the fuzz targets ($BUILD/)"
-CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
-  -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
-rm -f "$BUILD.configure.log"
-nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
+STEPS="${KF_FUZZ_STEPS:-build run}"
+if [[ $STEPS == *build* ]]; then
+  echo "== configuring and building the fuzz targets ($BUILD/)"
+  CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
+    -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
+  rm -f "$BUILD.configure.log"
+  nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
+fi
+[[ $STEPS == *run* ]] || exit 0
 
 SEEDS="$BUILD/seeds"
 rm -rf "$SEEDS"
@@ -31,21 +37,32 @@ declare -A SEED_DIR=([fuzz_hid_descriptor]=hid_descriptor [fuzz_hid_recorder]=hi
                      [fuzz_calibration_table]=calibration_table)
 declare -A MAX_LEN=([fuzz_hid_descriptor]=4096 [fuzz_hid_recorder]=16384
                     [fuzz_session_file]=16384 [fuzz_command_args]=4096 [fuzz_calibration_table]=4096)
-failed=()
-for target in "${TARGETS[@]}"; do
-  corpus="$BUILD/corpus/$target"
-  artifacts="$BUILD/artifacts/$target"
+# fuzz <target>: runs it for SECONDS_PER_TARGET on one core; its log in $BUILD/<target>.log.
+fuzz() {
+  local target=$1 corpus="$BUILD/corpus/$1" artifacts="$BUILD/artifacts/$1"
   mkdir -p "$corpus" "$artifacts"
-  echo "== $target: ${SECONDS_PER_TARGET} s"
   # -rss_limit_mb and -timeout: unbounded memory or work is a finding, not a hang of the run.
-  if ! "$BUILD/tests/fuzz/$target" "$corpus" "$SEEDS/${SEED_DIR[$target]}" \
-      -max_total_time="$SECONDS_PER_TARGET" -max_len="${MAX_LEN[$target]}" -timeout=10 -rss_limit_mb=1024 \
-      -artifact_prefix="$artifacts/" -print_final_stats=1 > "$BUILD/$target.log" 2>&1; then
-    failed+=("$target")
-    tail -40 "$BUILD/$target.log"
-  fi
-  grep -E "^stat::(number_of_executed_units|peak_rss_mb)" "$BUILD/$target.log" | tr -s ' \n' '  '
-  echo
+  "$BUILD/tests/fuzz/$target" "$corpus" "$SEEDS/${SEED_DIR[$target]}" \
+    -max_total_time="$SECONDS_PER_TARGET" -max_len="${MAX_LEN[$target]}" -timeout=10 -rss_limit_mb=1024 \
+    -artifact_prefix="$artifacts/" -print_final_stats=1 > "$BUILD/$target.log" 2>&1
+}
+
+failed=()
+declare -A PID_OF=()
+for ((first = 0; first < ${#TARGETS[@]}; first += $(nproc))); do
+  batch=("${TARGETS[@]:first:$(nproc)}")
+  echo "== ${batch[*]}: ${SECONDS_PER_TARGET} s each, side by side"
+  for target in "${batch[@]}"; do
+    fuzz "$target" &
+    PID_OF[$target]=$!
+  done
+  for target in "${batch[@]}"; do
+    if ! wait "${PID_OF[$target]}"; then
+      failed+=("$target")
+      tail -40 "$BUILD/$target.log"
+    fi
+    echo "$target: $(grep -E "^stat::(number_of_executed_units|peak_rss_mb)" "$BUILD/$target.log" | tr -s ' \n' '  ')"
+  done
 done
 if ((${#failed[@]})); then
   echo "fuzz.sh: findings in ${failed[*]} (inputs in $BUILD/artifacts/)"
