@@ -17,12 +17,8 @@
 #              suites under Wine, and the Clang + libc++ build with the POSIX code macOS takes
 #              (build-libcxx/); both build every default target, as a user's cmake --build
 #              does (the plugin .scx, the bench), and the suites
-#   builds     the builds of sanitize, fuzz and cross alone (scripts/test.sh runs them while the
-#              tests of build/ run, at the lowest priority), then sanitize-run, fuzz-run and
-#              cross-run run what they built
 # Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin|cross|
-#                         sanitize-plugin-build|sanitize-plugin-findings|
-#                         builds|sanitize-run|fuzz-run|cross-run]...
+#                         sanitize-plugin-build|sanitize-plugin-findings]...
 #        (none: all but sclang-lines, which format runs, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -79,17 +75,13 @@ configure_and_build() {
   cmake --build "$dir" -j "$(nproc)" "${build[@]}"
 }
 
-build_sanitize() {
-  echo "== dsp/, device/ and host/ without SuperCollider, under ASan + UBSan (build-asan/)"
+check_sanitize() {
+  echo "== dsp/, device/ and host/ without SuperCollider, C++ tests under ASan + UBSan (build-asan/)"
   # At -O1, as the sanitizers' own documentation builds: it finds what -O3 does (an optimiser may
   # fold undefined behaviour away before UBSan sees it, never the reverse) and compiled host_tests
   # in 153 s against 225 s at -O3 (from nothing, side by side). build/ runs the same tests at -O3.
   configure_and_build build-asan -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined \
     -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -DNDEBUG"
-}
-
-run_sanitize() {
-  echo "== the C++ tests under ASan + UBSan (build-asan/)"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/|host/'
 }
@@ -153,8 +145,8 @@ run_suites() {
   done
 }
 
-build_cross() {
-  echo "== cross: the Windows build (build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
+check_cross() {
+  echo "== cross: Windows build under Wine (build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
   # Every default target: a user's build (the bench included) compiles what the suites do not
   # (bench/log_choice.cpp once stopped a MinGW build on M_PI, unseen while only the suites and the
   # plugin were built here).
@@ -164,11 +156,7 @@ build_cross() {
   configure_and_build build-libcxx -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/clang-libcxx.cmake -DKF_PLATFORM=posix \
     -DKF_SUPERNOVA=OFF
   echo "cross: both built in $((SECONDS - start)) s"
-}
-
-run_cross() {
-  echo "== cross: the Windows suites under Wine, the Clang + libc++ suites"
-  local start=$SECONDS
+  start=$SECONDS
   # One after the other: side by side, the Wine suites' wall-clock bounds were missed on this
   # 2-core machine (a board's current off 18 ms after close, bound 10 ms).
   # Debian's wine64 is not on PATH; as the toolchain file runs it (a prefix of the build's own).
@@ -197,14 +185,6 @@ check_fuzz() {
   scripts/fuzz.sh "${KF_FUZZ_SECONDS:-20}"
 }
 
-# What scripts/test.sh runs beside build/'s tests: every build of sanitize, fuzz and cross, each
-# as it would build alone.
-build_all() {
-  build_sanitize
-  KF_FUZZ_STEPS=build scripts/fuzz.sh
-  build_cross
-}
-
 checks=("$@")
 ((${#checks[@]})) || checks=(format pyflakes sanitize fuzz sanitize-plugin cross)
 for check in "${checks[@]}"; do
@@ -212,19 +192,14 @@ for check in "${checks[@]}"; do
     format) check_format; check_sclang_lines; check_test_names ;;
     sclang-lines) check_sclang_lines ;;
     pyflakes) check_pyflakes ;;
-    sanitize) build_sanitize; run_sanitize ;;
+    sanitize) check_sanitize ;;
     fuzz) check_fuzz ;;
-    builds) build_all ;;
-    sanitize-run) run_sanitize ;;
-    fuzz-run) KF_FUZZ_STEPS=run scripts/fuzz.sh "${KF_FUZZ_SECONDS:-20}" ;;
-    cross-run) run_cross ;;
     sanitize-plugin) check_sanitize_plugin ;;
     sanitize-plugin-build) build_sanitized_plugin ;;
     sanitize-plugin-findings) sanitized_plugin_findings ;;
-    cross) build_cross; run_cross ;;
+    cross) check_cross ;;
     *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin, cross;" \
-         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh;" \
-         "builds, then sanitize-run, fuzz-run and cross-run: the other checks' halves)" >&2
+         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh)" >&2
        exit 2 ;;
   esac
 done

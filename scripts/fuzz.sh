@@ -4,8 +4,7 @@
 # Usage: scripts/fuzz.sh [seconds per target, default 20] [target...]
 # Exit status 1 if any target found a crash, leak, timeout or out-of-memory; its input is left
 # in build-fuzz/artifacts/<target>/ (make it a regression test). The targets run as many at a
-# time as there are cores, each on one. KF_FUZZ_STEPS=build or run: only that half
-# (scripts/test.sh builds while other tests run).
+# time as there are cores, each on one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET="${1:-20}"
@@ -18,15 +17,11 @@ TARGETS=("$@")
 source scripts/packages.sh
 kf_install_missing clang libclang-rt-dev
 BUILD=build-fuzz
-STEPS="${KF_FUZZ_STEPS:-build run}"
-if [[ $STEPS == *build* ]]; then
-  echo "== configuring and building the fuzz targets ($BUILD/)"
-  CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
-    -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
-  rm -f "$BUILD.configure.log"
-  nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
-fi
-[[ $STEPS == *run* ]] || exit 0
+echo "== configuring and building the fuzz targets ($BUILD/)"
+CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
+  -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
+rm -f "$BUILD.configure.log"
+nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
 
 SEEDS="$BUILD/seeds"
 rm -rf "$SEEDS"

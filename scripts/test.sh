@@ -1,14 +1,12 @@
 #!/usr/bin/env bash
 # Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
-# (scripts/check.sh: format, pyflakes, the plugin built with both sanitizers), then in one ctest the
+# (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
+# fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
 # sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
 # (dsp, device, host), the NRT scene tests (scsynth and supernova), the help files, the QEMU guest,
 # and the realtime tests against JACK's dummy driver: one more at a time than there are cores.
-# Meanwhile the other checks' builds (the C++ tests under ASan+UBSan without SuperCollider, the
-# fuzz targets, the cross builds: scripts/check.sh builds) run at the lowest priority the kernel
-# has (SCHED_IDLE: only on a core that nothing else wants, so they take none of the tests' time
-# and soak up what the tests leave while they wait on audio clocks); what they have not finished
-# when ctest ends is finished at normal priority, and then those checks run what they built. The
+# (The other checks' builds were once run beside the ctest under SCHED_IDLE: the help examples
+# took 301 s against 163-203 s alone and failed three claims, so nothing runs beside it.) The
 # realtime tests mostly wait on the audio clock and run one at a time per build
 # (tests/realtime/CMakeLists.txt), so each has beside it at most the other build's and one CPU-bound
 # test (the two hogs they are built to hold); the QEMU guest and the main jobs run alone
@@ -94,16 +92,9 @@ if $quick; then
   stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
-  for check in format pyflakes sanitize-plugin-build; do
+  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross; do
     stage "$check" scripts/check.sh "$check"
   done
-  # The other checks' builds, beside the ctest below, in a process group of their own (killed by
-  # its id) and with their output in a file (shown if they fail when finished at normal priority).
-  idle=(chrt --idle 0)
-  "${idle[@]}" true 2>/dev/null || idle=(nice -n 19)
-  mkdir -p build
-  setsid "${idle[@]}" scripts/check.sh builds > build/idle-builds.log 2>&1 &
-  idle_builds=$!
   # build/'s tests and the sanitized plugin's scene and realtime tests (sanitized/...) in one
   # ctest, so that the two builds' realtime chains run side by side and the CPU-bound tests of
   # either fill the cores beside them: a folder whose CTestTestfile names both.
@@ -111,16 +102,6 @@ else
   printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
     > build/with-sanitized/CTestTestfile.cmake
   stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 1))" "$@"
-  # What the idle builds left is built now, at normal priority (make keeps what they finished).
-  idle_done=yes
-  kill -0 "$idle_builds" 2>/dev/null && idle_done=no
-  kill -TERM -- "-$idle_builds" 2>/dev/null
-  wait "$idle_builds" 2>/dev/null
-  echo "== the idle builds had $([ $idle_done = yes ] && echo finished || echo "not finished: finishing them") (log: build/idle-builds.log)"
-  stage builds scripts/check.sh builds
-  for check in sanitize-run fuzz-run cross-run; do
-    stage "$check" scripts/check.sh "$check"
-  done
   stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
 fi
 summary build/test-stages.txt
