@@ -75,4 +75,6 @@ bool publishDriveIfSameDevice(int index, uint32_t generation, const Device* devi
 
 void haltAllDrives() { gDrivesHalted.store(true, std::memory_order_relaxed); }
 
+bool drivesHalted() { return gDrivesHalted.load(std::memory_order_relaxed); }
+
 }  // namespace kf::sc

@@ -59,5 +59,8 @@ bool publishDriveIfSameDevice(int index, uint32_t generation, const Device* devi
 // process is on its way out; should a host's handler keep it alive, the drives stay at 0).
 // One atomic store: async-signal-safe.
 void haltAllDrives();
+// Whether haltAllDrives was called: a FrictionDrive then outputs 0 without a word (its device has
+// its calibration; the server is quitting).
+bool drivesHalted();
 
 }  // namespace kf::sc

@@ -42,6 +42,11 @@ class FrictionDrive : public SCUnit {
     bool another = false;
     const float* samples = drive->samples(clock, generation, *force, another);
     if (samples == nullptr) {  // another drive of the slot ran first, or no chain: 0, said once each
+      // Halted (a /quit's unload, a signal: the blocks until the driver stops): 0, nothing to say.
+      if (kf::sc::drivesHalted()) {
+        std::fill_n(output, numSamples, 0.0f);
+        return;
+      }
       if (another && mNotes.first(kAnotherDrive))
         kf::sc::postFromRt(mWorld,
                            "FrictionDrive: the device at index %d has one drive, and another FrictionDrive of "
