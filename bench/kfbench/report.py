@@ -7,7 +7,7 @@ import numpy as np
 
 from kfharness import profile
 
-from . import drive_path, goals, patterns, realtime, report_rate, spatial, texture_rate, thresholds, timing
+from . import drive_path, goals, patterns, realtime, report_rate, rtload, spatial, texture_rate, thresholds, timing
 from .common import BLOCK, DEVICE, FORCE_FRAME_MS, GRID_SPEEDS, LOOP_HZ, LOUDNESS_IN_SC, LTF_N, MAPPING, MAPPINGS, \
     ORIGIN, PARTS, PILOT_PERIOD, SPATIAL_S, SR, fmt, running_sum_chain_sc
 from .native import reconstruction_checks
@@ -219,13 +219,20 @@ def rtload_section(rt):
                      f"{f['skippedFrames'] + f['frameQueueOverflows']:.0f}", f"{f['watchdogTrips']:.0f}",
                      f"{m['reportP99S'] * 1e3:.3f}", f"{m['reportMaxS'] * 1e3:.3f}",
                      f"{f['deviceThreadPriority']:.0f} / {m['mouseThreadPriority']:.0f}",
-                     f"{r['client_xruns']}",
-                     f"{r['witness']['max_us'] / 1e3:.3f}" if r.get("witness") else "-"))
+                     f"{r['client_xruns']}", faults(r),
+                     rtload.machine_ms(r, "p99_us"), rtload.machine_ms(r, "max_us")))
     return render("rtload", cmd=CMD, seconds=rt["seconds"], load=rt["load"], priority=rt["jack_priority"],
                   table=table(["rate / period", "scheduling", "force p50 (ms)", "p99", "p99.9", "max",
                                "loop jitter p99 (ms)", "loop max (ms)", "missed deadlines", "missed frames",
                                "watchdog trips", "report to UGen p99 (ms)", "max", "device / reader thread",
-                               "JACK xruns", "machine wake-up max (ms)"], rows))
+                               "JACK xruns", "device threads' page faults (minor / major)",
+                               "machine wake-up p99 (ms)", "max"], rows))
+
+
+def faults(run):
+    """The two device threads' page faults during the run, "-" where not counted (older results)."""
+    counts = [run.get("faults", {}).get(name) for name in ("kf-device-0", "kf-device-1")]
+    return "-" if None in counts else " + ".join(f"{minor} / {major}" for minor, major in counts)
 
 
 def scale_section(sc):

@@ -7,6 +7,7 @@ Each run: jackd -d dummy (-R -P 70 with realtime scheduling), scsynth booted by 
 FrictionPilot on a simulated device (slot 0) and a FrictionMouseIn on a replayed 1 kHz mouse
 (slot 1), `seconds` long; then each device's /kfStatus reply (numbers, FrictionDevice.statusOf).
 """
+import re
 import time
 
 from kfharness import jack, load, paths, sclang, status
@@ -23,6 +24,17 @@ CONDITIONS = [  # name, realtime scheduling, background load
     ("normal priority, loaded", False, True),
 ]
 HID = "genius-gila-gaming-mouse-0458-0138.hid"
+
+
+def thread_faults(output):
+    """{thread name: (minor, major)}: each server thread's page faults from the device's open to the
+    run's end (rtload.scd posts /proc's counts at both; threads of one name summed)."""
+    seen = {}
+    for when, name, minor, major in re.findall(r"^KF-RTLOAD-FAULTS (open|end) (\S+) (\d+) (\d+)$", output, re.M):
+        counts = seen.setdefault(name, {"open": [0, 0], "end": [0, 0]})[when]
+        counts[0] += int(minor)
+        counts[1] += int(major)
+    return {name: (w["end"][0] - w["open"][0], w["end"][1] - w["open"][1]) for name, w in seen.items()}
 
 
 def run_one(bench, sample_rate, period, realtime, loaded, seconds):
@@ -50,8 +62,15 @@ def run_one(bench, sample_rate, period, realtime, loaded, seconds):
     if set(figures) != {0, 1}:
         raise SystemExit(f"rtload: no /kfStatus figures for both devices:\n{run.output[-4000:]}")
     return {"rate": sample_rate, "period": period, "realtime": realtime, "loaded": loaded, "seconds": seconds,
-            "force": figures[0], "mouse": figures[1], "client_xruns": client_xruns(jack_log),
+            "force": figures[0], "mouse": figures[1], "faults": thread_faults(run.output),
+            "client_xruns": client_xruns(jack_log),
             "driver_xruns": driver_xruns(jack_log), "witness": witnessed, "wall_s": time.monotonic() - t}
+
+
+def machine_ms(run, key):
+    """The witness's figure (us) in ms as text, "-" when not measured."""
+    value = (run.get("witness") or {}).get(key)
+    return "-" if value is None else f"{value / 1e3:.3f}"
 
 
 def run_all(bench, seconds=20.0):
@@ -68,8 +87,8 @@ def run_all(bench, seconds=20.0):
                 f"max {f['forceMaxS'] * 1e3:.3f} ms; loop p99 {f['loopP99S'] * 1e3:.3f} ms; missed deadlines "
                 f"{f['missedDeadlines']:.0f}; skipped {f['skippedFrames']:.0f}; watchdog {f['watchdogTrips']:.0f}; "
                 f"report to UGen p99 {m['reportP99S'] * 1e3:.3f} ms; device thread priority "
-                f"{f['deviceThreadPriority']:.0f}; the machine's own wake-up max in the same window "
-                f"{r['witness']['max_us'] / 1e3 if r['witness'] else float('nan'):.3f} ms")
+                f"{f['deviceThreadPriority']:.0f}, page faults (minor, major) {r['faults'].get('kf-device-0')}; the "
+                f"machine's own wake-up in the same window p99 {machine_ms(r, 'p99_us')} max {machine_ms(r, 'max_us')} ms")
             runs.append(r)
     return {"runs": runs, "seconds": seconds, "load": load.BackgroundLoad().describe(),
             "jack_priority": REALTIME_PRIORITY}

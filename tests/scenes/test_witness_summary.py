@@ -23,8 +23,20 @@ CYCLICTEST = """# /dev/cpu_dma_latency set to 0us
 
 
 def test_the_summary_gives_the_worst_latency_the_mean_and_the_most_stalls_of_a_thread():
-    assert summary(CYCLICTEST) == {"max_us": 2121, "avg_us": 13.5, "stalls": 8}
+    # Every wake-up counted is beyond the histogram's one bin: its 99th percentile is out of range.
+    assert summary(CYCLICTEST) == {"max_us": 2121, "avg_us": 13.5, "stalls": 8, "p99_us": None}
     assert summary("cyclictest: no summary") is None
+
+
+def test_the_99th_percentile_is_of_every_threads_wake_ups_together_overflows_above_the_range():
+    # 1000 wake-ups: 900 at 10 us, 85 at 11 us (985), 5 at 12 us (990: the 99th percentile), 8 at
+    # 13 us and 2 beyond the range (one a thread).
+    lines = ["# Histogram", "000010 000450\t000450", "000011 000040\t000045", "000012 000005\t000000",
+             "000013 000004\t000004", "# Min Latencies: 00010 00010", "# Avg Latencies: 00010 00010",
+             "# Max Latencies: 00200 00300", "# Histogram Overflows: 00001 00001"]
+    assert summary("\n".join(lines) + "\n")["p99_us"] == 12
+    lines[3] = "000012 000004\t000000"  # 989 up to 12 us: the 99th percentile is the next bin's
+    assert summary("\n".join(lines) + "\n")["p99_us"] == 13
 
 
 def test_a_witness_held_longer_than_its_threshold_counts_the_stall():
