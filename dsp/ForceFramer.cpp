@@ -94,8 +94,9 @@ bool ForceFramer::closeBin(FrameSink sink, void* context) {
     // not a step for the filter to ring above it.
     lastBinMeanN_ = std::clamp(weightedSum_ / weight_, minForceN_, maxForceN_);
     frameHasSamples_ = true;
-    if (!historySeeded_) std::fill(std::begin(history_), std::end(history_), lastBinMeanN_);
-    historySeeded_ = true;
+    if (!historySeeded_ && filter_ == FrameFilter::kAntiAlias)
+      std::fill(std::begin(history_), std::end(history_), lastBinMeanN_);
+    historySeeded_ = filter_ == FrameFilter::kAntiAlias;  // the mean keeps no past
   }
   if (historySeeded_) {
     history_[historyNext_] = lastBinMeanN_;  // a bin without samples holds the last mean

@@ -69,6 +69,29 @@ double referenceMean(const Rate& rate, int64_t k, Signal signal) {
   return sum / static_cast<double>(rate.num);
 }
 
+constexpr double kPi = 3.14159265358979323846;
+
+// A line fitted to the frames from `first` on: least squares of (force - 1 N) against sin and cos
+// at f, each frame taken at its start plus `centreS` (what it stands for): {sin part, cos part},
+// so that the gain is twice their length and the phase left is the cos part.
+struct LineFit {
+  double sinPart, cosPart;
+};
+LineFit fitLine(const std::vector<Frame>& frames, size_t first, double f, double centreS) {
+  double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0;
+  for (size_t k = first; k < frames.size(); ++k) {
+    const double t = frames[k].timeS + centreS;
+    const double s = std::sin(2 * kPi * f * t), c = std::cos(2 * kPi * f * t), y = frames[k].forceN - 1.0;
+    ss += s * s;
+    sc += s * c;
+    cc += c * c;
+    ys += y * s;
+    yc += y * c;
+  }
+  const double det = ss * cc - sc * sc;
+  return {(ys * cc - yc * sc) / det, (yc * ss - ys * sc) / det};
+}
+
 }  // namespace
 
 TEST_CASE("ForceFramer: a constant gives exactly that value in every frame", "[framer]") {
@@ -258,7 +281,6 @@ TEST_CASE("ForceFramer: its frequency response at 1 and 8 kHz frames is the desi
   // sine of f in gives, at the frame rate, a sine of gain |sin(pi f M / fs) / (M sin(pi f / fs))|
   // delayed by (M - 1) / 2 samples from the frame's start (its centre). The framer's rate is
   // the device's force rate: 1 kHz (the paper's) or 8 kHz (a 2.1 board, PROTOCOL.md 3.1).
-  constexpr double kPi = 3.14159265358979323846;
   for (const double frameHz : {1000.0, 8000.0}) {
     for (const int64_t fs : {int64_t{48000}, int64_t{96000}, int64_t{192000}}) {
       const double m = static_cast<double>(fs) / frameHz;
@@ -269,20 +291,8 @@ TEST_CASE("ForceFramer: its frequency response at 1 and 8 kHz frames is the desi
         auto sine = [&](int64_t j) { return static_cast<float>(1.0 + 0.5 * std::sin(2 * kPi * f * j / fs)); };
         const auto out = runFramer(framer, fs, static_cast<int64_t>(frames * m), 64, sine);
         REQUIRE(out.size() >= static_cast<size_t>(frames - 1));
-        // Least squares of the frames against sin and cos at f, sampled at each frame's centre
-        // (its start plus (M - 1) / 2 samples): the gain and what phase is left.
-        double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0;
-        for (const Frame& frame : out) {
-          const double t = frame.timeS + (m - 1) / 2 / fs;
-          const double s = std::sin(2 * kPi * f * t), c = std::cos(2 * kPi * f * t), y = frame.forceN - 1.0;
-          ss += s * s;
-          sc += s * c;
-          cc += c * c;
-          ys += y * s;
-          yc += y * c;
-        }
-        const double det = ss * cc - sc * sc;
-        const double a = (ys * cc - yc * sc) / det, b = (yc * ss - ys * sc) / det;
+        // The line at each frame's centre (its start plus (M - 1) / 2 samples).
+        const auto [a, b] = fitLine(out, 0, f, (m - 1) / 2 / fs);
         const double design = std::fabs(std::sin(kPi * f * m / fs) / (m * std::sin(kPi * f / fs)));
         INFO("frames at " << frameHz << " Hz, fs " << fs << ", f " << f << " Hz: gain " << 2 * std::hypot(a, b)
                           << ", design " << design);
@@ -352,7 +362,6 @@ TEST_CASE("ForceFramer's anti-alias filter: its response at 1 and 8 kHz frames, 
   // 2 frames and half a sample before the frame's end (1.5 frames before the mean's centre). A line
   // above half the frame rate is seen at its alias, the same fit. Then the design's claims: with the
   // board's hold within one Weber fraction (0.11) up to 0.3 F, and -30 dB from 0.7 F up.
-  constexpr double kPi = 3.14159265358979323846;
   const struct {
     double frameHz;
     int64_t fs;
@@ -365,19 +374,9 @@ TEST_CASE("ForceFramer's anti-alias filter: its response at 1 and 8 kHz frames, 
       auto sine = [&](int64_t j) { return static_cast<float>(1.0 + 0.5 * std::sin(2 * kPi * f * j / c.fs)); };
       const auto out = runFramer(framer, c.fs, static_cast<int64_t>(4000 * m), 64, sine);
       REQUIRE(out.size() == 4000);
-      double ss = 0, sc = 0, cc = 0, ys = 0, yc = 0;
-      for (size_t k = 4; k < out.size(); ++k) {  // after the filter's start
-        // the frame's end, less the group delay of 2 frames and the held samples' half sample
-        const double t = out[k].timeS + 1.0 / c.frameHz - 2.0 / c.frameHz - 0.5 / c.fs;
-        const double s = std::sin(2 * kPi * f * t), co = std::cos(2 * kPi * f * t), y = out[k].forceN - 1.0;
-        ss += s * s;
-        sc += s * co;
-        cc += co * co;
-        ys += y * s;
-        yc += y * co;
-      }
-      const double det = ss * cc - sc * sc;
-      const double a = (ys * cc - yc * sc) / det, b = (yc * ss - ys * sc) / det;
+      // After the filter's start (4 frames), at the frame's end less the group delay of 2 frames
+      // and the held samples' half sample.
+      const auto [a, b] = fitLine(out, 4, f, 1.0 / c.frameHz - 2.0 / c.frameHz - 0.5 / c.fs);
       double design = 0.0;
       for (int j = 0; j < frame_filter::kTaps; ++j)
         design += frame_filter::tap(j) * std::cos(2 * kPi * f * (j - 7.5) * l / c.fs);
