@@ -3,15 +3,19 @@
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
 # fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
 # sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
-# (dsp, device, host), the NRT scene tests (scsynth and supernova), the help files, the QEMU guest,
-# and the realtime tests against JACK's dummy driver: one more at a time than there are cores.
+# (dsp, device, host), the NRT scene tests on supernova, the help files, the QEMU guest, the main
+# jobs and the realtime tests against JACK's dummy driver. The scene tests run on scsynth once,
+# against the sanitized plugin, as sanitized/scenes/...: build/'s scenes/... are the same files
+# against the same sources built without the sanitizers' checks, whose -O3 build the supernova
+# scenes, the realtime tests, the help files and the main jobs load (the quick tier runs them).
+# ctest shares the machine by resources (build/ctest-resources.json, tests/CMakeLists.txt): a busy
+# test takes a core, the QEMU guest all of them, the realtime tests, which mostly wait on the audio
+# clock, none; they run one at a time per build (tests/realtime/CMakeLists.txt), so each has beside
+# it at most the other build's and two busy tests (the two hogs they are built to hold).
 # (The other checks' builds were once run beside the ctest under SCHED_IDLE: the help examples
-# took 301 s against 163-203 s alone and failed three claims, so nothing runs beside it.) The
-# realtime tests mostly wait on the audio clock and run one at a time per build
-# (tests/realtime/CMakeLists.txt), so each has beside it at most the other build's and one CPU-bound
-# test (the two hogs they are built to hold); the QEMU guest and the main jobs run alone
-# (RUN_SERIAL). A failing stage does not stop the next: every stage runs, and the command fails if
-# any did (with ctest's exit code when ctest was the one).
+# took 301 s against 163-203 s alone and failed three claims, so nothing runs beside it.) A failing
+# stage does not stop the next: every stage runs, and the command fails if any did (with ctest's
+# exit code when ctest was the one).
 #
 # At the end each stage's wall time is printed and written to build/test-stages.txt, with what
 # the machine was (cores, realtime scheduling allowed, the CPU time the hypervisor stole), so
@@ -22,7 +26,7 @@
 #            host), the NRT scene tests on scsynth, and one realtime scene
 #            (realtime/test_device_realtime). No sanitizers, fuzzing, cross builds, supernova,
 #            help files, main jobs or guest: CI runs the whole command.
-#   extra arguments go to the final ctest, e.g. scripts/test.sh -R scenes/
+#   extra arguments go to the final ctest, e.g. scripts/test.sh -R sanitized/scenes/
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -89,7 +93,8 @@ if ((rc != 0)); then
 fi
 source scripts/env.sh
 if $quick; then
-  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 1))" \
+  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 2))" \
+    --resource-spec-file "$PWD/build/ctest-resources.json" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
   for check in format pyflakes sanitize fuzz sanitize-plugin-build cross; do
@@ -101,7 +106,9 @@ else
   mkdir -p build/with-sanitized
   printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
     > build/with-sanitized/CTestTestfile.cmake
-  stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 1))" "$@"
+  # As many tests at once as the cores and the two realtime chains allow (the resources decide).
+  stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 2))" \
+    --resource-spec-file "$PWD/build/ctest-resources.json" -E '^scenes/test_' "$@"
   stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
 fi
 summary build/test-stages.txt

@@ -278,11 +278,17 @@ TEST_CASE("board gadget: 10 s of set-points, each received once and in order", "
   for (size_t i = 1; i < applied.size(); ++i) {
     const int64_t gapNs = applied[i].timeNs - applied[i - 1].timeNs;
     longestNs = std::max(longestNs, gapNs);
-    if (gapNs >= 20 * kTickNs) ++watchdogGaps;
+    // The pin shows a watchdog only where it had a current to turn off: a gap after a set-point
+    // of drive 0 (the window's first ones, from before the stream) trips it with the pin at 0
+    // already, and nothing is logged (seen beside realtime tests: 114 trips logged for 115 gaps).
+    if (gapNs >= 20 * kTickNs && applied[i - 1].drive != 0) ++watchdogGaps;
   }
   long watchdogs = 0;
-  for (const auto& target : report.targets)  // not the one after the window, where reading stopped
-    watchdogs += target.why == "watchdog" && target.timeNs <= applied.back().timeNs;
+  // A gap's trip is logged by the tick 20 ms into it or, when the gadget was held up, as the frame
+  // that ends it arrives, just after that frame's time; a trip after the window's last frame (the
+  // stream stopped) is logged 20 ms after it at the earliest.
+  for (const auto& target : report.targets)
+    watchdogs += target.why == "watchdog" && target.timeNs < applied.back().timeNs + 20 * kTickNs;
   long notApplied = static_cast<long>(report.frames.size() - applied.size());
   char figures[400];
   std::snprintf(
