@@ -110,9 +110,9 @@ check_sanitize_plugin() {
   build_sanitized_plugin
   echo "== scene and realtime tests against the plugin under ASan + UBSan"
   local rc=0
-  # As scripts/test.sh runs ctest: one test more than the cores, the realtime ones one at a time
-  # beside the scenes.
-  ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 1))" \
+  # As scripts/test.sh runs ctest: the machine shared by resources (tests/CMakeLists.txt).
+  ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 3))" \
+    --resource-spec-file "$PWD/build-asan-plugin/ctest-resources.json" \
     -R "${KF_SANITIZED_TESTS:-^sanitized/(scenes|realtime)/}" || rc=$?
   sanitized_plugin_findings || rc=1
   return "$rc"

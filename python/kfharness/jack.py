@@ -20,6 +20,13 @@ class JackServer:
 
     def __init__(self, sample_rate=48000, period=64, realtime_priority=None):
         self.name = f"kfrt{os.getpid()}x{random.randrange(16 ** 6):06x}"
+        # scsynth's JACK client name here (ServerOptions.device, kfharness.sclang): JACK names a
+        # client's notification socket /dev/shm/jack_<client>_<uid>_0, whatever its server, so two
+        # scsynths named SuperCollider that open at once on two servers take each other's socket,
+        # and one fails: "NotifyAddClient new_client fails name = SuperCollider", "Connection reset
+        # by peer" in jackd's log, "Cannot open SuperCollider client" in scsynth's (seen with
+        # realtime tests side by side).
+        self.sc_client = f"SuperCollider-{self.name}"
         self.sample_rate = sample_rate
         self.period = period
         self.realtime_priority = realtime_priority

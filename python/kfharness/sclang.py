@@ -132,6 +132,7 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 	options.memSize = 65536;
 	options.maxLogins = 4;
 	options.bindAddress = "127.0.0.1";
+	options.device = "%(device)s";
 %(options)s	KineticFriction.addPluginPath(options);
 	// Quits the server if it runs, and exits once its process has ended (sclang has posted its
 	// exit code; checked every 0.02 s), or 0.5 s after at the latest.
@@ -187,6 +188,7 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
     script = paths.work_dir() / f"{key}.scd"
     script.write_text(SERVER_WRAPPER % dict(code=sc_string(code_path), port=port, rate=jack.sample_rate,
                                             period=jack.period, timeout=max(timeout - 10, 5), program=server_program_code(),
+                                            device=f"{jack.name}:{jack.sc_client}",
                                             options="".join(f"\toptions.{k} = {v};\n"
                                                             for k, v in (server_options or {}).items())))
     log_path = paths.work_dir() / f"{key}.log"

@@ -58,11 +58,11 @@ def test_the_looped_drive_is_the_commanded_force_and_zero_after_free_cmd_period_
         dev = FrictionDevice.sim(s, 0);
         s.sync;
         dev.loadDrive({sclang.sc_string(drive_path)});
-        "jack_connect SuperCollider:out_1 SuperCollider:in_1".systemCmd;
+        "jack_connect {jack.sc_client}:out_1 {jack.sc_client}:in_1".systemCmd;
         start.value;
         s.sync;
         rec = ("jack_rec -f " ++ {sclang.sc_string(wav)} ++ " -d 2.0 -b 32 "
-            "SuperCollider:out_1 SuperCollider:out_2 SuperCollider:out_3").unixCmd;
+            "{jack.sc_client}:out_1 {jack.sc_client}:out_2 {jack.sc_client}:out_3").unixCmd;
         capture.(bufs[0]);
         s.sync;
         0.2.wait;
