@@ -454,7 +454,10 @@ TEST_CASE(
   HostBoard host;
   const uint16_t drive = host.streamHalf();
   const BoardTelemetry before = host.telemetry();  // first, as in the halt's case
-  gadget.report();
+  // What the gadget logged up to the pause: the last set-point before it may be there rather than
+  // in the window after (seen with the guest held up as the window began: none in it before the
+  // coil went off).
+  const GadgetReport lead = gadget.report();
   const int64_t pauseNs = nowNs();
   gadget.command("reading off");
   std::this_thread::sleep_for(200ms);
@@ -470,6 +473,7 @@ TEST_CASE(
   CHECK(off->drive == 0);
   const auto applied = report.applied();
   int64_t lastBeforeNs = 0, firstAfterNs = 0;
+  for (const GadgetFrame& f : lead.applied()) lastBeforeNs = f.timeNs;
   for (const GadgetFrame& f : applied) {
     if (f.timeNs < off->timeNs) lastBeforeNs = f.timeNs;
     if (f.timeNs > off->timeNs && firstAfterNs == 0) firstAfterNs = f.timeNs;
