@@ -12,6 +12,11 @@
 // Per case: the applied force's line at the grating's frequency against the ideal's (gain, in dB
 // and in Weber fractions of 0.11 for a friction change: Gueorguiev et al. 2017), and the largest
 // other line inside the touch band (10 Hz .. 1 kHz: what an alias folds into), relative to it.
+// Textures too (FrictionPattern.texture: 16 sines of spatial frequencies drawn in a band, on the
+// paper's range), three bands (periods 1-5, 0.5-2 and 0.2-0.5 mm) at the same speeds, against the
+// ideal through their spectra: the texture's band's amplitude (root of its power) and its worst
+// third-octave's, in Weber fractions, and the power in the touch band outside the texture's band
+// (aliases, images of the held steps), relative to the texture's.
 // Per variant: the latency from the audio's step to the applied force's half-way point (mean over
 // 64 phases of the step against the frames), and the CPU time per second of force of the
 // framing, encoding and firmware (thread CPU, the variants interleaved in each round).
@@ -27,6 +32,7 @@
 
 #include "ForceFramer.hpp"
 #include "board/BoardEmulator.hpp"
+#include "patterns/TexturePattern.hpp"
 
 namespace {
 
@@ -172,6 +178,112 @@ struct Case {
   double gainDb[kNumVariants], weber[kNumVariants], spurDb[kNumVariants];
 };
 
+// Texture cases: one band of FrictionPattern.texture crossed at one speed, compared with the
+// ideal force through their spectra over the same 2.048 s (a power of two of steps at 1, 8 and
+// 64 kHz, so that the bins are the same 0.49 Hz apart in all three).
+using kf::patterns::TexturePattern;
+constexpr uint64_t kTextureSeed = 7;
+constexpr double kTextureSpanS = 2.048, kTextureFromS = 0.02, kIdealRateHz = 64000;
+
+struct TextureCase {
+  double loPerMm, hiPerMm, speedMmPerS;
+  double bandWeber[kNumVariants], worstWeber[kNumVariants], worstHz[kNumVariants], spurDb[kNumVariants];
+};
+
+// In-place radix-2 FFT (size a power of two).
+void fft(std::vector<std::complex<double>>& x) {
+  const size_t n = x.size();
+  for (size_t i = 1, j = 0; i < n; ++i) {
+    size_t bit = n >> 1;
+    for (; j & bit; bit >>= 1) j ^= bit;
+    j ^= bit;
+    if (i < j) std::swap(x[i], x[j]);
+  }
+  for (size_t len = 2; len <= n; len <<= 1) {
+    const std::complex<double> turn = std::polar(1.0, -2 * kPi / len);
+    for (size_t i = 0; i < n; i += len) {
+      std::complex<double> w = 1;
+      for (size_t k = 0; k < len / 2; ++k, w *= turn) {
+        const std::complex<double> u = x[i + k], v = x[i + k + len / 2] * w;
+        x[i + k] = u + v;
+        x[i + k + len / 2] = u - v;
+      }
+    }
+  }
+}
+
+// The force's power per bin (amplitude squared, bins 1 / kTextureSpanS apart) from kTextureFromS
+// over kTextureSpanS, 4-term Blackman-Harris window, the hold of each step taken into account.
+std::vector<double> powerSpectrum(const Applied& a) {
+  const auto first = static_cast<size_t>(std::ceil((kTextureFromS - a.startS) / a.stepS));
+  const auto count = static_cast<size_t>(std::lround(kTextureSpanS / a.stepS));
+  std::vector<std::complex<double>> x(count);
+  double windowSum = 0;
+  for (size_t k = 0; k < count; ++k) {
+    const double u = 2 * kPi * (k + 0.5) / count;
+    const double window = 0.35875 - 0.48829 * std::cos(u) + 0.14128 * std::cos(2 * u) - 0.01168 * std::cos(3 * u);
+    x[k] = window * (first + k < a.forceN.size() ? a.forceN[first + k] - kMeanN : 0.0);
+    windowSum += window;
+  }
+  fft(x);
+  std::vector<double> power(count / 2);
+  for (size_t k = 0; k < power.size(); ++k) {
+    const double w = 2 * kPi * k / kTextureSpanS * a.stepS;
+    const double hold = k == 0 ? 1.0 : std::fabs(std::sin(w / 2) / (w / 2));
+    power[k] = std::norm(2.0 * x[k] * hold / windowSum);
+  }
+  return power;
+}
+
+double bandPower(const std::vector<double>& power, double fromHz, double toHz) {
+  double sum = 0;
+  for (size_t k = 0; k < power.size(); ++k) {
+    const double f = k / kTextureSpanS;
+    if (f >= fromHz && f < toHz) sum += power[k];
+  }
+  return sum;
+}
+
+TextureCase measureTexture(double lo, double hi, double speed) {
+  TextureCase c{lo, hi, speed, {}, {}, {}, {}};
+  auto audio = [&](double t) { return kMinN + (kMaxN - kMinN) * TexturePattern::at(lo, hi, kTextureSeed, speed * t); };
+  const double durationS = kTextureFromS + kTextureSpanS + 0.01;
+  Applied ideal{0.0, 1.0 / kIdealRateHz, {}};
+  for (int k = 0; (k + 0.5) / kIdealRateHz < durationS; ++k) ideal.forceN.push_back(audio((k + 0.5) / kIdealRateHz));
+  const std::vector<double> idealPower = powerSpectrum(ideal);
+  // The texture's band, widened by the window's main lobe (4 bins) on each side; its third-octave
+  // bands (at least one), and the touch band (10 Hz .. 1 kHz) outside it.
+  const double lobeHz = 4 / kTextureSpanS, bandLoHz = std::max(lo * speed - lobeHz, 0.5 / kTextureSpanS),
+               bandHiHz = hi * speed + lobeHz;
+  std::vector<double> edges{bandLoHz};
+  while (edges.back() * std::pow(2.0, 1.0 / 3) < bandHiHz) edges.push_back(edges.back() * std::pow(2.0, 1.0 / 3));
+  edges.back() = bandHiHz;
+  if (edges.size() < 2) edges.push_back(bandHiHz);
+  const double idealBand = bandPower(idealPower, bandLoHz, bandHiHz);
+  for (int r = 0; r < kNumVariants; ++r) {
+    const std::vector<double> power =
+        powerSpectrum(onGrid(render(audio, durationS, kVariants[r]), durationS, kVariants[r].perFrame));
+    c.bandWeber[r] = std::fabs(std::sqrt(bandPower(power, bandLoHz, bandHiHz) / idealBand) - 1) / kWeber;
+    for (size_t b = 0; b + 1 < edges.size(); ++b) {
+      const double want = bandPower(idealPower, edges[b], edges[b + 1]);
+      // Only a third-octave that holds at least half of one component's power (1/16 of the band's):
+      // in one the drawn components leave (nearly) empty the ratio measures the window's skirts.
+      if (want < 0.5 * idealBand / TexturePattern::kComponents) continue;
+      const double weber = std::fabs(std::sqrt(bandPower(power, edges[b], edges[b + 1]) / want) - 1) / kWeber;
+      if (weber >= c.worstWeber[r]) {
+        c.worstWeber[r] = weber;
+        c.worstHz[r] = std::sqrt(edges[b] * edges[b + 1]);
+      }
+    }
+    // Power in the touch band outside the texture's: below it and above it, relative to the
+    // texture's (what the ideal has there is its clamp's, shown for the ideal too).
+    const double outside =
+        bandPower(power, 10, std::min(bandLoHz, 1000.0)) + bandPower(power, std::max(bandHiHz, 10.0), 1000);
+    c.spurDb[r] = 10 * std::log10(std::max(outside, 1e-18) / idealBand);
+  }
+  return c;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -204,6 +316,12 @@ int main(int argc, char** argv) {
       }
       cases.push_back(c);
     }
+
+  // Textures: three bands of periods (1-5, 0.5-2 and 0.2-0.5 mm) at the gratings' speeds.
+  const double bands[][2] = {{0.2, 1.0}, {0.5, 2.0}, {2.0, 5.0}};
+  std::vector<TextureCase> textures;
+  for (const auto& band : bands)
+    for (double v : speeds) textures.push_back(measureTexture(band[0], band[1], v));
 
   // The headline: the highest frequency whose line is within one Weber fraction, per variant, by
   // bisection (below the rate's Nyquist frequency the gain leaves 1 once, for good, as f rises).
@@ -283,6 +401,20 @@ int main(int argc, char** argv) {
     std::printf(", \"spurDb\": ");
     list(c.spurDb, "%.2f");
     std::printf("}%s\n", i + 1 < cases.size() ? "," : "");
+  }
+  std::printf(" ],\n \"textures\": [\n");
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const TextureCase& c = textures[i];
+    std::printf("  {\"loPerMm\": %g, \"hiPerMm\": %g, \"speedMmPerS\": %g, \"bandWeber\": ", c.loPerMm, c.hiPerMm,
+                c.speedMmPerS);
+    list(c.bandWeber, "%.4f");
+    std::printf(", \"worstWeber\": ");
+    list(c.worstWeber, "%.4f");
+    std::printf(", \"worstHz\": ");
+    list(c.worstHz, "%.1f");
+    std::printf(", \"spurDb\": ");
+    list(c.spurDb, "%.2f");
+    std::printf("}%s\n", i + 1 < textures.size() ? "," : "");
   }
   std::printf(" ]}\n");
   return 0;

@@ -14,7 +14,8 @@ def needed(bench):
                 and bench.exe("bench", "kf_report_rate_bench").exists()
                 and bench.exe("bench", "kf_core_path").exists()
                 and bench.exe("bench", "kf_patterns_bench").exists()
-                and bench.exe("bench", "kf_texture_rate_bench").exists())
+                and bench.exe("bench", "kf_texture_rate_bench").exists()
+                and bench.exe("bench", "kf_device_rate_bench").exists())
 
 
 def build(bench):
@@ -23,7 +24,7 @@ def build(bench):
         subprocess.run(["cmake", "-S", str(paths.REPO_DIR), "-B", str(bench.build), "-DCMAKE_BUILD_TYPE=Release"],
                        check=True, stdout=subprocess.DEVNULL)
     targets = ["KineticFriction", "KFBenchClock", "kf_log_choice", "kf_reconstruction_bench", "kf_report_rate_bench",
-               "kf_core_path", "kf_patterns_bench", "kf_texture_rate_bench"]
+               "kf_core_path", "kf_patterns_bench", "kf_texture_rate_bench", "kf_device_rate_bench"]
     if bench.tests_enabled():
         targets.append("dsp_tests")
     log(f"building {', '.join(targets)} (-j2)")

@@ -182,7 +182,10 @@ def texture_rate_section(tr, build_dir):
                   within_1k=tr["within_weber_hz"][0], within_8k=tr["within_weber_hz"][1],
                   within_8k_filter=tr["within_weber_hz"][2], latency_1k=tr["latency_ms"][0],
                   latency_8k=tr["latency_ms"][1], latency_8k_filter=tr["latency_ms"][2],
-                  variants=texture_rate.variants_table(tr, table), fidelity=texture_rate.fidelity_table(tr, table))
+                  variants=texture_rate.variants_table(tr, table), fidelity=texture_rate.fidelity_table(tr, table),
+                  textures=texture_rate.textures_table(tr, table), device=texture_rate.device_table(tr, table),
+                  device_seconds=tr["device"]["seconds"], device_rounds=tr["device"]["rounds"], build_dir=build_dir,
+                  **dict(zip(["tex_1k", "tex_8k", "tex_8k_filter"], texture_rate.textures_within_weber_hz(tr))))
 
 
 def thresholds_section(th):
