@@ -38,15 +38,19 @@ if [ "${1:-}" = --quick ]; then
   shift
 fi
 
-stages=() seconds=() results=()
+stages=() seconds=() cpu_seconds=() results=()
 rc=0
-# stage <name> <command...>: runs it, records its wall time and exit code; the first failure's
-# code becomes the command's.
+# The machine's busy CPU time in jiffies (1/100 s): /proc/stat's cpu line without idle and iowait.
+busy_jiffies() { awk '/^cpu / { print $2 + $3 + $4 + $7 + $8 + $9 }' /proc/stat; }
+# stage <name> <command...>: runs it, records its wall time, the CPU time the whole machine was
+# busy meanwhile (the stage's and anything beside it) and its exit code; the first failure's code
+# becomes the command's.
 stage() {
-  local name=$1 start=$SECONDS code=0
+  local name=$1 start=$SECONDS code=0 busy_start
+  busy_start=$(busy_jiffies)
   shift
   "$@" || code=$?
-  stages+=("$name") seconds+=($((SECONDS - start))) results+=("$code")
+  stages+=("$name") seconds+=($((SECONDS - start))) cpu_seconds+=($((($(busy_jiffies) - busy_start) / 100))) results+=("$code")
   if ((code != 0)); then
     echo "== stage $name FAILED (exit $code)" >&2
     ((rc == 0)) && rc=$code
@@ -64,21 +68,23 @@ machine() {
 }
 
 summary() {
-  local total=0 i line
+  local total=0 total_cpu=0 i line
   read -r total_end steal_end < <(cpu_jiffies)
   local stolen="?"
   ((total_end > total_start)) && stolen=$(((steal_end - steal_start) * 1000 / (total_end - total_start)))
   {
     echo "$machine_line"
     echo "CPU time stolen by the hypervisor during the run: ${stolen} per mille"
-    printf '%-26s %8s  %s\n' stage seconds result
+    # cpu-s: CPU-seconds the machine was busy during the stage; of cores: that over seconds x cores.
+    printf '%-26s %8s %8s %9s  %s\n' stage seconds cpu-s "of cores" result
     for i in "${!stages[@]}"; do
-      total=$((total + seconds[i]))
+      total=$((total + seconds[i])) total_cpu=$((total_cpu + cpu_seconds[i]))
       line=passed
       ((results[i] != 0)) && line="FAILED (exit ${results[i]})"
-      printf '%-26s %8d  %s\n' "${stages[i]}" "${seconds[i]}" "$line"
+      printf '%-26s %8d %8d %8d%%  %s\n' "${stages[i]}" "${seconds[i]}" "${cpu_seconds[i]}" \
+        "$((100 * cpu_seconds[i] / (seconds[i] * $(nproc) + (seconds[i] == 0))))" "$line"
     done
-    printf '%-26s %8d\n' total "$total"
+    printf '%-26s %8d %8d %8d%%\n' total "$total" "$total_cpu" "$((100 * total_cpu / (total * $(nproc) + (total == 0))))"
   } > "$1"
   echo "== stage timings (also in $1)"
   cat "$1"
