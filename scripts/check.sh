@@ -16,10 +16,9 @@
 #              (MinGW-w64, no hardware backends: build-mingw/) with its dsp/, device/ and host/
 #              suites under Wine, and the Clang + libc++ build with the POSIX code macOS takes
 #              (build-libcxx/); both build every default target, as a user's cmake --build
-#              does (the plugin .scx, the bench), and the suites; its halves cross-build and
-#              cross-suites (scripts/test.sh runs the builds beside its ctest)
+#              does (the plugin .scx, the bench), and the suites
 # Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin|cross|
-#                         sanitize-plugin-build|sanitize-plugin-findings|cross-build|cross-suites]...
+#                         sanitize-plugin-build|sanitize-plugin-findings]...
 #        (none: all but sclang-lines, which format runs, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -146,8 +145,8 @@ run_suites() {
   done
 }
 
-check_cross_build() {
-  echo "== cross builds: Windows (MinGW-w64, build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
+check_cross() {
+  echo "== cross: Windows build under Wine (build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
   # Every default target: a user's build (the bench included) compiles what the suites do not
   # (bench/log_choice.cpp once stopped a MinGW build on M_PI, unseen while only the suites and the
   # plugin were built here).
@@ -157,11 +156,7 @@ check_cross_build() {
   configure_and_build build-libcxx -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/clang-libcxx.cmake -DKF_PLATFORM=posix \
     -DKF_SUPERNOVA=OFF
   echo "cross: both built in $((SECONDS - start)) s"
-}
-
-check_cross_suites() {
-  echo "== cross suites: under Wine (build-mingw/), then Clang + libc++ (build-libcxx/)"
-  local start=$SECONDS
+  start=$SECONDS
   # One after the other: side by side, the Wine suites' wall-clock bounds were missed on this
   # 2-core machine (a board's current off 18 ms after close, bound 10 ms).
   # Debian's wine64 is not on PATH; as the toolchain file runs it (a prefix of the build's own).
@@ -185,8 +180,6 @@ check_cross_suites() {
   return "$rc"
 }
 
-check_cross() { check_cross_build && check_cross_suites; }
-
 check_fuzz() {
   echo "== fuzzing (build-fuzz/)"
   scripts/fuzz.sh "${KF_FUZZ_SECONDS:-20}"
@@ -205,11 +198,8 @@ for check in "${checks[@]}"; do
     sanitize-plugin-build) build_sanitized_plugin ;;
     sanitize-plugin-findings) sanitized_plugin_findings ;;
     cross) check_cross ;;
-    cross-build) check_cross_build ;;
-    cross-suites) check_cross_suites ;;
     *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin, cross;" \
-         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh;" \
-         "cross-build and cross-suites: cross's two halves)" >&2
+         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh)" >&2
        exit 2 ;;
   esac
 done

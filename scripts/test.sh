@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
-# fuzz targets, the plugin built with both sanitizers), then in one ctest the
+# fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
 # sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
 # (dsp, device, host), the NRT scene tests on supernova, the help files, the QEMU guest, the main
 # jobs and the realtime tests against JACK's dummy driver. The scene tests run on scsynth once,
@@ -14,12 +14,13 @@
 # build's and two busy tests (the two hogs they are built to hold); the QEMU guest a core and both
 # builds' realtime locks, first. (Three realtime tests at once took the stage from 1,039 s to
 # 935 s, but a help example's refusal then came after its block had ended, in a fresh clone.)
-# Beside the ctest, on the CPU time it leaves (SCHED_IDLE), the cross builds, whose suites run
-# after it (check.sh cross). (All the other checks' builds beside an earlier ctest under
-# SCHED_IDLE once slowed the help examples from 163-203 s to 301 s, and three of their claims
-# failed; the cross builds beside this one: the help examples took 203 and 152 s, against 215 and
-# 156 s alone, and every test passed.) A failing stage does not stop the next: every stage runs,
-# and the command fails if any did (with ctest's exit code when ctest was the one).
+# Nothing runs beside the ctest. (The other checks' builds beside it under SCHED_IDLE once slowed
+# the help examples from 163-203 s to 301 s and three of their claims failed; the cross builds
+# alone beside it, started with it, left every test passing in the ctest stage alone here, but in
+# a fresh clone the QEMU guest, which ctest runs first, played its gadget's set-points at 0.42 a
+# millisecond, the scene's audio at 62 % of real time, and one of its cases failed.) A failing
+# stage does not stop the next: every stage runs, and the command fails if any did (with ctest's
+# exit code when ctest was the one).
 #
 # At the end each stage's wall time is printed and written to build/test-stages.txt, with what
 # the machine was (cores, realtime scheduling allowed, the CPU time the hypervisor stole), so
@@ -60,40 +61,6 @@ stage() {
   return 0
 }
 
-# background_stage_start <name> <log> <command...>: a stage that runs beside the next ones, its
-# output to <log> (shown when it fails); background_stage_wait waits for it and records it as
-# stage() does, its wall time from its start, its CPU-seconds its own (the stages beside it
-# count them too).
-background_stage_start() {
-  background_name=$1 background_log=$2 background_start=$SECONDS
-  shift 2
-  mkdir -p "$(dirname "$background_log")"
-  echo "== stage $background_name beside the next ones (output: $background_log)"
-  (
-    code=0
-    "$@" > "$background_log" 2>&1 || code=$?
-    # `times` (in this shell, not a pipeline's): the shell's, then its children's user and system
-    # time (XmY.Zs).
-    times > "$background_log.times"
-    awk 'NR == 2 { for (i = 1; i <= 2; i++) { split($i, t, /[ms]/); s += 60 * t[1] + t[2] } print int(s) }' \
-      "$background_log.times" > "$background_log.cpu"
-    exit "$code"
-  ) &
-  background_pid=$!
-}
-background_stage_wait() {
-  local code=0
-  wait "$background_pid" || code=$?
-  stages+=("$background_name (beside)") seconds+=($((SECONDS - background_start)))
-  cpu_seconds+=("$(cat "$background_log.cpu" 2>/dev/null || echo 0)") results+=("$code")
-  tail -3 "$background_log"
-  if ((code != 0)); then
-    cat "$background_log" >&2
-    echo "== stage $background_name FAILED (exit $code)" >&2
-    ((rc == 0)) && rc=$code
-  fi
-}
-
 # user + nice + system + ... + steal jiffies, and steal alone, from /proc/stat's cpu line.
 cpu_jiffies() { awk '/^cpu / { t = 0; for (i = 2; i <= 9; i++) t += $i; print t, $9 }' /proc/stat; }
 
@@ -104,8 +71,7 @@ machine() {
 }
 
 summary() {
-  # The totals: the command's own wall time and the machine's busy CPU time over it (a stage run
-  # beside others is in theirs too, so the rows do not add up to them).
+  # The totals: the command's own wall time and the machine's busy CPU time over it.
   local total=$SECONDS total_cpu=$((($(busy_jiffies) - busy_at_start) / 100)) i line
   read -r total_end steal_end < <(cpu_jiffies)
   local stolen="?"
@@ -113,8 +79,7 @@ summary() {
   {
     echo "$machine_line"
     echo "CPU time stolen by the hypervisor during the run: ${stolen} per mille"
-    # cpu-s: CPU-seconds the machine was busy during the stage (a stage beside others: its own);
-    # of cores: that over seconds x cores.
+    # cpu-s: CPU-seconds the machine was busy during the stage; of cores: that over seconds x cores.
     printf '%-26s %8s %8s %9s  %s\n' stage seconds cpu-s "of cores" result
     for i in "${!stages[@]}"; do
       line=passed
@@ -144,7 +109,7 @@ if $quick; then
     --resource-spec-file "$PWD/build/ctest-resources.json" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
-  for check in format pyflakes sanitize fuzz sanitize-plugin-build; do
+  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross; do
     stage "$check" scripts/check.sh "$check"
   done
   # build/'s tests and the sanitized plugin's scene and realtime tests (sanitized/...) in one
@@ -153,17 +118,9 @@ else
   mkdir -p build/with-sanitized
   printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
     > build/with-sanitized/CTestTestfile.cmake
-  # The cross builds run beside it on the CPU time it leaves (SCHED_IDLE: they take a core only
-  # while no test wants it), their suites after it: the ctest's last minutes, when only the two
-  # realtime chains are left, had the cores 25 to 65 % busy. Measured here (the ctest stage alone,
-  # with the builds beside it): all 471 passed in 990 s against 1,050 s without them, and the
-  # builds ended 93 s after it, where alone they take 234 s after it.
-  background_stage_start cross-build build/cross-build.log chrt --idle 0 scripts/check.sh cross-build
   # As many tests at once as the cores and the two realtime chains allow (the resources decide).
   stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 2))" \
     --resource-spec-file "$PWD/build/ctest-resources.json" -E '^scenes/test_' "$@"
-  background_stage_wait
-  stage cross-suites scripts/check.sh cross-suites
   stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
 fi
 summary build/test-stages.txt
