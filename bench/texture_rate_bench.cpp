@@ -376,6 +376,11 @@ int main(int argc, char** argv) {
       std::printf(i + 1 < count ? ", " : "]");
     }
   };
+  // Prints `, "name": [values...]`, one per variant.
+  auto field = [&](const char* name, const double* values, const char* format) {
+    std::printf(", \"%s\": ", name);
+    list(values, format);
+  };
   std::printf("{\"sampleRateHz\": %g, \"block\": %d, \"rounds\": %d, \"weber\": %g,\n \"variants\": [", kSampleRate,
               kBlock, rounds, kWeber);
   for (int r = 0; r < kNumVariants; ++r)
@@ -393,27 +398,21 @@ int main(int argc, char** argv) {
   std::printf(" \"cases\": [\n");
   for (size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
-    std::printf("  {\"periodMm\": %g, \"speedMmPerS\": %g, \"frequencyHz\": %g, \"gainDb\": ", c.periodMm,
-                c.speedMmPerS, c.frequencyHz);
-    list(c.gainDb, "%.4f");
-    std::printf(", \"weber\": ");
-    list(c.weber, "%.4f");
-    std::printf(", \"spurDb\": ");
-    list(c.spurDb, "%.2f");
+    std::printf("  {\"periodMm\": %g, \"speedMmPerS\": %g, \"frequencyHz\": %g", c.periodMm, c.speedMmPerS,
+                c.frequencyHz);
+    field("gainDb", c.gainDb, "%.4f");
+    field("weber", c.weber, "%.4f");
+    field("spurDb", c.spurDb, "%.2f");
     std::printf("}%s\n", i + 1 < cases.size() ? "," : "");
   }
   std::printf(" ],\n \"textures\": [\n");
   for (size_t i = 0; i < textures.size(); ++i) {
     const TextureCase& c = textures[i];
-    std::printf("  {\"loPerMm\": %g, \"hiPerMm\": %g, \"speedMmPerS\": %g, \"bandWeber\": ", c.loPerMm, c.hiPerMm,
-                c.speedMmPerS);
-    list(c.bandWeber, "%.4f");
-    std::printf(", \"worstWeber\": ");
-    list(c.worstWeber, "%.4f");
-    std::printf(", \"worstHz\": ");
-    list(c.worstHz, "%.1f");
-    std::printf(", \"spurDb\": ");
-    list(c.spurDb, "%.2f");
+    std::printf("  {\"loPerMm\": %g, \"hiPerMm\": %g, \"speedMmPerS\": %g", c.loPerMm, c.hiPerMm, c.speedMmPerS);
+    field("bandWeber", c.bandWeber, "%.4f");
+    field("worstWeber", c.worstWeber, "%.4f");
+    field("worstHz", c.worstHz, "%.1f");
+    field("spurDb", c.spurDb, "%.2f");
     std::printf("}%s\n", i + 1 < textures.size() ? "," : "");
   }
   std::printf(" ]}\n");
