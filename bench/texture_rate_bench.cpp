@@ -151,6 +151,12 @@ Applied onGrid(const std::vector<BoardEmulator::Change>& timeline, double durati
   return applied;
 }
 
+// The 4-term Blackman-Harris window's value at step k of count (sidelobes under -92 dB).
+double blackmanHarris(size_t k, size_t count) {
+  const double x = 2 * kPi * (k + 0.5) / count;
+  return 0.35875 - 0.48829 * std::cos(x) + 0.14128 * std::cos(2 * x) - 0.01168 * std::cos(3 * x);
+}
+
 // The applied force's complex amplitude at f over [fromS, fromS + spanS) (4-term Blackman-Harris
 // window: sidelobes under -92 dB, so that the grating's own line leaks nothing into the others),
 // exact for a force held over each step: the steps' sum times the step's own transform.
@@ -165,8 +171,7 @@ std::complex<double> line(const Applied& a, double f, double fromS, double spanS
   std::complex<double> sum = 0;
   double windowSum = 0;
   for (size_t k = 0; k < count && first + k < a.forceN.size(); ++k, phasor *= turn) {
-    const double x = 2 * kPi * (k + 0.5) / count;
-    const double window = 0.35875 - 0.48829 * std::cos(x) + 0.14128 * std::cos(2 * x) - 0.01168 * std::cos(3 * x);
+    const double window = blackmanHarris(k, count);
     sum += window * (a.forceN[first + k] - kMeanN) * phasor;
     windowSum += window;
   }
@@ -220,8 +225,7 @@ std::vector<double> powerSpectrum(const Applied& a) {
   std::vector<std::complex<double>> x(count);
   double windowSum = 0;
   for (size_t k = 0; k < count; ++k) {
-    const double u = 2 * kPi * (k + 0.5) / count;
-    const double window = 0.35875 - 0.48829 * std::cos(u) + 0.14128 * std::cos(2 * u) - 0.01168 * std::cos(3 * u);
+    const double window = blackmanHarris(k, count);
     x[k] = window * (first + k < a.forceN.size() ? a.forceN[first + k] - kMeanN : 0.0);
     windowSum += window;
   }

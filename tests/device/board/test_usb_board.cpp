@@ -122,7 +122,7 @@ TEST_CASE("board driver: close sends drive 0, disarms, releases and closes", "[b
   const auto timeline = bus->timeline();
   REQUIRE(!timeline.empty());
   CHECK(std::string(timeline.back().why) == "set-point");  // the zero set-point, before DISARM
-  const double offS = bus->timeline().back().timeS;
+  const double offS = timeline.back().timeS;
   std::printf("board driver: close took %.2f ms, current off %.2f ms after close began\n", (closedS - closeS) * 1e3,
               (offS - closeS) * 1e3);
   CHECK(offS - closeS < 0.010);
@@ -315,7 +315,7 @@ TEST_CASE("a device with the board: frames drive it, the watchdog and close turn
   // stalled test thread can first read after the watchdog (a TSan run beside a busy ctest: 454 ms
   // stalled, the drive already off when polling began).
   CHECK(std::any_of(timeline.begin(), timeline.end(), [](const auto& change) { return change.drive == kDriveFull; }));
-  const double offS = bus->timeline().back().timeS;
+  const double offS = timeline.back().timeS;
   std::printf(
       "device + board: current off %.2f ms after the last frame was pushed (%s), machine stalled %.2f ms, "
       "%d late frames, the latest %.2f ms after its start\n",
