@@ -5,7 +5,8 @@
 #   pyflakes   no unused import or undefined name in the Python
 #   sanitize   dsp/, device/ and host/ built without SuperCollider, their C++ tests under AddressSanitizer
 #              + UndefinedBehaviorSanitizer (build-asan/); any finding fails
-#   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh)
+#   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh), built
+#              in build-asan/ (sanitize-build alone: that build without running anything)
 #   sanitize-plugin
 #              the scene and realtime tests against the plugin built with both sanitizers
 #              (build-asan-plugin/, tests named sanitized/...), their runtimes preloaded into every
@@ -16,9 +17,12 @@
 #              (MinGW-w64, no hardware backends: build-mingw/) with its dsp/, device/ and host/
 #              suites under Wine, and the Clang + libc++ build with the POSIX code macOS takes
 #              (build-libcxx/); both build every default target, as a user's cmake --build
-#              does (the plugin .scx, the bench), and the suites
+#              does (the plugin .scx, the bench), and the suites; its parts cross-build,
+#              cross-suites-windows and cross-suites-libcxx (scripts/test.sh runs the suites as
+#              tests of its final ctest)
 # Usage: scripts/check.sh [format|sclang-lines|pyflakes|sanitize|fuzz|sanitize-plugin|cross|
-#                         sanitize-plugin-build|sanitize-plugin-findings]...
+#                         sanitize-build|sanitize-plugin-build|sanitize-plugin-findings|cross-build|
+#                         cross-suites-windows|cross-suites-libcxx]...
 #        (none: all but sclang-lines, which format runs, in this order)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -75,13 +79,27 @@ configure_and_build() {
   cmake --build "$dir" -j "$(nproc)" "${build[@]}"
 }
 
+# build-asan/: dsp/, device/ and host/ without SuperCollider, built by clang under ASan + UBSan
+# with libFuzzer's coverage, so that one build serves both the C++ tests and the fuzz targets
+# (scripts/fuzz.sh builds here too). At -O1, as the sanitizers' own documentation builds: it finds
+# what -O3 does (an optimiser may fold undefined behaviour away before UBSan sees it, never the
+# reverse). One build instead of two (g++ for the tests, clang for the fuzz targets): 188 s and
+# 368 CPU-s from nothing against about 250 s for the tests' alone, with the fuzz build's 60 s
+# gone; the tests take 79 s instead of 58 (clang's -O1 and the coverage counters). build/ runs the
+# same tests at -O3 with g++, and build-asan-plugin/ compiles dsp/ and device/ under g++'s ASan.
+build_sanitized_tests() {
+  source scripts/packages.sh
+  kf_install_missing clang libclang-rt-dev
+  # A build-asan/ configured with g++ before this was clang's: CMake keeps a cache's compiler.
+  [ -e build-asan/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:.*clang' build-asan/CMakeCache.txt &&
+    rm -rf build-asan
+  CC=clang CXX=clang++ configure_and_build build-asan -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined -DKF_FUZZ=ON \
+    -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -DNDEBUG"
+}
+
 check_sanitize() {
   echo "== dsp/, device/ and host/ without SuperCollider, C++ tests under ASan + UBSan (build-asan/)"
-  # At -O1, as the sanitizers' own documentation builds: it finds what -O3 does (an optimiser may
-  # fold undefined behaviour away before UBSan sees it, never the reverse) and compiled host_tests
-  # in 153 s against 225 s at -O3 (from nothing, side by side). build/ runs the same tests at -O3.
-  configure_and_build build-asan -DKF_WITH_SC=OFF -DKF_SANITIZE=address,undefined \
-    -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -DNDEBUG"
+  build_sanitized_tests
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -R 'dsp/|device/|host/'
 }
@@ -145,8 +163,8 @@ run_suites() {
   done
 }
 
-check_cross() {
-  echo "== cross: Windows build under Wine (build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
+cross_build() {
+  echo "== cross builds: Windows (MinGW-w64, build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
   # Every default target: a user's build (the bench included) compiles what the suites do not
   # (bench/log_choice.cpp once stopped a MinGW build on M_PI, unseen while only the suites and the
   # plugin were built here).
@@ -156,32 +174,48 @@ check_cross() {
   configure_and_build build-libcxx -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/clang-libcxx.cmake -DKF_PLATFORM=posix \
     -DKF_SUPERNOVA=OFF
   echo "cross: both built in $((SECONDS - start)) s"
-  start=$SECONDS
-  # One after the other: side by side, the Wine suites' wall-clock bounds were missed on this
-  # 2-core machine (a board's current off 18 ms after close, bound 10 ms).
-  # Debian's wine64 is not on PATH; as the toolchain file runs it (a prefix of the build's own).
-  local wine64=wine64
-  [ -x /usr/lib/wine/wine64 ] && wine64=/usr/lib/wine/wine64
-  local wine=(env WINEPREFIX="$PWD/build-mingw/wine-prefix" WINEDEBUG=-all WINEDLLOVERRIDES=mscoree,mshtml= "$wine64")
-  rm -f build-mingw/suites.log* build-libcxx/suites.log*
-  run_suites build-mingw build-mingw/suites.log "${wine[@]}" -- "${KF_CROSS_SKIP[@]}" "${KF_WINE_SKIP[@]}"
-  run_suites build-libcxx build-libcxx/suites.log -- "${KF_CROSS_SKIP[@]}"
-  echo "cross: suites ran in $((SECONDS - start)) s"
-  local rc=0 log
-  for log in build-mingw/suites.log.* build-libcxx/suites.log.*; do
+}
+
+# cross_suites <windows|libcxx>: one cross build's three suites (under Wine for windows), each
+# suite's summary, and the logs of any that failed. scripts/test.sh runs each as a test of its
+# final ctest, taking a core as the other busy tests do.
+cross_suites() {
+  local dir runner=() skip=("${KF_CROSS_SKIP[@]}")
+  case $1 in
+    windows)
+      dir=build-mingw
+      # Debian's wine64 is not on PATH; as the toolchain file runs it (a prefix of the build's own).
+      local wine64=wine64
+      [ -x /usr/lib/wine/wine64 ] && wine64=/usr/lib/wine/wine64
+      runner=(env WINEPREFIX="$PWD/build-mingw/wine-prefix" WINEDEBUG=-all WINEDLLOVERRIDES=mscoree,mshtml= "$wine64")
+      skip+=("${KF_WINE_SKIP[@]}") ;;
+    libcxx) dir=build-libcxx ;;
+  esac
+  echo "== cross suites: $1 ($dir/)"
+  local start=$SECONDS log
+  rm -f "$dir"/suites.log*
+  run_suites "$dir" "$dir/suites.log" "${runner[@]}" -- "${skip[@]}"
+  echo "cross: $1 suites ran in $((SECONDS - start)) s"
+  for log in "$dir"/suites.log.*; do
     echo "$log: $(grep -E '^(All tests passed|test cases:)' "$log" | tail -1)"
   done
-  for log in build-mingw/suites.log build-libcxx/suites.log; do
-    if [ -e "$log" ]; then
-      cat "$log" "$log".* >&2
-      rc=1
-    fi
-  done
+  if [ -e "$dir/suites.log" ]; then
+    cat "$dir/suites.log" "$dir"/suites.log.* >&2
+    return 1
+  fi
+}
+
+check_cross() {
+  echo "== cross: Windows build under Wine (build-mingw/), Clang + libc++ with macOS's platform code (build-libcxx/)"
+  cross_build || return 1
+  local rc=0
+  cross_suites windows || rc=1
+  cross_suites libcxx || rc=1
   return "$rc"
 }
 
 check_fuzz() {
-  echo "== fuzzing (build-fuzz/)"
+  echo "== fuzzing (build-asan/)"
   scripts/fuzz.sh "${KF_FUZZ_SECONDS:-20}"
 }
 
@@ -193,13 +227,18 @@ for check in "${checks[@]}"; do
     sclang-lines) check_sclang_lines ;;
     pyflakes) check_pyflakes ;;
     sanitize) check_sanitize ;;
+    sanitize-build) build_sanitized_tests ;;
     fuzz) check_fuzz ;;
     sanitize-plugin) check_sanitize_plugin ;;
     sanitize-plugin-build) build_sanitized_plugin ;;
     sanitize-plugin-findings) sanitized_plugin_findings ;;
     cross) check_cross ;;
+    cross-build) cross_build ;;
+    cross-suites-windows) cross_suites windows ;;
+    cross-suites-libcxx) cross_suites libcxx ;;
     *) echo "unknown check: $check (format, sclang-lines, pyflakes, sanitize, fuzz, sanitize-plugin, cross;" \
-         "sanitize-plugin-build and sanitize-plugin-findings: its two halves around a ctest of scripts/test.sh)" >&2
+         "sanitize-build: sanitize's build alone; sanitize-plugin-build and sanitize-plugin-findings: its two" \
+         "halves around a ctest of scripts/test.sh; cross-build, cross-suites-windows, cross-suites-libcxx: cross's parts)" >&2
        exit 2 ;;
   esac
 done

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (AddressSanitizer + UndefinedBehaviorSanitizer) in
-# build-fuzz/ and runs each for a bounded time on seeds made from the real recordings.
+# build-asan/ and runs each for a bounded time on seeds made from the real recordings.
 # Usage: scripts/fuzz.sh [seconds per target, default 20] [target...]
 # Exit status 1 if any target found a crash, leak, timeout or out-of-memory; its input is left
-# in build-fuzz/artifacts/<target>/ (make it a regression test). The targets run as many at a
+# in build-asan/artifacts/<target>/ (make it a regression test). The targets run as many at a
 # time as there are cores, each on one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,16 +13,11 @@ TARGETS=("$@")
 ((${#TARGETS[@]})) || TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args
                                fuzz_calibration_table)
 
-# clang and its libFuzzer runtime, installed when missing (as scripts/setup.sh does its packages).
-source scripts/packages.sh
-kf_install_missing clang libclang-rt-dev
-BUILD=build-fuzz
-echo "== configuring and building the fuzz targets ($BUILD/)"
-CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKF_FUZZ=ON -DKF_WITH_SC=OFF \
-  -DKF_TESTS=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
-rm -f "$BUILD.configure.log"
-nice cmake --build "$BUILD" -j "$(nproc)" --target "${TARGETS[@]}" make_fuzz_seeds
-
+# The targets are built with the C++ tests in build-asan/ (clang, ASan + UBSan, libFuzzer's
+# coverage: scripts/check.sh sanitize-build), which installs clang when missing.
+BUILD=build-asan
+echo "== building the fuzz targets ($BUILD/)"
+scripts/check.sh sanitize-build
 SEEDS="$BUILD/seeds"
 rm -rf "$SEEDS"
 "$BUILD/tests/fuzz/make_fuzz_seeds" "$SEEDS" tests/data/hid/*.hid

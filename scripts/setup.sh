@@ -31,7 +31,7 @@ PACKAGES=(
   python3-scipy python3-questplus psignifit  # the threshold fit and the study report's t test; their references
   rt-tests
   g++-mingw-w64-x86-64-posix wine64 libc++-dev libc++abi-dev  # scripts/check.sh cross
-  clang libclang-rt-dev  # scripts/fuzz.sh (which installs them itself too; scripts/test.sh kills no apt-get)
+  clang libclang-rt-dev  # build-asan/ (check.sh installs them itself too; scripts/test.sh kills no apt-get)
   qemu-system-x86 linux-image-amd64 busybox-static udev systemd  # tests/kernel: the QEMU guest (python/kfharness/guest.py)
   libaio-dev  # the board gadget (device/board/gadget): FunctionFS through kernel AIO
 )

@@ -2,7 +2,8 @@
 # Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
 # (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
 # fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
-# sanitized plugin's scene and realtime tests (sanitized/...) and every test of build/: Catch2
+# sanitized plugin's scene and realtime tests (sanitized/...), the cross builds' suites (cross/...,
+# under Wine for Windows) and every test of build/: Catch2
 # (dsp, device, host), the NRT scene tests on supernova, the help files, the QEMU guest, the main
 # jobs and the realtime tests against JACK's dummy driver. The scene tests run on scsynth once,
 # against the sanitized plugin, as sanitized/scenes/...: build/'s scenes/... are the same files
@@ -109,7 +110,7 @@ if $quick; then
     --resource-spec-file "$PWD/build/ctest-resources.json" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
-  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross; do
+  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross-build; do
     stage "$check" scripts/check.sh "$check"
   done
   # build/'s tests and the sanitized plugin's scene and realtime tests (sanitized/...) in one
@@ -118,6 +119,13 @@ else
   mkdir -p build/with-sanitized
   printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
     > build/with-sanitized/CTestTestfile.cmake
+  # The cross builds' suites too (scripts/check.sh cross-suites-...), each a busy test of one core
+  # (KF_CORE, tests/CMakeLists.txt): run after their builds, they left a core idle for 96 s. COST:
+  # early, beside the QEMU guest's one core, rather than last (ctest starts costlier tests first).
+  for suites in windows libcxx; do
+    printf 'add_test([=[cross/%s suites]=] "%s" "cross-suites-%s")\n' "$suites" "$PWD/scripts/check.sh" "$suites"
+    printf 'set_tests_properties([=[cross/%s suites]=] PROPERTIES RESOURCE_GROUPS "cores:1" COST 500 TIMEOUT 600)\n' "$suites"
+  done >> build/with-sanitized/CTestTestfile.cmake
   # As many tests at once as the cores and the two realtime chains allow (the resources decide).
   stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 2))" \
     --resource-spec-file "$PWD/build/ctest-resources.json" -E '^scenes/test_' "$@"

@@ -329,7 +329,7 @@ TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> queueS(0.0, 0.0004);
     std::vector<float> out(block), vel(block);
-    double lastCounts = std::floor(x(0.0) / kCountMm), sum = 0.0;
+    double lastCounts = std::floor(x(0.0) / kCountMm);
     int k = 1;
     double nextArrivalS = 0.0, nextDeviceS = kIntervalS;
     auto scheduleNext = [&]() {
@@ -348,7 +348,6 @@ TEST_CASE("TrajectoryReconstructor: 100 ppm drift through DeviceClockMapper, 10 
         const double counts = std::floor(x(nextDeviceS) / kCountMm);
         const double dx = (counts - lastCounts) * kCountMm;
         lastCounts = counts;
-        sum += dx;
         rec.addReport(mapper.map(nextDeviceS, nextArrivalS), dx, 0.0);
         ++k;
         scheduleNext();

@@ -30,7 +30,10 @@ TEST_CASE("force path order: non-finite, clamp, slew, calibration, drive limit, 
   // Calibration: quadratic-ish coil, 0.14 N at rest, 1.4 N at full drive.
   safety.setCalibration(table({{0.0, 0.14}, {0.5, 0.5}, {1.0, 1.4}}));
   double t = 0.0;
-  auto frame = [&](float forceN) { return safety.applyFrame({t += 0.001, forceN}, t); };
+  auto frame = [&](float forceN) {
+    t += 0.001;
+    return safety.applyFrame({t, forceN}, t);
+  };
 
   // 1: NaN is the minimum, which is drive 0.
   CHECK(frame(std::numeric_limits<float>::quiet_NaN()) == 0.14f);
@@ -68,7 +71,8 @@ TEST_CASE("the heat estimate derates a long full drive smoothly, and recovers wh
   int reversals = 0;
   float lastStep = 0.0f;
   for (int i = 0; i < 20000; ++i) {  // 20 s of full force
-    safety.applyFrame({t += 0.001, 1.4f}, t);
+    t += 0.001;
+    safety.applyFrame({t, 1.4f}, t);
     const float drive = safety.driveLevel();
     if (drive < 1.0f && firstDerateS < 0.0) firstDerateS = t;
     const float step = drive - previousDrive;
@@ -86,10 +90,13 @@ TEST_CASE("the heat estimate derates a long full drive smoothly, and recovers wh
   CHECK(reversals <= 2);
   CHECK(safety.commandedForceN() < 1.4f * 0.6f);
   // Off for 10 s (a gap between frames cools the coil): full drive again.
-  safety.applyFrame({t += 0.001, 0.14f}, t);
+  t += 0.001;
+  safety.applyFrame({t, 0.14f}, t);
   CHECK(safety.driveLevel() == 0.0f);
-  safety.applyFrame({t += 10.0, 0.14f}, t);
-  safety.applyFrame({t += 0.001, 1.4f}, t);
+  t += 10.0;
+  safety.applyFrame({t, 0.14f}, t);
+  t += 0.001;
+  safety.applyFrame({t, 1.4f}, t);
   CHECK(safety.driveLevel() == 1.0f);
 }
 

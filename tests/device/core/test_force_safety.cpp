@@ -24,10 +24,15 @@ TEST_CASE("forces are clamped to the device range", "[safety]") {
   ForceSafety safety(spec);
   double timeS = 0.0;
   float commanded = 0.0f;
-  for (int i = 0; i < 10; ++i) commanded = safety.applyFrame({timeS += 0.001, 5.0f}, timeS);
+  for (int i = 0; i < 10; ++i) {
+    timeS += 0.001;
+    commanded = safety.applyFrame({timeS, 5.0f}, timeS);
+  }
   CHECK(commanded == static_cast<float>(spec.maxForceN));
-  CHECK(safety.applyFrame({timeS += 0.001, -1.0f}, timeS) == static_cast<float>(spec.minForceN));
-  CHECK(safety.applyFrame({timeS += 0.001, 0.7f}, timeS) == 0.7f);
+  timeS += 0.001;
+  CHECK(safety.applyFrame({timeS, -1.0f}, timeS) == static_cast<float>(spec.minForceN));
+  timeS += 0.001;
+  CHECK(safety.applyFrame({timeS, 0.7f}, timeS) == 0.7f);
 }
 
 TEST_CASE("force changes are slew limited", "[safety]") {
@@ -38,15 +43,18 @@ TEST_CASE("force changes are slew limited", "[safety]") {
   float previous = static_cast<float>(spec.minForceN);
   int frames = 0;
   for (; frames < 100; ++frames) {
-    const float commanded = safety.applyFrame({timeS += 0.001, 1.4f}, timeS);
+    timeS += 0.001;
+    const float commanded = safety.applyFrame({timeS, 1.4f}, timeS);
     CHECK(commanded - previous <= 0.1f + 1e-6f);
     previous = commanded;
     if (commanded == 1.4f) break;
   }
   CHECK(frames + 1 == 13);  // 1.26 N at 0.1 N per frame
   // Down as well; a longer gap between frames allows a larger step.
-  CHECK(safety.applyFrame({timeS += 0.001, 0.14f}, timeS) == Approx(1.3f));
-  CHECK(safety.applyFrame({timeS += 0.005, 0.14f}, timeS) == Approx(0.8f));
+  timeS += 0.001;
+  CHECK(safety.applyFrame({timeS, 0.14f}, timeS) == Approx(1.3f));
+  timeS += 0.005;
+  CHECK(safety.applyFrame({timeS, 0.14f}, timeS) == Approx(0.8f));
   // The default slew (2000 N/s) passes a full-range jump within one frame.
   ForceSafety fast{DeviceSpec{}};
   CHECK(fast.applyFrame({0.001, 1.4f}, 0.001) == Approx(1.4f));
