@@ -214,11 +214,20 @@ FrictionThreshold {
 	// Ends what a run started (its stimulus, the signal's buffer, the answers' window and
 	// responders), each once: run does it on any way out; call it when run's Routine was stopped.
 	stop {
-		var synth = runSynth, buffer = runBuffer;
-		// One bundle: the buffer goes with the synth that reads it (server.latency from now).
-		(synth ? buffer) !? { |any| any.server.bind { synth !? _.free; buffer !? _.free } };
+		var synth = runSynth, buffer = runBuffer, server = (runSynth ? runBuffer) !? _.server;
 		runSynth = runBuffer = nil;
 		this.prStopAnswers;
+		// One bundle, server.latency from now: the buffer goes with the synth that reads it. Its
+		// number goes back to sclang's allocator once the server has freed it (the bundle's /sync
+		// answered): Buffer.free gives it back at once, and a buffer allocated before the bundle ran
+		// (in a study, another session's recording, side by side) got it and was freed by the bundle.
+		server !? {
+			Routine {
+				server.sync(nil, [synth !? { synth.freeMsg }, buffer !? { [\b_free, buffer.bufnum] }].select(_.notNil),
+					server.latency);
+				buffer !? { buffer.uncache; server.bufferAllocator.free(buffer.bufnum) };
+			}.play(SystemClock)
+		}
 	}
 
 	prStopAnswers {

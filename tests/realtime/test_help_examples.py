@@ -47,6 +47,8 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
   // the force reaches <N> N   device slot 0 commands that force (or more) at some time in the
                                piece's time (polled 20 times a second, from 0.1 s after it starts)
   // the force stays at <N> N  ... and only that force, throughout
+  // the force stays between <A> and <B> N
+                               ... and only forces from A to B, throughout (a crossfade's bound)
   // no jump in the sound      the speakers' sound has no step between two samples in the piece's
                                time from 0.5 s after it starts (its second difference stays under
                                3/4 of its first): a claim for a block's last piece, whose time runs
@@ -322,7 +324,7 @@ files.do { |path, f|
 				// The meter's readings sent before the piece are in before its time starts.
 				if(%(meter)s and: { s.serverRunning }) { s.sync };
 				pieceStart = Main.elapsedTime;
-				if(piece.find("the force reaches").notNil or: { piece.find("the force stays at").notNil }) {
+				if(piece.find("the force reaches").notNil or: { piece.find("the force stays").notNil }) {
 					polled = pollForce.();
 					known.add(polled[1]);  // not one of the piece's routines, to wait for
 				};
@@ -439,6 +441,7 @@ ANNOTATIONS = [
     ("writes", re.compile(r"\bwrites (\S+\.\w+(?: \([^)]*\))?)")),
     ("force reaches", re.compile(r"\bthe force reaches ([-+]?\d+(?:\.\d+)?) N\b")),
     ("force stays at", re.compile(r"\bthe force stays at ([-+]?\d+(?:\.\d+)?) N\b")),
+    ("force stays between", re.compile(r"\bthe force stays between ([-+]?\d+(?:\.\d+)? and [-+]?\d+(?:\.\d+)?) N\b")),
     ("no jump", re.compile(r"\b(no jump) in the sound\b")),
     ("sound", re.compile(r"(?<!\bno )\b(sound) on the outputs\b")),
     ("silence", re.compile(r"\b(silence) on the outputs\b")),
@@ -646,9 +649,12 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                 # Slot 0's commanded force over the piece's time (from 0.1 s after it starts), to the
                 # precision the number is written with.
                 count, least, most = example.forces.get(piece, (0, 0, 0))
-                wanted, tolerance = float(text), precision(text)
-                ok = count > 0 and (most >= wanted - tolerance if kind == "force reaches" else
-                                    wanted - tolerance <= least and most <= wanted + tolerance)
+                low, high = text.split(" and ") if kind == "force stays between" else (text, text)
+                if kind == "force reaches":
+                    ok = most >= float(text) - precision(text)
+                else:
+                    ok = float(low) - precision(low) <= least and most <= float(high) + precision(high)
+                ok = ok and count > 0
                 if not ok:
                     problems.append(f"{example} piece {piece}: // the {kind} {text} N: slot 0 commanded "
                                     f"{least:g} to {most:g} N ({count} readings)")
@@ -889,6 +895,8 @@ fork {
 1 + 1;
 // the force stays at 0.5 N (but it is 0.3 N)
 2 + 2;
+// the force stays between 0.14 and 0.2 N (but it is 0.3 N)
+3 + 3;
 (~kfPush.free; ~kfForce.close;)
 ::
 
@@ -918,6 +926,7 @@ BROKEN = [("BrokenExamples", 0, "FAILURE IN SERVER /n_set Node 99999 not found")
           ("BrokenExamples", 7, "the server has no default group"),
           # (0.3 N commanded, or the floor's 0.14 N in a frame after a watchdog trip on a busy machine)
           ("BrokenGuide", 10, "piece 2: // the force stays at 0.5 N: slot 0 commanded"),
+          ("BrokenGuide", 10, "piece 3: // the force stays between 0.14 and 0.2 N: slot 0 commanded"),
           ("BrokenGuide", 12, "a slot with no device"), ("BrokenGuide", 12, "a node left running")]
 # The meter's claims (the release pass only: METER).
 BROKEN_METER = [("BrokenGuide", 2, "// silence on the outputs: the loudest heard"),

@@ -209,3 +209,27 @@ def test_forces_the_device_cannot_render_are_refused_not_clamped(jack):
     assert sorted(float(f[0]) for f in run.lines("KF-TRIAL-RAN ")) == [0.1, 1.1], run.output[-3000:]
     assert run.lines("KF-NODES ") == [["0"]]
     assert run.lines("KF-ACCEPTED") == [["inRange"]]
+
+
+def test_a_buffer_allocated_as_a_run_ends_keeps_its_number(jack):
+    """An asynchrony experiment's signal buffer is freed with its synth in one bundle,
+    server.latency after the run ends; its number goes back to sclang only once the server has
+    freed it. Buffer.free gave it back at once: a buffer allocated in between (in a study, another
+    session's recording starting, side by side) got the same number and was freed by the bundle,
+    its file left empty (a study job's audio.wav of 0 bytes)."""
+    run = sclang.require_ok(sclang.run_with_server(on_tempo_clock(r"""
+        var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80)), b, info = Condition(false);
+        // After the last trial the run ends: its bundle is sent, then run waits server.latency.
+        // Meanwhile another routine allocates a buffer (10 ms after the trial, before the bundle).
+        var allocate = { fork { 0.01.wait; b = Buffer.alloc(s, 1024, 1) } };
+        FrictionThreshold.asynchrony(FrictionQuestPlus([5, 10], maxTrials: 1), \mapping2, 0.3, 0.2, 0.05, seed: 7)
+            .run(dev, FrictionObserver(15, 3.5, 0.02, seed: 8), allocate);
+        s.sync;
+        0.3.wait;  // the run's bundle has run
+        b.updateInfo({ info.test = true; info.signal });
+        info.wait;
+        "KF-AFTER-RUN %".format(b.numFrames).postln;
+        b.free;
+        dev.close;
+    """), jack, name="threshold-buffer", timeout=120))
+    assert run.lines("KF-AFTER-RUN ") == [["1024"]], run.output[-3000:]
