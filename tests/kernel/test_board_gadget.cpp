@@ -119,6 +119,22 @@ std::string hostOutcomes(const CountingPort& port, const std::vector<GadgetFrame
   return text;
 }
 
+// The set-points the gadget did not receive whose transfers the host saw complete: each lost one
+// must be one the host knows it lost (a stall or a time-out). Counting the host's stalls instead
+// raced on the guest's one CPU: a second stall of the set-point endpoint was counted after the test
+// had read that endpoint's count, so as the status endpoint's (a fresh clone, 5 missing against 4).
+long lostUnseen(const CountingPort& port, const std::vector<GadgetFrame>& applied) {
+  const auto outcomes = port.setPoints();
+  long unseen = 0;
+  for (size_t i = 1; i < applied.size(); ++i)
+    for (uint16_t seq = applied[i - 1].sequence + 1; seq != applied[i].sequence; ++seq)
+      if (std::none_of(outcomes.begin(), outcomes.end(), [&](const CountingPort::SetPointOutcome& o) {
+            return o.sequence == seq && o.status != usb::TransferStatus::kCompleted;
+          }))
+        ++unseen;
+  return unseen;
+}
+
 std::string describeCounts(const CountingPort::Counts& c) {
   return "submitted " + std::to_string(c.submitted) + ", called back " + std::to_string(c.calledBack) + " (cancelled " +
          std::to_string(c.cancelled) + ", no device " + std::to_string(c.noDevice) + "), in flight at close " +
@@ -435,10 +451,10 @@ TEST_CASE("board gadget: a halted endpoint is cleared by the host, and set-point
   reportFigure("board gadget halt", figures);
   CHECK(afterOut > 20);  // the board received them: the set-points went on after the halt
   CHECK(statusesAfterIn > 0);
-  // The set-points lost are those whose transfers stalled, no others.
+  // The set-points lost are those whose transfers stalled or timed out, no others.
   INFO("halts at " << haltOutNs / 1000000 << " and " << haltInNs / 1000000 << " ms; jumps:" << sequences.where);
   INFO("the host's side of the missing ones:" << hostOutcomes(*host.port, applied));
-  CHECK(sequences.missing <= static_cast<long>(outStalls + after.lostTransfers - before.lostTransfers));
+  CHECK(lostUnseen(*host.port, applied) == 0);
   CHECK(sequences.duplicates == 0);
   CHECK(after.connected);
   CHECK(after.status.state == board::BoardState::kArmed);
