@@ -122,8 +122,9 @@ else
   # The cross builds' suites too (scripts/check.sh cross-suites-...), each a busy test of one core
   # (KF_CORE, tests/CMakeLists.txt): run after their builds, they left a core idle for 96 s. After
   # the QEMU guest (DEPENDS orders, whatever its result): Wine's server and the suites' threads
-  # are more than the one busy test the guest is measured to hold beside it (tests/kernel), and the
-  # guest took 188 s with the Windows suites beside it, against 132 s in the fresh clone before.
+  # are more than the one busy test the guest is measured to hold beside it (tests/kernel); the
+  # guest took 188 s with the Windows suites beside it, 132 to 161 s without them in fresh clones
+  # (how much of that is the suites' and how much the machine's speed was not measured apart).
   # COST: right after it, rather than last (ctest starts costlier tests first).
   for suites in windows libcxx; do
     printf 'add_test([=[cross/%s suites]=] "%s" "cross-suites-%s")\n' "$suites" "$PWD/scripts/check.sh" "$suites"
