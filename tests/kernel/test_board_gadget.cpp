@@ -187,7 +187,18 @@ TEST_CASE("board gadget: opened through libusb by its identity and serial, never
   CHECK(t.lastClear.remaining == 0);
   // The status frames after it no longer carry it (the first one read may be up to a tick old,
   // built before CLEAR_ERRORS).
-  CHECK(waitUntil([&] { return host.telemetry().haveStatus && host.telemetry().status.errors == 0; }, kGuardS));
+  CHECK(waitUntil(
+      [&] { return host.telemetry().haveStatus && (host.telemetry().status.errors & board::kErrUsbReset) == 0; },
+      kGuardS));
+  // Nor any other error but the one the host's own counts explain: the idle set-points stream from
+  // open, and on a slow guest one whose transfer the host gave up on (lostTransfers) leaves a jump
+  // in sequence the board flags until the next CLEAR_ERRORS. (A fresh clone at 85c5ca9 saw the
+  // errors stay non-zero for the whole 10 s when this asked for none at all.)
+  const BoardTelemetry cleared = host.telemetry();
+  INFO("status errors 0x" << std::hex << cleared.status.errors << std::dec << ", host lost " << cleared.lostTransfers
+                          << " transfers");
+  CHECK((cleared.status.errors & ~board::kErrSequenceGap) == 0);
+  if (cleared.status.errors & board::kErrSequenceGap) CHECK(cleared.lostTransfers > 0);
   CHECK(host.telemetry().status.state == board::BoardState::kDisarmed);
 
   // Held by one program, it is busy for another (libusb's claim), and nothing is detached.
