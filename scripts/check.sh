@@ -86,7 +86,8 @@ configure_and_build() {
 # reverse). One build instead of two (g++ for the tests, clang for the fuzz targets): 188 s and
 # 368 CPU-s from nothing against about 250 s for the tests' alone, with the fuzz build's 60 s
 # gone; the tests take 79 s instead of 58 (clang's -O1 and the coverage counters). build/ runs the
-# same tests at -O3 with g++, and build-asan-plugin/ compiles dsp/ and device/ under g++'s ASan.
+# same tests on the code built at -O3 by g++ (tests/CMakeLists.txt), and build-asan-plugin/
+# compiles dsp/ and device/ under g++'s ASan.
 build_sanitized_tests() {
   source scripts/packages.sh
   kf_install_missing clang libclang-rt-dev
