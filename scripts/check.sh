@@ -106,10 +106,12 @@ check_sanitize() {
 }
 
 # The plugin under ASan + UBSan, its scene and realtime tests registered as sanitized/... with
-# the environment their servers need (tests/CMakeLists.txt); the finding logs emptied.
+# the environment their servers need (tests/CMakeLists.txt); the finding logs emptied. At -O1, as
+# build-asan/ and for the same reason; the plugin's files compiled in 124 CPU-s against 190 at -O3.
 build_sanitized_plugin() {
   echo "== the plugin under ASan + UBSan (build-asan-plugin/)"
-  configure_and_build build-asan-plugin -DKF_SANITIZE=address,undefined -DKF_SUPERNOVA=OFF -- --target KineticFriction
+  configure_and_build build-asan-plugin -DKF_SANITIZE=address,undefined -DKF_SUPERNOVA=OFF \
+    -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -DNDEBUG" -- --target KineticFriction
   rm -rf build-asan-plugin/sanitizer-logs && mkdir -p build-asan-plugin/sanitizer-logs
 }
 
