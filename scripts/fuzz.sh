@@ -1,37 +1,26 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (AddressSanitizer + UndefinedBehaviorSanitizer) in
 # build-asan/ and runs each for a bounded time on seeds made from the real recordings.
-# Usage: scripts/fuzz.sh [--built] [seconds per target, default KF_FUZZ_SECONDS or 20] [target...]
-#        scripts/fuzz.sh --list   (the targets, one per line)
-#   --built  runs what build-asan/ holds without building (scripts/test.sh runs each target so,
-#            as a test of its final ctest, after building build-asan/ once)
+# Usage: scripts/fuzz.sh [seconds per target, default 20] [target...]
 # Exit status 1 if any target found a crash, leak, timeout or out-of-memory; its input is left
 # in build-asan/artifacts/<target>/ (make it a regression test). The targets run as many at a
 # time as there are cores, each on one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-ALL_TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args fuzz_calibration_table)
-if [ "${1:-}" = --list ]; then
-  printf '%s\n' "${ALL_TARGETS[@]}"
-  exit 0
-fi
-build=true
-if [ "${1:-}" = --built ]; then
-  build=false
-  shift
-fi
-SECONDS_PER_TARGET="${1:-${KF_FUZZ_SECONDS:-20}}"
+SECONDS_PER_TARGET="${1:-20}"
 shift || true
 TARGETS=("$@")
-((${#TARGETS[@]})) || TARGETS=("${ALL_TARGETS[@]}")
+((${#TARGETS[@]})) || TARGETS=(fuzz_hid_descriptor fuzz_hid_recorder fuzz_session_file fuzz_command_args
+                               fuzz_calibration_table)
 
 # The targets are built with the C++ tests in build-asan/ (clang, ASan + UBSan, libFuzzer's
 # coverage: scripts/check.sh sanitize-build), which installs clang when missing.
 BUILD=build-asan
-if $build; then
-  echo "== building the fuzz targets ($BUILD/)"
-  scripts/check.sh sanitize-build
-fi
+echo "== building the fuzz targets ($BUILD/)"
+scripts/check.sh sanitize-build
+SEEDS="$BUILD/seeds"
+rm -rf "$SEEDS"
+"$BUILD/tests/fuzz/make_fuzz_seeds" "$SEEDS" tests/data/hid/*.hid
 
 declare -A SEED_DIR=([fuzz_hid_descriptor]=hid_descriptor [fuzz_hid_recorder]=hid_recorder
                      [fuzz_session_file]=session_file [fuzz_command_args]=command_args
@@ -39,14 +28,11 @@ declare -A SEED_DIR=([fuzz_hid_descriptor]=hid_descriptor [fuzz_hid_recorder]=hi
 declare -A MAX_LEN=([fuzz_hid_descriptor]=4096 [fuzz_hid_recorder]=16384
                     [fuzz_session_file]=16384 [fuzz_command_args]=4096 [fuzz_calibration_table]=4096)
 # fuzz <target>: runs it for SECONDS_PER_TARGET on one core; its log in $BUILD/<target>.log.
-# Each target's seeds in a folder of its own: targets run as separate tests may start together.
 fuzz() {
-  local target=$1 corpus="$BUILD/corpus/$1" artifacts="$BUILD/artifacts/$1" seeds="$BUILD/seeds/$1"
-  mkdir -p "$corpus" "$artifacts" "$BUILD/seeds"
-  rm -rf "$seeds"
-  "$BUILD/tests/fuzz/make_fuzz_seeds" "$seeds" tests/data/hid/*.hid
+  local target=$1 corpus="$BUILD/corpus/$1" artifacts="$BUILD/artifacts/$1"
+  mkdir -p "$corpus" "$artifacts"
   # -rss_limit_mb and -timeout: unbounded memory or work is a finding, not a hang of the run.
-  "$BUILD/tests/fuzz/$target" "$corpus" "$seeds/${SEED_DIR[$target]}" \
+  "$BUILD/tests/fuzz/$target" "$corpus" "$SEEDS/${SEED_DIR[$target]}" \
     -max_total_time="$SECONDS_PER_TARGET" -max_len="${MAX_LEN[$target]}" -timeout=10 -rss_limit_mb=1024 \
     -artifact_prefix="$artifacts/" -print_final_stats=1 > "$BUILD/$target.log" 2>&1
 }

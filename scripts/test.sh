@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # Every test, in stages: set-up (scripts/setup.sh --all), the checks CI enforces
-# (scripts/check.sh: format, pyflakes, the build without SuperCollider under ASan+UBSan with the
-# fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest that
-# build's C++ tests (sanitized/dsp/..., device/, host/) and fuzz targets (sanitized/fuzz/...), the
+# (scripts/check.sh: format, pyflakes, the C++ tests under ASan+UBSan without SuperCollider, the
+# fuzz targets, the plugin built with both sanitizers, the cross builds), then in one ctest the
 # sanitized plugin's scene and realtime tests (sanitized/...), the cross builds' suites (cross/...,
 # under Wine for Windows) and every test of build/: Catch2
 # (dsp, device, host), the NRT scene tests on supernova, the help files, the QEMU guest, the main
@@ -113,23 +112,15 @@ if $quick; then
     --resource-spec-file "$PWD/build/ctest-resources.json" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
-  for check in format pyflakes sanitize-build sanitize-plugin-build cross-build; do
+  for check in format pyflakes sanitize fuzz sanitize-plugin-build cross-build; do
     stage "$check" scripts/check.sh "$check"
   done
-  # build/'s tests, the sanitized plugin's scene and realtime tests (sanitized/...) and build-asan/'s
-  # C++ suites (sanitized/dsp/..., as scripts/check.sh sanitize runs them) in one ctest, so that
-  # the two builds' realtime chains run side by side and the CPU-bound tests of any fill the cores
-  # beside them: a folder whose CTestTestfile names them all. (Run as stages of their own, build-asan/'s
-  # suites and the fuzz targets kept 29 % and 22 % of the cores idle, 73 s and 65 s in a fresh
-  # clone at 404f0f6: the suites wait on their threads' clocks, five targets on two cores.)
+  # build/'s tests and the sanitized plugin's scene and realtime tests (sanitized/...) in one
+  # ctest, so that the two builds' realtime chains run side by side and the CPU-bound tests of
+  # either fill the cores beside them: a folder whose CTestTestfile names both.
   mkdir -p build/with-sanitized
-  printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan" "$PWD/build-asan-plugin/tests/scenes" \
-    "$PWD/build-asan-plugin/tests/realtime" > build/with-sanitized/CTestTestfile.cmake
-  # Each fuzz target for KF_FUZZ_SECONDS (scripts/check.sh fuzz), a busy test of one core.
-  for target in $(scripts/fuzz.sh --list); do
-    printf 'add_test([=[sanitized/fuzz/%s]=] "%s" --built "" %s)\n' "$target" "$PWD/scripts/fuzz.sh" "$target"
-    printf 'set_tests_properties([=[sanitized/fuzz/%s]=] PROPERTIES RESOURCE_GROUPS "cores:1" TIMEOUT 300)\n' "$target"
-  done >> build/with-sanitized/CTestTestfile.cmake
+  printf 'subdirs("%s")\n' "$PWD/build" "$PWD/build-asan-plugin/tests/scenes" "$PWD/build-asan-plugin/tests/realtime" \
+    > build/with-sanitized/CTestTestfile.cmake
   # The cross builds' suites too (scripts/check.sh cross-suites-...), each a busy test of one core
   # (KF_CORE, tests/CMakeLists.txt): run after their builds, they left a core idle for 96 s. After
   # the QEMU guest (DEPENDS orders, whatever its result): Wine's server and the suites' threads
