@@ -3,8 +3,8 @@ and each threshold experiment to 24 trials of 0.2 s intervals. It sets up, build
 study and its threshold part with five simulated participants side by side on a realtime server,
 and writes the sessions and the report (FrictionStudy.report, from sclang) into KF_STUDY_JOB_OUT.
 The test checks the sessions, the report's figures (PNG) and tables (CSV) against the sessions,
-the binds statistic (where it measures, and its test), and the threshold fits against the model
-observers' known thresholds."""
+the binds statistic (where it measures, and its test), the puck held where friction is raised,
+and the threshold fits against the model observers' known thresholds."""
 import os
 import shutil
 import subprocess
@@ -191,11 +191,36 @@ def check_binds():
         d = np.array([float(p["speed_off"]) - float(p["speed_on"]) for p in pairs if p["mapping"] == mapping])
         t = d.mean() / (d.std(ddof=1) / np.sqrt(len(d)))
         assert int(test["n"]) == 5 and abs(float(test["t"]) - t) < 1e-9 * abs(t), (mapping, test, t)
-    # Mapping 1's 6 mm of 0.5 N bind every simulated participant's typical speed there (the
-    # participants learn a constant resistance within 2 to 4 s, but each crossing of the fragment
-    # is shorter than that). Mapping 3's bumps are another matter (stick and slip: released past a
-    # peak, the puck slides fast to the next), so no sign is asserted there.
-    assert float(tests["mapping1"]["mean_difference"]) > 0, tests["mapping1"]
+    # No sign is asserted of the typical speeds' difference: in these 3 s explorations it is not
+    # the friction's to decide. A participant's intended speed steps up every 0.5 s whether or not
+    # the puck moves, so one held at the fragment crosses it later, in a faster step: mapping 1's
+    # difference was negative for P5 in all of six runs (fresh clones 19 to 23 and one more at
+    # e64f5f0: -2.1 to -5.2 mm/s), for P4 in two (down to -10.5), and its mean over the five once
+    # (-1.15). That the friction binds the puck is checked where it does: check_held.
+    check_held()
+
+
+def check_held():
+    """Where mappings 1 and 2 raise the friction (0.5 N against the 0.14 N of friction off), the
+    puck stands still longer with friction on, for every participant: its push rises by maxPushN
+    per adaptS (0.43 to 0.94 N/s for these five) until the puck slides, so passing 0.5 N rather
+    than 0.14 N holds it about 0.4 to 0.8 s more. Measured over six runs (the ones named above),
+    the time standing still in the raised parts rose by 0.29 s at the least (mapping 2, P4: 0.05
+    to 0.34 s) and 0.33 to 0.79 s in all; at least 0.15 s, half the least, is asserted. Mapping 3
+    raises its friction in bumps, and the puck also stands still between them, so none there."""
+    import pandas as pd
+    from kfstudy import report_statistics, report_tables
+    samples = report_tables.load(OUT / "sessions").samples
+    parts = pd.read_csv(OUT / "binds-parts.csv")
+    parts["part"] = parts.groupby("mapping").cumcount()
+    parts["raised"] = parts.raised.fillna(False).astype(bool)
+    still = samples[report_statistics.where_raised(samples, parts) & (samples.v_mm_s.astype(float) == 0)]
+    # Samples are the mouse's reports, 125 a second.
+    held_s = still.groupby([still.mapping, still.participant, still.friction.astype(bool)]).size() / 125
+    for mapping in ("mapping1", "mapping2"):
+        for participant in ("P1", "P2", "P3", "P4", "P5"):
+            off, on = (held_s.get((mapping, participant, friction), 0.0) for friction in (False, True))
+            assert on >= off + 0.15, (mapping, participant, off, on, frame_rates())
 
 
 def check_threshold_fits(sessions, report):
