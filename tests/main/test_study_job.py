@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import bids_check, paths
+from kfharness import bids_check, paths, profile
 from kfstudy import bids, psychometric, readers, session_folder
 
 OUT = Path(os.environ["KF_STUDY_JOB_OUT"])
@@ -206,8 +206,8 @@ def check_held():
     per adaptS (0.43 to 0.94 N/s for these five) until the puck slides, so passing 0.5 N rather
     than 0.14 N holds it about 0.4 to 0.8 s more. Measured over six runs (the ones named above),
     the time standing still in the raised parts rose by 0.29 to 0.73 s (the least: mapping 2, P4,
-    0.05 to 0.34 s); at least 0.15 s, half the least, is asserted. Mapping 3
-    raises its friction in bumps, and the puck also stands still between them, so none there."""
+    0.05 to 0.34 s); at least 0.15 s, half the least, is asserted. Mapping 3 raises its friction
+    in bumps, and the puck also stands still between them, so none there."""
     import pandas as pd
     from kfstudy import report_statistics, report_tables
     samples = report_tables.load(OUT / "sessions").samples
@@ -215,8 +215,9 @@ def check_held():
     parts["part"] = parts.groupby("mapping").cumcount()
     parts["raised"] = parts.raised.fillna(False).astype(bool)
     still = samples[report_statistics.where_raised(samples, parts) & (samples.v_mm_s.astype(float) == 0)]
-    # Samples are the mouse's reports, 125 a second.
-    held_s = still.groupby([still.mapping, still.participant, still.friction.astype(bool)]).size() / 125
+    # A sample per mouse report.
+    held_s = (still.groupby([still.mapping, still.participant, still.friction.astype(bool)]).size()
+              / profile.device()["updateRateHz"])
     for mapping in ("mapping1", "mapping2"):
         for participant in ("P1", "P2", "P3", "P4", "P5"):
             off, on = (held_s.get((mapping, participant, friction), 0.0) for friction in (False, True))
