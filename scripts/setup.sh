@@ -45,7 +45,7 @@ fi
 # build/KineticFriction whatever an earlier configure cached (README's -DKF_EXTENSION_DIR=user).
 configure=(-DCMAKE_BUILD_TYPE=Release -DKF_EXTENSION_DIR="$PWD/build/KineticFriction")
 if $all; then
-  configure+=(-DKF_TESTS=ON -DKF_SUPERNOVA=ON)
+  configure+=(-DKF_TESTS=ON -DKF_SUPERNOVA=ON -DCMAKE_UNITY_BUILD=ON)  # unity: scripts/check.sh configure_and_build
 elif [ ! -e build/CMakeCache.txt ]; then
   configure+=(-DKF_TESTS=OFF -DKF_SUPERNOVA=OFF)  # kept as they are in a build/ set up --all
 fi

@@ -17,7 +17,7 @@ bool allDigits(const std::string& text) {
   return true;
 }
 
-bool parseHexId(const std::string& text, uint16_t& out) {
+bool parseSelectorHexId(const std::string& text, uint16_t& out) {
   if (text.empty() || text.size() > 4) return false;
   char* end = nullptr;
   const unsigned long value = std::strtoul(text.c_str(), &end, 16);
@@ -79,9 +79,9 @@ bool selectMouse(std::vector<MouseInfo> mice, const std::string& which, MouseInf
   const size_t colon = ids.find(':');
   const size_t second = colon == std::string::npos ? std::string::npos : ids.find(':', colon + 1);
   uint16_t vendorId = 0, productId = 0;
-  if (colon == std::string::npos || !parseHexId(ids.substr(0, colon), vendorId) ||
-      !parseHexId(ids.substr(colon + 1, second == std::string::npos ? std::string::npos : second - colon - 1),
-                  productId)) {
+  if (colon == std::string::npos || !parseSelectorHexId(ids.substr(0, colon), vendorId) ||
+      !parseSelectorHexId(ids.substr(colon + 1, second == std::string::npos ? std::string::npos : second - colon - 1),
+                          productId)) {
     error = "cannot read the mouse selector '" + which +
             "': give an index, a device path, or VVVV:PPPP[:serial] or VVVV:PPPP@port in hex";
     return false;

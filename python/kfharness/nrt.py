@@ -4,7 +4,7 @@ import os
 import subprocess
 import time
 
-from . import paths, sclang
+from . import paths, sclang, sclang_session
 from kfstudy import readers
 
 
@@ -60,8 +60,8 @@ def score_and_render(name, score_code, sample_rate=48000, channels=1, **render_a
     scsynth output)."""
     score_path = paths.work_dir() / f"{name}.osc"
     wav_path = paths.work_dir() / f"{name}-render.wav"
-    sclang.run_script(f"var score;\n{score_code.strip().rstrip(';')};\n"
-                      f"score.writeOSCFile({sclang.sc_string(score_path)});", name=name)
+    sclang_session.shared().run(f"var score;\n{score_code.strip().rstrip(';')};\n"
+                                f"score.writeOSCFile({sclang.sc_string(score_path)});")
     log = render(score_path, wav_path, sample_rate, channels, **render_args)
     data, rate = readers.read_wav(wav_path)
     assert rate == sample_rate

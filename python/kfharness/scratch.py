@@ -6,10 +6,11 @@ of one's own: it is left as it is."""
 import os
 import shutil
 
-from . import paths
+from . import paths, sclang_session
 
 
 def pytest_sessionfinish(session, exitstatus):
+    sclang_session.stop_shared()  # it runs in the scratch folder
     if os.environ.get("KF_TEST_WORK_DIR") or paths.work_dir.cache_info().currsize == 0:
         return  # a folder of one's own, or none made
     if exitstatus == 0:

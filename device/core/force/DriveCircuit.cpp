@@ -12,8 +12,8 @@ namespace kf {
 
 namespace {
 
-constexpr const char* kHeader = "kf-drive";
-constexpr int kVersion = 1;
+constexpr const char* kDriveHeader = "kf-drive";
+constexpr int kDriveVersion = 1;
 constexpr uint64_t kMaxFileBytes = 64 * 1024;  // a dozen lines; anything larger is not one
 constexpr size_t kMaxLineChars = 1024;
 
@@ -53,7 +53,7 @@ double DriveCircuit::sampleForDrive(double driveLevel) const {
 }
 
 bool DriveCircuit::parse(const std::string& text, DriveCircuit& out, std::string& magnetTablePath, std::string& error) {
-  TableLines lines(text, kHeader, kVersion, "drive format");
+  TableLines lines(text, kDriveHeader, kDriveVersion, "drive format");
   std::istringstream fields;
   std::string key;
   bool seen[kNumFields] = {};

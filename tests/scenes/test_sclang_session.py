@@ -1,0 +1,37 @@
+"""The harness's shared sclang (kfharness.sclang_session), which writes every scene's Score: each
+piece's output is its own, a failing piece fails its test with sclang's error and leaves the next
+one working, a piece's environment does not reach the next, and a session whose sclang is gone
+starts again."""
+import pytest
+
+from kfharness.sclang_session import SclangSession
+
+
+@pytest.fixture
+def session():
+    s = SclangSession(name="session-test")
+    yield s
+    s.stop()
+
+
+def test_each_piece_gets_its_own_output_and_environment(session):
+    first = session.run('"piece one %".format(1 + 1).postln; ~left = 7;')
+    second = session.run('"piece two sees %".format(~left).postln;')
+    assert "piece one 2" in first and "piece two" not in first
+    assert "piece two sees nil" in second and "piece one" not in second
+
+
+def test_an_error_fails_its_piece_only(session):
+    with pytest.raises(AssertionError, match=r"(?s)piece 0: error.*Message 'notAMethod' not understood"):
+        session.run("1.notAMethod;")
+    with pytest.raises(AssertionError, match="piece 1: syntax-error"):
+        session.run("(1 + ;")
+    assert "after 3" in session.run('"after %".format(1 + 2).postln;')
+
+
+def test_a_session_whose_sclang_ended_starts_again(session):
+    session.run("1;")
+    first = session.proc.pid
+    session.stop()
+    assert "again" in session.run('"again".postln;')
+    assert session.proc.pid != first
