@@ -110,7 +110,12 @@ class SclangRun:
         return "KF-SCRIPT-OK" in self.output and self.returncode == 0
 
     def lines(self, tag):
-        """The fields after `tag` on every line that starts with it."""
+        """The fields after `tag` on every line that starts with it. A tagged line that may meet
+        the server's posts is best posted in one write, `"TAG %\\n".postf(...)`: sclang 3.13's
+        postln writes the text, then the line break (seen with strace), and the server's output,
+        which reaches the same log, can land between them: "KF-POS 0 0 0 0.0FrictionMouseIn: no
+        device is open at index 0", then an empty line (two tests failed so in a fresh clone at
+        4908f79)."""
         return [line[len(tag):].split() for line in self.output.splitlines() if line.startswith(tag)]
 
     def error_lines(self):

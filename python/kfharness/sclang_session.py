@@ -2,9 +2,10 @@
 sclang start compiles the whole class library and starts Qt WebEngine (about 0.8 CPU-s here), and
 a scene test file writes up to a dozen Scores. Each piece is compiled on its own and runs in an
 Environment of its own, so that its variables and `~names` do not reach the next; what it leaves in
-class variables does (a FrictionDevice slot, a SynthDef in the library), so only code that writes
-a Score, and depends on nothing a fresh interpreter has that this one may not, runs here
-(nrt.score_and_render); the rest still starts sclang of its own (sclang.run_script).
+class variables does (a FrictionDevice slot, a SynthDef in the library), so only code that depends
+on nothing a fresh interpreter has and this one may not runs here: every Score nrt.score_and_render
+writes, and the scene tests' checks of classes without a server (`run`); what needs an environment,
+a HOME or a class library of its own still starts sclang of its own (sclang.run_script).
 
 The protocol is files in a folder of the session's: the harness writes <n>.scd, then <n>.go; sclang,
 polling every 10 ms on AppClock, runs it, posts its output between KF-REQUEST-BEGIN <n> and
@@ -151,3 +152,9 @@ def shared():
 def stop_shared():
     if _shared is not None:
         _shared.stop()
+
+
+def run(code, timeout=120):
+    """`code` run by this process's session: for code that, like a Score's, depends on nothing a
+    fresh interpreter has and this one may not (see above)."""
+    return shared().run(code, timeout)

@@ -76,7 +76,7 @@ def test_the_looped_drive_is_the_commanded_force_and_zero_after_free_cmd_period_
         s.sync;
         s.quit;
         1.0.wait;
-        "KF-DONE".postln;
+        "KF-DONE\n".post;
     """, jack, name="driveloop", server_options={"numOutputBusChannels": 3}))
     assert "KF-DONE" in run.output and "FrictionDrive:" not in run.output, run.output[-3000:]
 

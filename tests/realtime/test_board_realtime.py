@@ -19,7 +19,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         var dev, hold, phase = {{ |name|
             3.do {{ dev.status; s.sync; 0.05.wait }};
             0.05.wait;
-            ("KF-PHASE " ++ name).postln
+            ("KF-PHASE " ++ name ++ "\n").post
         }};
         dev = FrictionDevice.sim(s, 5);
         s.sync;
@@ -34,7 +34,7 @@ def test_emulated_board_follows_arming_calibration_and_the_watchdog(jack):
         phase.(\\armed);
         dev.boardStatus {{ |e|
             ("KF-BOARD-STATUS " ++ [e.hasBoard, e.connected, e.armed, e.boardState, e.currentLevel.round(0.001),
-                                    e.setPointsSent > 100, e.forceRateHz.asInteger]).postln
+                                    e.setPointsSent > 100, e.forceRateHz.asInteger] ++ "\n").post
         }};
         0.2.wait;
         FrictionCalibration([[0, 0.14], [0.25, 0.77], [1, 1.4]], "KF-EMU-0001").write({sclang.sc_string(table)});

@@ -84,8 +84,8 @@ def test_every_malformed_command_gets_one_answer_and_the_server_renders_on(jack)
             answers.clear;
             s.listSendMsg(['/cmd'] ++ msg);
             s.sync;
-            "KF-ANSWERS % %".format(i, answers.size).postln;
-            answers.do { |a| "KF-ANSWER % % % %".format(i, a[0], a[2], a[3].replace("\n", " ")).postln };
+            "KF-ANSWERS % %\n".postf(i, answers.size);
+            answers.do { |a| "KF-ANSWER % % % %\n".postf(i, a[0], a[2], a[3].replace("\n", " ")) };
         };
         s.listSendMsg(['/cmd', \kfOpenSim, 0, -1, 0]);
         s.sync;
@@ -95,20 +95,20 @@ def test_every_malformed_command_gets_one_answer_and_the_server_renders_on(jack)
         synth = { SendReply.kr(Impulse.kr(100), '/kfAlive', SinOsc.ar(440)); Silent.ar }.play;
         0.5.wait;
         synth.free;
-        "KF-ALIVE %".format(alive).postln;
+        "KF-ALIVE %\n".postf(alive);
         // FrictionDevice raises the server's reason, not a time-out.
         dev = FrictionDevice.sim(s, 1);
-        try { dev.record("/tmp/" ++ String.fill(5000, $x)) } { |e| "KF-RAISED record %".format(e.errorString).postln };
-        try { dev.arm } { |e| "KF-RAISED arm %".format(e.errorString).postln };
-        try { dev.addBoard("NO-SUCH-BOARD") } { |e| "KF-RAISED addBoard %".format(e.errorString).postln };
+        try { dev.record("/tmp/" ++ String.fill(5000, $x)) } { |e| "KF-RAISED record %\n".postf(e.errorString) };
+        try { dev.arm } { |e| "KF-RAISED arm %\n".postf(e.errorString) };
+        try { dev.addBoard("NO-SUCH-BOARD") } { |e| "KF-RAISED addBoard %\n".postf(e.errorString) };
         dev.close;
         s.sync;
         // A refused statusValues leaves no responder awaiting a /kfStatus that will not come.
         // kfStatus answers every slot, open or not, so the object is made to name slot 16.
         dev.instVarPut(\index, 16);
-        try { dev.statusValues { "KF-STATUS-CAME".postln } } { |e| "KF-RAISED status %".format(e.errorString).postln };
-        "KF-STATUS-RESPONDERS %".format(OSCFunc.allFuncProxies.values.flatten.count { |f|
-            f.respondsTo(\path) and: { f.path == '/kfStatus' } }).postln;
+        try { dev.statusValues { "KF-STATUS-CAME\n".post } } { |e| "KF-RAISED status %\n".postf(e.errorString) };
+        "KF-STATUS-RESPONDERS %\n".postf(OSCFunc.allFuncProxies.values.flatten.count { |f|
+            f.respondsTo(\path) and: { f.path == '/kfStatus' } });
     """, jack, name="answers", timeout=240))
     counts = {int(f[0]): int(f[1]) for f in run.lines("KF-ANSWERS ")}
     answers = {}

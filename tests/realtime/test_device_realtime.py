@@ -39,8 +39,8 @@ s.sync;
 """
 
 POS_DUMP = r"""
-~posLog.do { |row| ("KF-POS " ++ row.collect { |v| v.asStringPrec(10) }.join(" ")).postln };
-~forceLog.do { |row| ("KF-FORCE " ++ row.collect { |v| v.asStringPrec(10) }.join(" ")).postln };
+~posLog.do { |row| ("KF-POS " ++ row.collect { |v| v.asStringPrec(10) }.join(" ") ++ "\n").post };
+~forceLog.do { |row| ("KF-FORCE " ++ row.collect { |v| v.asStringPrec(10) }.join(" ") ++ "\n").post };
 """
 
 
@@ -62,11 +62,11 @@ def test_sim_device_moves_the_puck_and_receives_the_force(jack):
         s.sync;
         dev.record({sclang.sc_string(record)});
         s.sync;
-        "KF-OPENED %".format(Main.elapsedTime - ~t0).postln;
+        "KF-OPENED %\n".postf(Main.elapsedTime - ~t0);
         2.5.wait;
         // Frames stop without an orderly stop (the synth paused, as when the audio side dies):
         // the watchdog must drive the magnet off ~10 ms later.
-        "KF-FREE-FORCE %".format(Main.elapsedTime - ~t0).postln;
+        "KF-FREE-FORCE %\n".postf(Main.elapsedTime - ~t0);
         force.run(false);
         // Until the bus shows the puck at rest again, 3 mm or more further on (at most 5 s), not
         // a fixed 0.5 s: the bus follows the audio clock, which without realtime scheduling beside
@@ -81,7 +81,7 @@ def test_sim_device_moves_the_puck_and_receives_the_force(jack):
         0.05.wait;
         dev.status;
         s.sync;
-        "KF-CLOSING %".format(Main.elapsedTime - ~t0).postln;
+        "KF-CLOSING %\n".postf(Main.elapsedTime - ~t0);
         dev.close;
         s.sync;
         0.2.wait;
@@ -280,7 +280,7 @@ def test_quitting_the_server_turns_the_magnet_off(jack):
         Synth(\\kfForceOnly);
         s.sync;
         1.0.wait;
-        "KF-QUITTING".postln;
+        "KF-QUITTING\n".post;
         // The device stays open; quitting the server must close it.
         s.quit;
         50.do {{ if(s.serverRunning) {{ 0.1.wait }} }};

@@ -66,10 +66,10 @@ def signal_each_in_turn(jack, signal_numbers, records):
                 while {{ waited < 10 and: {{ ("kill -0 " ++ pid ++ " 2>/dev/null").systemCmd == 0 }} }} {{
                     0.1.wait; waited = waited + 0.1;
                 }};
-                "KF-GONE % % %".format(signal, waited, pid).postln;
+                "KF-GONE % % %\n".postf(signal, waited, pid);
             }} {{ |error|
                 error.reportError;
-                "KF-SIGNAL-ERROR %".format(signal).postln;
+                "KF-SIGNAL-ERROR %\n".postf(signal);
             }};
             // The turn's server goes (SIGKILL if the signal did not end it) and sclang sees it
             // go (Server.prOnServerProcessExit), then forgets its devices: nothing is sent.

@@ -56,7 +56,7 @@ def test_a_file_size_limit_stops_the_recording_and_nothing_else(jack):
         ~kfPostStatus.(dev, "KF-STATUS-B");
         dev.status;
         s.sync;
-        "KF-ALIVE %".format(s.serverRunning).postln;
+        "KF-ALIVE %\n".postf(s.serverRunning);
         syn.free;
         dev.close;
         s.sync;

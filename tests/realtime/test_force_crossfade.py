@@ -85,7 +85,7 @@ def test_an_ndef_crossfade_moves_the_force_from_old_to_new_never_above_the_large
         // a fade of 2 s was not over when the next step came.
         step = {{ |name|
             var done = Condition.new, node;
-            "KF-STEP % %".format(name, thisThread.seconds).postln;
+            "KF-STEP % %\n".postf(name, thisThread.seconds);
             s.bind {{ node = Synth(\\kfAudioWait, [\\dur, {STEP_S}]) }};
             node.onFree {{ done.test = true; done.signal }};
             done.wait;
@@ -251,7 +251,7 @@ def test_a_proxyspace_crossfade_and_a_synth_release_move_the_force_as_their_soun
         dev.record({sclang.sc_string(record)});
         // {STEP_S} s of the server's audio between the steps (see the Ndef test).
         wait = {{ |name| var done = Condition.new, node;
-            "KF-STEP % %".format(name, thisThread.seconds).postln;
+            "KF-STEP % %\n".postf(name, thisThread.seconds);
             s.bind {{ node = Synth(\\kfAudioWait, [\\dur, {STEP_S}]) }};
             node.onFree {{ done.test = true; done.signal }}; done.wait }};
         // A live coder's ProxySpace: ~kf reassigned with a fade, 0.3 N to 0.7 N, then ended.

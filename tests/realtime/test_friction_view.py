@@ -58,22 +58,22 @@ shot = { |name|
 	// the last picture reach the display, and grab it. The device's position (the pilot's bus,
 	// shared memory) is read when the picture stops and again at the grab.
 	before = pilot.monitorBus.getnSynchronous(2);
-	"KF-NOW % %".format(name, v.timeS).postln;  // the latest frame's time when the bus is read
+	"KF-NOW % %\n".postf(name, v.timeS);  // the latest frame's time when the bus is read
 	v.paused = true;
 	0.3.wait;
 	image = Image.fromWindow(win);
 	after = pilot.monitorBus.getnSynchronous(2);
 	image.write(path);
 	d = v.drawn;
-	"KF-STATE % % % % %".format(name, d.positionMm, v.speedMmPerS, d.timeS, v.frameCount).postln;
-	"KF-MAP % % % % % %".format(name, d.rangeMm[0], d.rangeMm[1], d.forceRangeN[0], d.forceRangeN[1], v.historyS).postln;
+	"KF-STATE % % % % %\n".postf(name, d.positionMm, v.speedMmPerS, d.timeS, v.frameCount);
+	"KF-MAP % % % % % %\n".postf(name, d.rangeMm[0], d.rangeMm[1], d.forceRangeN[0], d.forceRangeN[1], v.historyS);
 	u = v.userView.absoluteBounds; w = win.view.absoluteBounds; sr = d.surfaceRect; fr = d.forceRect;
-	"KF-SHOT % % % % % % % % % %".format(name, path, image.width, image.height, u.left - w.left, u.top - w.top, u.width, u.height, w.width, w.height).postln;
+	"KF-SHOT % % % % % % % % % %\n".postf(name, path, image.width, image.height, u.left - w.left, u.top - w.top, u.width, u.height, w.width, w.height);
 	image.free;
-	"KF-BUS % % % % %".format(name, before[0], before[1], after[0], after[1]).postln;
-	"KF-RECTS % % % % % % % % % %".format(name, sr.left, sr.top, sr.width, sr.height, fr.left, fr.top, fr.width, fr.height, v.minForceN).postln;
-	"KF-FRAGMENT % % %".format(name, *v.fragmentMm).postln;
-	v.history.do { |row| ("KF-HIST " ++ name ++ " " ++ row.collect { |x| x.asStringPrec(9) }.join(" ")).postln };
+	"KF-BUS % % % % %\n".postf(name, before[0], before[1], after[0], after[1]);
+	"KF-RECTS % % % % % % % % % %\n".postf(name, sr.left, sr.top, sr.width, sr.height, fr.left, fr.top, fr.width, fr.height, v.minForceN);
+	"KF-FRAGMENT % % %\n".postf(name, *v.fragmentMm);
+	v.history.do { |row| ("KF-HIST " ++ name ++ " " ++ row.collect { |x| x.asStringPrec(9) }.join(" ") ++ "\n").post };
 	v.paused = false;
 };
 // Shot 1: the puck on the fragment (or the time is up); shot 2: after it left the fragment.
@@ -86,7 +86,7 @@ v.free;
 pilot.free;
 dev.close;
 s.sync;
-"KF-VIEW-FREED % %".format(v.isFree, v.synth).postln;
+"KF-VIEW-FREED % %\n".postf(v.isFree, v.synth);
 """
 
 
@@ -301,9 +301,9 @@ s.sync;
 v = FrictionView(dev, buf, 100, 5, bus);
 t0 = Main.elapsedTime;
 while { v.frameCount < 45 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
-"KF-BEFORE % % % % % %".format(v.frameCount, v.forceN, v.commandedForceN, v.signalFrames, v.timeS, v.fragmentMm).postln;
-v.history.do { |row| "KF-ROW % %".format(row[1], row[2]).postln };
-"KF-HEADER %".format(v.drawn !? { |d| d[\header] }).postln;
+"KF-BEFORE % % % % % %\n".postf(v.frameCount, v.forceN, v.commandedForceN, v.signalFrames, v.timeS, v.fragmentMm);
+v.history.do { |row| "KF-ROW % %\n".postf(row[1], row[2]) };
+"KF-HEADER %\n".postf(v.drawn !? { |d| d[\header] });
 ~kfPostStatus.(dev, "KF-STATUS");  // its watchdog trips so far
 // A second view on the user's position bus (audio rate): it shows the user's position.
 w2 = Window().front;
@@ -311,28 +311,28 @@ v2 = FrictionView(dev, buf, 100, 5, bus, posBus, parent: w2);
 t0 = Main.elapsedTime;
 while { v2.frameCount < 15 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
 p = v.history.last;
-"KF-POSBUS % % % % %".format(v2.positionMm, v2.speedMmPerS, v.history.keep(-15).collect { |r| r[2].abs }.maxItem, p[1], p[2]).postln;
+"KF-POSBUS % % % % %\n".postf(v2.positionMm, v2.speedMmPerS, v.history.keep(-15).collect { |r| r[2].abs }.maxItem, p[1], p[2]);
 v2.free;
 w2.close;
 // Follow the puck; zoom with the mapping about the puck; wheel and drag (their actions, called as
 // Qt calls them).
 v.follow = true;
 0.3.wait;
-"KF-FOLLOW % %".format(v.rangeMm.mean, v.positionMm).postln;
+"KF-FOLLOW % %\n".postf(v.rangeMm.mean, v.positionMm);
 v.follow = false;
 v.rangeMm = [v.positionMm - 8, v.positionMm + 12];
 v.zoomToMapping = true;
 v.samplesPerMm = 200;
 0.3.wait;
-"KF-ZOOM-MAPPING % % %".format(v.rangeMm[0], v.rangeMm[1], v.positionMm).postln;
+"KF-ZOOM-MAPPING % % %\n".postf(v.rangeMm[0], v.rangeMm[1], v.positionMm);
 v.zoomToMapping = false;
 v.rangeMm = [0, 20];
 v.userView.mouseWheelAction.value(v.userView, v.mmToX(5), 100, 0, 0, 120);
-"KF-WHEEL % %".format(v.rangeMm[0], v.rangeMm[1]).postln;
+"KF-WHEEL % %\n".postf(v.rangeMm[0], v.rangeMm[1]);
 v.userView.mouseDownAction.value(v.userView, 300, 100, 0, 0, 1);
 v.userView.mouseMoveAction.value(v.userView, 300 + (v.surfaceRect.width / 4), 100, 0);
 v.userView.mouseUpAction.value(v.userView, 300 + (v.surfaceRect.width / 4), 100, 0, 0);
-"KF-DRAG % %".format(v.rangeMm[0], v.rangeMm[1]).postln;
+"KF-DRAG % %\n".postf(v.rangeMm[0], v.rangeMm[1]);
 // Cmd-. frees every node (the view's monitor too) and drops deferred functions: the view starts
 // its monitor again and keeps drawing. (The harness runs this code in a routine, which a real
 // Cmd-. would stop: the clocks are left alone here.)
@@ -342,7 +342,7 @@ CmdPeriod.run;
 CmdPeriod.clearClocks = true;
 t0 = Main.elapsedTime;
 while { v.frameCount - frames < 30 and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
-"KF-AFTER-CMDPERIOD % % % %".format(v.frameCount - frames, v.synth.notNil, v.timeS, Main.elapsedTime - t0).postln;
+"KF-AFTER-CMDPERIOD % % % %\n".postf(v.frameCount - frames, v.synth.notNil, v.timeS, Main.elapsedTime - t0);
 queried = v.synth.nodeID;
 OSCdef(\kfViewInfo, { |msg| info.add(msg[1]) }, '/n_info');
 s.sendMsg('/n_query', queried);
@@ -352,15 +352,15 @@ v.close;
 s.sendMsg('/n_query', queried);
 s.sync;
 0.2.wait;
-"KF-QUERIES % % %".format(info.size, info.includes(queried), v.isFree).postln;
-"KF-WINDOWS %".format(Window.allWindows.size).postln;
+"KF-QUERIES % % %\n".postf(info.size, info.includes(queried), v.isFree);
+"KF-WINDOWS %\n".postf(Window.allWindows.size);
 dev.close; buf.free; bus.free; posBus.free;
 // A device that plays force at 8 kHz (a 2.1 board's rate): the view says so.
 dev = FrictionDevice.sim(s, 3, FrictionHand.path([[0, 0], [1, 5]]), (forceFramePeriodS: 0.000125));
 v = FrictionView(dev);
 t0 = Main.elapsedTime;
 while { v.drawn.isNil and: { Main.elapsedTime - t0 < 10 } } { 0.05.wait };
-"KF-RATE % %".format(v.forceRateHz, v.drawn !? { |d| d[\header] }).postln;
+"KF-RATE % %\n".postf(v.forceRateHz, v.drawn !? { |d| d[\header] });
 v.close; dev.close;
 """
 

@@ -18,8 +18,8 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
     table = paths.work_dir() / "hardware-calibration.txt"
     run = sclang.require_ok(sclang.run_with_server(sclang.fill(r"""
         var a, b, got = (), order = List.new, cond = Condition.new, withBoard, e, dev, replay, t0, slot2S;
-        var catch = { |name, f| try { f.value; ("KF-" ++ name ++ " ok").postln } { |err|
-            ("KF-" ++ name ++ " ERROR " ++ (err.what ? err.errorString)).postln } };
+        var catch = { |name, f| try { f.value; ("KF-" ++ name ++ " ok" ++ "\n").post } { |err|
+            ("KF-" ++ name ++ " ERROR " ++ (err.what ? err.errorString) ++ "\n").post } };
         // The raw answers, in the order they come.
         OSCFunc({ |m| order.add("done " ++ m[1]) }, '/done', s.addr);
         OSCFunc({ |m| order.add("kfDone % %".format(m[2], FrictionAnswers.textOf(m))) }, '/kfDone', s.addr);
@@ -43,14 +43,14 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
         s.sendBundle(1.0, a.addBoardMsg("KF-NO-SUCH-BOARD"));
         s.sendBundle(nil, b.addBoardMsg(emulate: true));
         while { got.size < 2 } { cond.hang };
-        ("KF-SLOT1 " ++ got[1]).postln;
-        ("KF-SLOT2 " ++ got[2]).postln;
-        ("KF-SLOT2-S " ++ slot2S).postln;
-        ("KF-ORDER " ++ order.reject { |o| o.contains("kfOpenSim") }.join(", ")).postln;
+        ("KF-SLOT1 " ++ got[1] ++ "\n").post;
+        ("KF-SLOT2 " ++ got[2] ++ "\n").post;
+        ("KF-SLOT2-S " ++ slot2S ++ "\n").post;
+        ("KF-ORDER " ++ order.reject { |o| o.contains("kfOpenSim") }.join(", ") ++ "\n").post;
 
         // 2. hardware(): the mouse refused (none here); nothing else is sent, one Error.
         catch.("HW-MOUSE", { FrictionDevice.hardware(s, "/dev/hidraw-kf-none", \emulate, index: 3) });
-        ("KF-HW-MOUSE-HELD " ++ FrictionDevice.at(s, 3)).postln;
+        ("KF-HW-MOUSE-HELD " ++ FrictionDevice.at(s, 3) ++ "\n").post;
         catch.("HW-BADBOARD", { FrictionDevice.hardware(s, nil, 42) });
 
         // 3. Its board sequence on a simulated device: all parts succeed, one answer.
@@ -59,12 +59,12 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
         };
         FrictionCalibration([[0, 0.14], [0.25, 0.77], [1, 1.4]], "KF-EMU-0001").write(@table@);
         catch.("SEQ-OK", { dev = withBoard.(5, \emulate, @table@) });
-        ("KF-SEQ-OK-STATE " ++ [dev.state, FrictionDevice.at(s, 5) === dev, dev.boardSetup[\emulate]]).postln;
+        ("KF-SEQ-OK-STATE " ++ [dev.state, FrictionDevice.at(s, 5) === dev, dev.boardSetup[\emulate]] ++ "\n").post;
         // 4. The board refused: the device it opened is closed again; so is it when the
         // calibration is refused. The slot is free at once for the next open.
         catch.("SEQ-BOARD", { c = withBoard.(6, "KF-NO-SUCH-BOARD") });
         catch.("SEQ-CAL", { withBoard.(7, \emulate, "/nonexistent/kf-calibration.txt") });
-        ("KF-SEQ-HELD " ++ [FrictionDevice.at(s, 6), FrictionDevice.at(s, 7)]).postln;
+        ("KF-SEQ-HELD " ++ [FrictionDevice.at(s, 6), FrictionDevice.at(s, 7)] ++ "\n").post;
         catch.("SEQ-FREE", { FrictionDevice.sim(s, 6).close; FrictionDevice.sim(s, 7).close });
         // Outside a Routine: one ERROR posted for the whole.
         AppClock.sched(0, { withBoard.(8, "KF-NO-SUCH-BOARD"); nil });
@@ -79,12 +79,12 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
         // 6. The board methods wait for their answers: arm, then the status shows it armed.
         dev.arm;
         e = dev.boardStatus;
-        ("KF-ARMED " ++ [e[\hasBoard], e[\armed], e[\boardState]]).postln;
+        ("KF-ARMED " ++ [e[\hasBoard], e[\armed], e[\boardState]] ++ "\n").post;
         dev.disarm;
-        e = dev.boardStatus({ |v| ("KF-ACTION " ++ v[\armed]).postln });
-        ("KF-DISARMED " ++ e[\armed]).postln;
+        e = dev.boardStatus({ |v| ("KF-ACTION " ++ v[\armed] ++ "\n").post });
+        ("KF-DISARMED " ++ e[\armed] ++ "\n").post;
         e = a.boardStatus;  // a device without a board
-        ("KF-NO-BOARD " ++ [e[\hasBoard], e[\armed]]).postln;
+        ("KF-NO-BOARD " ++ [e[\hasBoard], e[\armed]] ++ "\n").post;
         catch.("STATUS-EMPTY", { FrictionDevice.new.prInit(s, 9, \sim).boardStatus });
         catch.("ARM-NO-BOARD", { a.arm });
         // Posted when it comes: the status asked for after it is answered after it (the server
@@ -99,7 +99,7 @@ def test_answers_by_slot_hardware_sequence_and_board_methods(jack):
         s.bootSync;
         while { dev.state == \opening } { 0.05.wait };
         e = dev.boardStatus;
-        ("KF-REBOOT " ++ [dev.state, e[\hasBoard], e[\armed]]).postln;
+        ("KF-REBOOT " ++ [dev.state, e[\hasBoard], e[\armed]] ++ "\n").post;
         [a, b, dev, replay].do(_.close);
         s.sync;
     """, table=sclang.sc_string(table), hid=sclang.sc_string(HID)), jack, name="hardware"))

@@ -149,7 +149,7 @@ piecesOf = { |code|
 	};
 	if(pending.notEmpty) { if(pieces.isEmpty) { pieces.add(pending) } { pieces[pieces.size - 1] = pieces.last ++ "\n" ++ pending } };
 	if(pieces.any { |p| p.compile.isNil }) {
-		"KF-HELP-NOTE a piece does not compile alone; the block runs as a whole".postln;
+		"KF-HELP-NOTE a piece does not compile alone; the block runs as a whole\n".post;
 		pieces = [code];
 	};
 	pieces
@@ -185,11 +185,11 @@ runPiece = { |fn|
 };
 serverAlive = { s.pid.notNil and: { s.pid.pidRunning } };
 restart = {
-	"KF-HELP-SERVER-DIED".postln;
+	"KF-HELP-SERVER-DIED\n".post;
 	s.quit;
 	1.wait;
 	s.bootSync;
-	"KF-SCSYNTH-PID %%".format(s.pid).postln;
+	"KF-SCSYNTH-PID %%\n".postf(s.pid);
 };
 // A boot is finished once ServerTree has run after it.
 ServerBoot.add({ treePending = true }, s);
@@ -216,7 +216,7 @@ waitLikeAPerson = { |known, path, b, value|
 		0.1.wait; waited = waited + 0.1
 	};
 	// (Reported once: a boot that stopped before ServerTree is not waited for again.)
-	if(waited >= %(boot_wait)f) { "KF-HELP-BOOT-TIMEOUT %% %%".format(path, b).postln; treePending = false };
+	if(waited >= %(boot_wait)f) { "KF-HELP-BOOT-TIMEOUT %% %%\n".postf(path, b); treePending = false };
 	if(waited > 0 and: { s.serverRunning }) { s.sync };
 	waited = 0;
 	while { note.(); started.any { |r| r.state != 6 } and: { waited < %(fork_wait)f } } {
@@ -305,20 +305,20 @@ pollForce = {
 	[forces, routine]
 };
 
-"KF-HELP-TEMPDIR %%".format(Platform.defaultTempDir).postln;
+"KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
 pieceStack = runPiece.({ nil })[\stack];
 files.do { |path, f|
 	var doc = SCDoc.parseFileFull(path), blocks, known = routinesQueued.(), fileStart = Main.elapsedTime;
-	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%".format(path).postln } {
+	if(doc.isNil) { "KF-HELP-PARSE-FAILED %%\n".postf(path) } {
 		blocks = codeBlocks.(doc);
-		"KF-HELP-FILE %% (%% blocks)".format(path, blocks.size).postln;
+		"KF-HELP-FILE %% (%% blocks)\n".postf(path, blocks.size);
 		blocks.do { |code, b|
 			var pieces = piecesOf.(code), start = Main.elapsedTime;
 			var lines = code.split($\n), first = lines.detect { |l| l.stripWhiteSpace.notEmpty and: { l.stripWhiteSpace != "(" } };
 			// The block and its comments, for the test to read what they say it does.
-			"KF-HELP-BLOCK %% %% %%".format(path, b, (first ? "").stripWhiteSpace.keep(70)).postln;
+			"KF-HELP-BLOCK %% %% %%\n".postf(path, b, (first ? "").stripWhiteSpace.keep(70));
 			if(code.stripWhiteSpace.beginsWith("// needs ")) {
-				"KF-HELP-SKIPPED %% %% (needs hardware)".format(path, b).postln;
+				"KF-HELP-SKIPPED %% %% (needs hardware)\n".postf(path, b);
 				pieces = [];
 			};
 			pieces.do { |piece, p|
@@ -330,42 +330,42 @@ files.do { |path, f|
 					polled = pollForce.();
 					known.add(polled[1]);  // not one of the piece's routines, to wait for
 				};
-				piece.split($\n).do { |line| line.find("//") !? { |at| "KF-HELP-COMMENT %% %%".format(p, line.drop(at + 2)).postln } };
-				"KF-HELP-PIECE %% %% %%".format(path, b, p).postln;
-				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%".format(path, b, p).postln } {
+				piece.split($\n).do { |line| line.find("//") !? { |at| "KF-HELP-COMMENT %% %%\n".postf(p, line.drop(at + 2)) } };
+				"KF-HELP-PIECE %% %% %%\n".postf(path, b, p);
+				if(fn.isNil) { "KF-HELP-COMPILE-FAILED %% %% %%\n".postf(path, b, p) } {
 					run = runPiece.(fn);
-					if(run[\threw]) { "KF-HELP-THROWN %% %% %%".format(path, b, p).postln } {
-						("-> " ++ run[\value].asString).postln;
+					if(run[\threw]) { "KF-HELP-THROWN %% %% %%\n".postf(path, b, p) } {
+						("-> " ++ run[\value].asString ++ "\n").post;
 						// (A piece that catches errors itself leaves them there, as any caught error
 						// does in SC 3.13: not ours to fix, and its Routine ends with the piece.)
 						if(run[\stack] > pieceStack and: { piece.find("try").isNil and: { piece.find("protect").isNil } }) {
-							"KF-HELP-STACK-LEFT %% %% %% %% slots".format(path, b, p, run[\stack] - pieceStack).postln
+							"KF-HELP-STACK-LEFT %% %% %% %% slots\n".postf(path, b, p, run[\stack] - pieceStack)
 						};
 					};
 				};
 				waitLikeAPerson.(known, path, b, run !? { run[\value] });
 				// The last piece's time runs to the block's end.
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
-				"KF-HELP-LEVELS %% %% %% %% %% %%".format(path, b, p, *levelsSince.(pieceStart)).postln;
+				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
 					var forces = polled[0].select { |f| f[0] >= (pieceStart + 0.1) }.collect(_[1]);
 					polled[1].stop;
-					"KF-HELP-FORCE %% %% %% %% %% %%".format(path, b, p, forces.size, forces.minItem, forces.maxItem).postln;
+					"KF-HELP-FORCE %% %% %% %% %% %%\n".postf(path, b, p, forces.size, forces.minItem, forces.maxItem);
 				};
 				// (In place: the meter's responder holds this List.)
 				while { meterLevels.notEmpty and: { meterLevels[0][0] < (Main.elapsedTime - 1) } } { meterLevels.removeAt(0) };
 			};
-			"KF-HELP-BLOCK-END %% %%".format(path, b).postln;
+			"KF-HELP-BLOCK-END %% %%\n".postf(path, b);
 			if(serverAlive.().not) { restart.() } {
-				if(hasDefaultGroup.().not) { "KF-HELP-NO-DEFAULT-GROUP %% %%".format(path, b).postln };
+				if(hasDefaultGroup.().not) { "KF-HELP-NO-DEFAULT-GROUP %% %%\n".postf(path, b) };
 				if(%(free_each_block)s) { s.freeAll; s.sync };
 			};
 		};
 		// A guide's last block is its clean-up: nothing of it may still run or post.
 		if(guides[f] and: { serverAlive.() }) {
-			"KF-HELP-CLEANED-UP %%".format(path).postln;
+			"KF-HELP-CLEANED-UP %%\n".postf(path);
 			%(cleanup_watch)f.wait;
-			nodesBesidesDefault.().do { |n| "KF-HELP-LEFT-RUNNING %% %%".format(path, n).postln };
+			nodesBesidesDefault.().do { |n| "KF-HELP-LEFT-RUNNING %% %%\n".postf(path, n) };
 		};
 		s.freeAll;
 		16.do { |i| s.sendMsg('/cmd', 'kfClose', i) };
@@ -373,7 +373,7 @@ files.do { |path, f|
 		Window.allWindows.do(_.close);
 		0.2.wait;
 		if(serverAlive.().not) { restart.() };
-		"KF-HELP-FILE-DONE %% in %% s".format(path, (Main.elapsedTime - fileStart).round(0.1)).postln;
+		"KF-HELP-FILE-DONE %% in %% s\n".postf(path, (Main.elapsedTime - fileStart).round(0.1));
 	};
 };
 // The soak, after the guides in their interpreter: every threshold procedure run again and again in one
@@ -394,16 +394,16 @@ if(%(soak)s and: { guides.includes(true) }) {
 			}
 		};
 		while { routine.next == \kfSoakRun } { stacks.add(routine.instVarAt(\stack).size) };
-		"KF-HELP-SOAK %% runs %% stack %% to %% in %% s".format(named[0], stacks.size, stacks.first, stacks.maxItem,
-			(Main.elapsedTime - start).round(0.1)).postln;
+		"KF-HELP-SOAK %% runs %% stack %% to %% in %% s\n".postf(named[0], stacks.size, stacks.first, stacks.maxItem,
+			(Main.elapsedTime - start).round(0.1));
 		0.01.wait;
 	};
 	// The collector's own check of its heap: it prints what it finds wrong ("grey count off", a list's
 	// "color wrong"), which FAILURES reads.
 	this.gcSanity;
-	"KF-HELP-GC-CHECKED".postln;
+	"KF-HELP-GC-CHECKED\n".post;
 };
-"KF-HELP-ALL-DONE".postln;
+"KF-HELP-ALL-DONE\n".post;
 """
 
 FAILURES = [

@@ -20,40 +20,40 @@ def test_a_rejected_open_is_an_error_and_a_taken_slot_is_refused_unless_replaced
         var bad, a, b, c, x = 0;
         // 1. The server rejects an unknown setting: an Error in sclang, with the server's reason.
         try { bad = FrictionDevice.sim(s, 0, profile: (noSuchSetting: 1)) } { |e|
-            ("KF-REJECTED " ++ e.errorString).postln };
-        "KF-ALL-AFTER-REJECT %".format(FrictionDevice.all.size).postln;
+            ("KF-REJECTED " ++ e.errorString ++ "\n").post };
+        "KF-ALL-AFTER-REJECT %\n".postf(FrictionDevice.all.size);
         // A nil server is Server.default, as everywhere in SC.
         x = FrictionDevice.sim(nil, 5);
-        "KF-NIL-SERVER % %".format(x.server === Server.default, x.isOpen).postln;
+        "KF-NIL-SERVER % %\n".postf(x.server === Server.default, x.isOpen);
         x.close;
         x = 0;
         // 2. A taken slot: refused in sclang ...
         a = FrictionDevice.sim(s, 0, FrictionHand.speeds([[40, 5]]));
-        try { FrictionDevice.sim(s, 0) } { |e| ("KF-TAKEN " ++ e.errorString).postln };
+        try { FrictionDevice.sim(s, 0) } { |e| ("KF-TAKEN " ++ e.errorString ++ "\n").post };
         // ... and by the server, for any client that sends the open itself.
-        OSCdef(\kfFail, { |msg| ("KF-SERVER-FAIL " ++ msg[3..].collect { |c| c.asInteger.asAscii }.join).postln },
+        OSCdef(\kfFail, { |msg| ("KF-SERVER-FAIL " ++ msg[3..].collect { |c| c.asInteger.asAscii }.join ++ "\n").post },
             '/kfFail');
         s.sendMsg(*FrictionDevice.describeSim(0).openMsg);
         s.sync;
         0.2.wait;
-        "KF-A-OPEN % %".format(a.isOpen, FrictionDevice.at(s, 0) === a).postln;
+        "KF-A-OPEN % %\n".postf(a.isOpen, FrictionDevice.at(s, 0) === a);
         // 3. Replaced explicitly: the old object no longer closes the slot.
         b = FrictionDevice.sim(s, 0, FrictionHand.speeds([[40, 5]]), replace: true);
-        "KF-REPLACED % % %".format(a.isOpen, b.isOpen, FrictionDevice.at(s, 0) === b).postln;
+        "KF-REPLACED % % %\n".postf(a.isOpen, b.isOpen, FrictionDevice.at(s, 0) === b);
         a.close;
         s.sync;
         OSCdef(\kfX, { |msg| x = msg[3] }, '/kfX');
         c = { SendReply.kr(Impulse.kr(20), '/kfX', FrictionMouseIn.kr(0)[0]); Silent.ar }.play;
         0.6.wait;
-        "KF-STILL-OPEN % %".format(b.isOpen, x).postln;
+        "KF-STILL-OPEN % %\n".postf(b.isOpen, x);
         b.close;
         s.sync;
-        "KF-CLOSED % %".format(b.isOpen, FrictionDevice.all.size).postln;
+        "KF-CLOSED % %\n".postf(b.isOpen, FrictionDevice.all.size);
         c.free;
         // 4. s.sync after every command, and a command on a closed slot fails with its reason.
-        try { b.zero } { |e| ("KF-ZERO-CLOSED " ++ e.errorString).postln };
+        try { b.zero } { |e| ("KF-ZERO-CLOSED " ++ e.errorString ++ "\n").post };
         s.sync;
-        "KF-SYNCED".postln;
+        "KF-SYNCED\n".post;
     """, jack, name="answers"))
     rejected = run.lines("KF-REJECTED ")
     assert rejected and "unknown setting" in " ".join(rejected[0]) and "noSuchSetting" in " ".join(rejected[0])
@@ -82,16 +82,16 @@ def test_pilot_and_force_writer_recover_from_cmd_period(jack):
         dev.forceBus;
         pilot = FrictionPilot(dev).play;
         s.sync; 0.5.wait;
-        "KF-BEFORE %".format(pilot.isPlaying).postln;
+        "KF-BEFORE %\n".postf(pilot.isPlaying);
         CmdPeriod.run;
         1.0.wait;
-        "KF-AFTER-CMDPERIOD % %".format(pilot.isPlaying, dev.isOpen).postln;
+        "KF-AFTER-CMDPERIOD % %\n".postf(pilot.isPlaying, dev.isOpen);
         pilot.mapping_(\\mapping2);    // no synth: nothing sent, no 'Node not found'
         pilot.play;
         s.sync; 0.3.wait;
         pilot.mapping_(\\mapping3);
         s.sync;
-        "KF-REPLAYED %".format(pilot.isPlaying).postln;
+        "KF-REPLAYED %\n".postf(pilot.isPlaying);
         pilot.free;
         // The device's force writer is back: a source into forceBus reaches the device.
         dev.record({sclang.sc_string(record)});
@@ -103,7 +103,7 @@ def test_pilot_and_force_writer_recover_from_cmd_period(jack):
         src.onFree {{ ended.test = true; ended.signal }};
         ended.wait;
         dev.close;
-        "KF-FAILS %".format(~fails).postln;
+        "KF-FAILS %\n".postf(~fails);
     """, jack, name="cmdperiod"))
     assert values(run, "KF-BEFORE ") == [["true"]]
     assert values(run, "KF-AFTER-CMDPERIOD ") == [["false", "true"]]
@@ -151,12 +151,12 @@ REBOOT = r"""
     monitor = FrictionViewMonitor(dev, dev.forceBus, dev.positionBus);
     s.sync;
     1.0.wait;
-    "KF-BEFORE % % % %".format(dev.isOpen, pilot.isPlaying, view.monitor.running, monitor.frameCount > 0).postln;
+    "KF-BEFORE % % % %\n".postf(dev.isOpen, pilot.isPlaying, view.monitor.running, monitor.frameCount > 0);
     bad.instVarPut(\source, \notAHand);
     numbersBefore = [fb.index, pb.index, pilot.monitorBus.index];
     userBoot = { userBuses = [Bus.audio(s, 2), Bus.control(s, 3)] };
     ServerBoot.add(userBoot, s);
-    "KF-REBOOTING".postln;
+    "KF-REBOOTING\n".post;
     s.reboot;
     // As a person waits for the boot to finish (ServerTree included).
     while { s.serverRunning.not and: { waited < 30 } } { 0.1.wait; waited = waited + 0.1 };
@@ -166,26 +166,26 @@ REBOOT = r"""
     s.sendMsg('/n_query', 1);
     s.sync;
     0.2.wait;
-    "KF-AFTER-REBOOT % % % % %".format(nodeOne, dev.isOpen, FrictionDevice.at(s, 1) === dev, pilotDev.isOpen,
-        bad.isOpen).postln;
+    "KF-AFTER-REBOOT % % % % %\n".postf(nodeOne, dev.isOpen, FrictionDevice.at(s, 1) === dev, pilotDev.isOpen,
+        bad.isOpen);
     ServerBoot.remove(userBoot, s);
-    "KF-SAME-BUSES % %".format(dev.forceBus === fb, dev.positionBus === pb).postln;
+    "KF-SAME-BUSES % %\n".postf(dev.forceBus === fb, dev.positionBus === pb);
     // Buses allocated after the boot, as a user's code would: none shares a channel with the
     // device's or the pilot's.
     strays = userBuses ++ [Bus.audio(s, 1), Bus.control(s, 4), Bus.control(s, 5), Bus.audio(s, 2), Bus.control(s, 1)];
     pilot.play;
     s.sync;
-    "KF-NUMBERS % %".format(numbersBefore, [fb.index, pb.index, pilot.monitorBus.index]).postln;
+    "KF-NUMBERS % %\n".postf(numbersBefore, [fb.index, pb.index, pilot.monitorBus.index]);
     busesOf = [dev.forceBus, dev.positionBus, pilot.monitorBus];
     busesOf.do { |a|
         strays.do { |b|
             if(a.rate == b.rate and: { a.index < (b.index + b.numChannels) } and: { b.index < (a.index + a.numChannels) }) {
-                "KF-SHARED % %".format(a, b).postln;
+                "KF-SHARED % %\n".postf(a, b);
                 overlaps = overlaps + 1;
             }
         }
     };
-    "KF-OVERLAPS %".format(overlaps).postln;
+    "KF-OVERLAPS %\n".postf(overlaps);
     // The position reader writes positionBus, the force writer sends forceBus to the device.
     pb.getn(4, { |v| x0 = v[0] });
     0.5.wait;
@@ -199,21 +199,21 @@ REBOOT = r"""
     dev.statusValues({ |v| force = v[\lastForceN] });
     s.sync;
     0.3.wait;
-    "KF-POSITION-BUS % %".format(x0, x1).postln;
-    "KF-FORCE-BUS %".format(force).postln;
-    "KF-DRIVE % %".format(dev.driveSetup.notNil, drive).postln;
+    "KF-POSITION-BUS % %\n".postf(x0, x1);
+    "KF-FORCE-BUS %\n".postf(force);
+    "KF-DRIVE % %\n".postf(dev.driveSetup.notNil, drive);
     // The monitor of the device's buses reads them again, the pilot's view its new frames.
     before = monitor.frameCount;
     0.5.wait;
-    "KF-MONITOR % % %".format(monitor.frameCount - before, monitor.positionMm, monitor.forceN).postln;
-    "KF-PILOT-VIEW % %".format(pilot.isPlaying, view.monitor.running).postln;
+    "KF-MONITOR % % %\n".postf(monitor.frameCount - before, monitor.positionMm, monitor.forceN);
+    "KF-PILOT-VIEW % %\n".postf(pilot.isPlaying, view.monitor.running);
     view.free; monitor.free; pilot.free;
     s.freeAll;
     [dev, pilotDev].do(_.close);
     strays.do(_.free);
     driveBus.free;
     s.sync;
-    "KF-DONE".postln;
+    "KF-DONE\n".post;
 """
 
 
@@ -255,10 +255,10 @@ def test_a_device_in_a_proxyspace_plays_the_puck_position(jack):
         var p = ProxySpace.push(s), vals;
         ~dev = FrictionDevice.sim(s, 2, FrictionHand.speeds([[30, 5]]));
         1.5.wait;
-        "KF-PROXY % % %".format(~dev.source.class, ~dev.source.isOpen, ~dev.numChannels).postln;
+        "KF-PROXY % % %\n".postf(~dev.source.class, ~dev.source.isOpen, ~dev.numChannels);
         ~dev.bus.getn(4, { |v| vals = v });
         s.sync; 0.1.wait;
-        "KF-PROXY-X %".format(vals[0]).postln;
+        "KF-PROXY-X %\n".postf(vals[0]);
         ~dev.source.close;
         p.pop;
     """, jack, name="proxyspace"))

@@ -9,22 +9,22 @@ def test_list_and_open_without_a_mouse(jack):
         var cond = Condition.new, found;
         FrictionDevice.listMice(s, nil, { |mice| found = mice; cond.unhang });
         cond.hang;
-        "KF-MICE %".format(found.size).postln;
-        found.do { |m| "KF-MOUSE % % %".format(m[\backend], m[\index], m[\path]).postln };
+        "KF-MICE %\n".postf(found.size);
+        found.do { |m| "KF-MOUSE % % %\n".postf(m[\backend], m[\index], m[\path]) };
         SynthDef(\kfMousePos, { SendReply.kr(Impulse.kr(20), '/kfMousePos', FrictionMouseIn.kr(0)) }).add;
-        OSCdef(\kfMousePos, { |msg| "KF-POS %".format(msg[3..6].join(" ")).postln }, '/kfMousePos');
+        OSCdef(\kfMousePos, { |msg| "KF-POS %\n".postf(msg[3..6].join(" ")) }, '/kfMousePos');
         s.sync;
         // Inside a Routine an open the server refuses is an Error, with the server's reason.
         [
             { if(found.isEmpty) { FrictionDevice.mouse(s, 0) } },  // "the first mouse": there is none
             { FrictionDevice.mouse(s, 1, "/dev/hidraw-kf-none", \hidapi) },
             { FrictionDevice.mouse(s, 2, "/dev/input/event-kf-none", \evdev, nil, true) }
-        ].do { |open| try(open) { |error| ("KF-REFUSED " ++ error.errorString).postln } };
+        ].do { |open| try(open) { |error| "KF-REFUSED %\n".postf(error.errorString) } };
         s.sendMsg('/cmd', 'kfReopenMouse', 3);
         s.sync;
         Synth(\kfMousePos);
         0.5.wait;
-        "KF-NO-MOUSE %".format(found.isEmpty).postln;
+        "KF-NO-MOUSE %\n".postf(found.isEmpty);
     """, jack, name="mouse"))
     out = run.output
     count = int(run.lines("KF-MICE ")[0][0])

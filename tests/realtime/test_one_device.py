@@ -67,7 +67,7 @@ def test_two_readers_agree_to_the_sample_and_a_late_reader_starts_where_the_puck
         // the late reader starts wherever the readers are then, which sclang's 1.5 s wait does
         // not fix (under load they play reports out up to 0.65 s behind the puck).
         dev = FrictionDevice.sim(s, 0, FrictionHand.speeds([[20, 1], [-10, 1], [40, 2]]));
-        "KF-OPEN %".format(dev.isOpen).postln;
+        "KF-OPEN %\n".postf(dev.isOpen);
         a = Synth(\kfReader, [\bus, busA]);
         1.5.wait;
         // B and its comparer start in one bundle, at one block.
@@ -79,7 +79,7 @@ def test_two_readers_agree_to_the_sample_and_a_late_reader_starts_where_the_puck
         ~kfAudioWait.(2.5);
         dev.close;
         [a, b, cmp].do(_.free);
-        ~diff.do { |row| ("KF-DIFF " ++ row.join(" ")).postln };
+        ~diff.do { |row| ("KF-DIFF " ++ row.join(" ") ++ "\n").post };
     """, jack, name="readers"))
     assert run.lines("KF-OPEN ")[0] == ["true"], "the open waits for /done inside a Routine"
     rows = floats(run, "KF-DIFF ")
@@ -116,19 +116,19 @@ def test_zero_rebases_every_reader_at_once(jack):
             cmp = Synth.tail(s, \kfCompare, [\busA, busA, \busB, busB]);
         };
         1.0.wait;
-        "KF-ZERO %".format(Main.elapsedTime).postln;
+        "KF-ZERO %\n".postf(Main.elapsedTime);
         dev.zero;        // waits for /done inside a Routine
-        "KF-ZERO-DONE %".format(Main.elapsedTime).postln;
+        "KF-ZERO-DONE %\n".postf(Main.elapsedTime);
         1.0.wait;
-        "KF-SET %".format(Main.elapsedTime).postln;
+        "KF-SET %\n".postf(Main.elapsedTime);
         dev.setPosition(100, 0);
-        "KF-SET-DONE %".format(Main.elapsedTime).postln;
+        "KF-SET-DONE %\n".postf(Main.elapsedTime);
         1.0.wait;
         // The readers go first: a closed slot reads 0, which is not the puck's position.
         [a, b, cmp].do(_.free);
         s.sync;
         dev.close;
-        ~rows.do { |row| ("KF-POS " ++ row.join(" ")).postln };
+        ~rows.do { |row| ("KF-POS " ++ row.join(" ") ++ "\n").post };
     """, jack, name="zero"))
     rows = floats(run, "KF-POS ")
     t, diff, x = rows[:, 0], rows[:, 1], rows[:, 2]
@@ -225,7 +225,7 @@ def test_a_jitlib_crossfade_into_the_force_bus_hands_over_smoothly(jack):
         Ndef(\\friction).play(dev.forceBus.index, 1);
         s.sync;
         ~kfAudioWait.(1.0);
-        "KF-SWITCH".postln;
+        "KF-SWITCH\n".post;
         dev.status;
         Ndef(\\friction, {{ DC.ar(1.0) }});
         ~kfWatch.(dev, 1.5);
@@ -329,7 +329,7 @@ def test_zoom_about_the_puck_in_realtime_and_the_position_bus(jack):
         0.5.wait;
         dev.positionBus.getn(4, {{ |v| pos = v }});
         s.sync; 0.1.wait;
-        "KF-POSITION-BUS %".format(pos.join(" ")).postln;
+        "KF-POSITION-BUS %\n".postf(pos.join(" "));
         dev.close;
     """, jack, name="zoom"))
     import soundfile
@@ -380,7 +380,7 @@ def test_every_pbind_note_reads_the_puck_where_it_is(jack):
         player.stop;
         0.2.wait;
         dev.close;
-        ~notes.do { |row| ("KF-NOTE " ++ row.join(" ")).postln };
+        ~notes.do { |row| ("KF-NOTE " ++ row.join(" ") ++ "\n").post };
     """, jack, name="pbind"))
     rows = floats(run, "KF-NOTE ")
     assert len(rows) >= 10, run.output[-2000:]

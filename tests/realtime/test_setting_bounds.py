@@ -60,7 +60,7 @@ def test_every_documented_bound_is_accepted_and_the_value_beyond_refused(jack):
         ~try = { |name, which, open|
             var answer = "ok";
             try { last = open.value } { |error| answer = error.errorString.replace("\n", " ") };
-            "KF-BOUND % % %".format(name, which, answer).postln;
+            "KF-BOUND % % %\n".postf(name, which, answer);
         };
         """ + "\n".join(tries) + r"""
         last !? { last.close };

@@ -37,7 +37,7 @@ def test_a_resumed_threshold_condition_continues_its_procedure(jack):
 ~session = ~study.(@MAX@).run("R1", @ROOT@, s, simulated: @SIM@, windows: false, experimenterOut: 2);
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
 while { ~session.isOver.not } { 0.1.wait };
-"KF-NOT-KILLED".postln;
+"KF-NOT-KILLED\n".post;
 """, MAX=MAX_TRIALS, ROOT=sclang.sc_string(str(root)), SIM=SIM,
                                 PIDS=sclang.sc_string(str(sclang.pids_file("study-threshold-run"))))
     trials_csv = session / "trials.csv"
@@ -55,15 +55,15 @@ while { ~session.isOver.not } { 0.1.wait };
 var straight = FrictionStaircase(0.4, 2, [0.2, 0.1, 0.05], \log, 8, @MAX@, maxLevel: 0.8), estimate;
 """, MAX=MAX_TRIALS) + STUDY + sclang.fill(r"""
 try { ~study.(5).resume(@SESSION@, s, simulated: @SIM@, windows: false) } { |e|
-	"KF-REFUSED %".format(e.errorString.replace("\n", " | ")).postln };
+	"KF-REFUSED %\n".postf(e.errorString.replace("\n", " | ")) };
 ~session = ~study.(@MAX@).resume(@SESSION@, s, simulated: @SIM@, windows: false);
 while { ~session.isOver.not } { 0.1.wait };
-"KF-RESUMED %".format(~session.state).postln;
+"KF-RESUMED %\n".postf(~session.state);
 // The same seeded observer (the simulated participant's seed, 4) through the same staircase, straight.
 estimate = FrictionObserver(0.1, 3.5, 0.02, seed: 4).runProcedure(straight);
-"KF-STRAIGHT-LEVELS %".format(straight.trials.collect(_.level).join(" ")).postln;
-"KF-STRAIGHT-CORRECT %".format(straight.trials.collect(_.correct).join(" ")).postln;
-"KF-STRAIGHT-ESTIMATE %".format(estimate.threshold).postln;
+"KF-STRAIGHT-LEVELS %\n".postf(straight.trials.collect(_.level).join(" "));
+"KF-STRAIGHT-CORRECT %\n".postf(straight.trials.collect(_.correct).join(" "));
+"KF-STRAIGHT-ESTIMATE %\n".postf(estimate.threshold);
 """, MAX=MAX_TRIALS, SESSION=sclang.sc_string(str(session)), SIM=SIM)
     run = sclang.require_ok(sclang.run_with_server(second, jack, timeout=120, name="study-threshold-resume",
                                                    server_options={"numOutputBusChannels": 4}))

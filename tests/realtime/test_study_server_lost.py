@@ -32,10 +32,10 @@ atKill = rows.value;
 while { session.isOver.not and: { Main.elapsedTime - killT < 30 } } { 0.05.wait };
 3.wait;  // what a session that went on would store meanwhile: a trial every 0.4 s
 later = rows.value;
-"KF-STATE %".format(session.state).postln;
-"KF-LOST-AFTER %".format(FrictionStudySession.lostAfterS).postln;
-"KF-DEATH-TO-FAILURE %".format(overT !? { overT - killT }).postln;
-"KF-ROWS % % %".format(atKill, atOver, later).postln;
+"KF-STATE %\n".postf(session.state);
+"KF-LOST-AFTER %\n".postf(FrictionStudySession.lostAfterS);
+"KF-DEATH-TO-FAILURE %\n".postf(overT !? { overT - killT });
+"KF-ROWS % % %\n".postf(atKill, atOver, later);
 """
 
 
@@ -120,8 +120,8 @@ while { File.exists(path).not } { 0.01.wait };
 while { session.isOver.not } { 0.05.wait };
 1.wait;
 s.sync;
-"KF-STATE %".format(session.state).postln;
-"KF-LEFT synths % slot %".format(s.numSynths, FrictionDevice.at(s, 0)).postln;
+"KF-STATE %\n".postf(session.state);
+"KF-LEFT synths % slot %\n".postf(s.numSynths, FrictionDevice.at(s, 0));
 """
 
 
@@ -147,11 +147,11 @@ study = FrictionStudy("silent", [
 	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
 session = study.run("C1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
 while { rows.value < 2 } { 0.01.wait };
-"KF-TIMEOUT %".format(FrictionStudySession.clientTimeoutS).postln;
+"KF-TIMEOUT %\n".postf(FrictionStudySession.clientTimeoutS);
 // sclang falls silent (as a crashed or killed one would), its synths playing on in the server.
 "kill -STOP %; sleep @STOPPED@; kill -CONT %".format(thisProcess.pid, thisProcess.pid).systemCmd;
 while { session.isOver.not } { 0.05.wait };
-"KF-STATE %".format(session.state).postln;
+"KF-STATE %\n".postf(session.state);
 """
 
 
@@ -200,7 +200,7 @@ session = study.run("K1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2
 while { rows.value < 2 } { 0.01.wait };
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
 120.wait;
-"KF-NOT-KILLED".postln;
+"KF-NOT-KILLED\n".post;
 """
 ORPHAN_TIMEOUT_S = 1.0
 

@@ -26,7 +26,7 @@ def test_bad_input_is_refused_before_anything_starts(jack):
     (root / "P1").mkdir(parents=True)
     code = sclang.fill(r"""
 var root = @ROOT@, sim = FrictionStudySimParticipant(1, 2), refused = { |tag, f|
-	try { f.value; "KF-ACCEPTED %".format(tag).postln } { |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
+	try { f.value; "KF-ACCEPTED %\n".postf(tag) } { |e| "KF-REFUSED % %\n".postf(tag, e.errorString) }
 };
 """ + STUDY + r"""
 refused.(\noConditions, { FrictionStudy("empty", []) });
@@ -74,7 +74,7 @@ def test_a_killed_session_resumes_with_nothing_lost(jack):
 	experimenterOut: 2);
 File.use(@PIDS@, "w", { |f| f.write("% %\n".format(thisProcess.pid, s.pid)) });
 while { ~session.isOver.not } { 0.1.wait };
-"KF-NOT-KILLED".postln;
+"KF-NOT-KILLED\n".post;
 """, ROOT=sclang.sc_string(str(root)), PIDS=sclang.sc_string(str(sclang.pids_file("study-run"))))
     second_events = session / "02-second" / "events.csv"
     started = {}
@@ -121,7 +121,7 @@ while { ~session.isOver.not } { 0.1.wait };
     second = STUDY + sclang.fill(r"""
 ~session = ~study.resume(@SESSION@, s, simulated: FrictionStudySimParticipant(3, 2.5), windows: false);
 while { ~session.isOver.not } { 0.1.wait };
-"KF-RESUMED % %".format(~session.state, ~session.position).postln;
+"KF-RESUMED % %\n".postf(~session.state, ~session.position);
 """, SESSION=sclang.sc_string(str(session)))
     run = sclang.require_ok(sclang.run_with_server(second, jack, timeout=120, name="study-resume",
                                                    server_options={"numOutputBusChannels": 4}))
@@ -178,7 +178,7 @@ session.answer("pressed the right button");
 while { session.state != \running } { 0.05.wait };
 session.abort;  // the experimenter: the second condition has no use here
 while { session.isOver.not } { 0.05.wait };
-"KF-BUTTON %".format(session.state).postln;
+"KF-BUTTON %\n".postf(session.state);
 device.close;
 // Its participant explores each condition 4 s: the abort below, after 0.5 s of the server's audio,
 // must come first (a 1.5 s participant finished first once beside a busy machine: the audio ran
@@ -199,7 +199,7 @@ s.sync;
 OSCFunc({ |msg| synths = msg[3]; counted.test = true; counted.signal }, '/status.reply', s.addr).oneShot;
 s.sendMsg('/status');
 counted.wait;
-"KF-ABORTED % % synths".format(aborted.state, synths).postln;
+"KF-ABORTED % % synths\n".postf(aborted.state, synths);
 """
 
 

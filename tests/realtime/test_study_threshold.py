@@ -27,8 +27,8 @@ while { session.isOver.not } {
 	if(File.exists(path)) { rows = rows.add(File.readAllString(path).split($\n).reject(_.isEmpty).size - 1) };
 	0.05.wait
 };
-"KF-ROWS %".format(rows.asSet.asArray.sort.join(" ")).postln;
-"KF-STATE %".format(session.state).postln;
+"KF-ROWS %\n".postf(rows.asSet.asArray.sort.join(" "));
+"KF-STATE %\n".postf(session.state);
 """
 
 
@@ -98,8 +98,8 @@ var root = @ROOT@, sim = FrictionStudySimParticipant(4, 2), refused = { |tag, ma
 		FrictionStudy("stimuli", [FrictionStudyCondition(\first, (mapping: \mapping1), "Explore.", [], 60),
 			FrictionStudyCondition.threshold(\forceStep, make, "Which?", [], 60, \keys,
 				{ |seed| FrictionObserver(0.1, seed: seed) })]).run(tag.asString, root, s, simulated: sim, windows: false);
-		"KF-ACCEPTED %".format(tag).postln
-	} { |e| "KF-REFUSED % %".format(tag, e.errorString).postln }
+		"KF-ACCEPTED %\n".postf(tag)
+	} { |e| "KF-REFUSED % %\n".postf(tag, e.errorString) }
 };
 refused.(\unrenderable, { FrictionThreshold.force(FrictionConstantStimuli([0.05, 2]), 0.3) });
 refused.(\negativeBase, { FrictionThreshold.force(FrictionStaircase(0.1), -0.3) });

@@ -41,7 +41,7 @@ shot = { |name, window|
 	0.4.wait;
 	image = Image.fromWindow(window);
 	image.write(dir +/+ name ++ ".png");
-	"KF-SHOT % %".format(name, dir +/+ name ++ ".png").postln;
+	"KF-SHOT % %\n".postf(name, dir +/+ name ++ ".png");
 	image.free;
 };
 session = study.run("W1", root, s, device: dev, windows: true);
@@ -64,9 +64,9 @@ session.experimenterWindow.repeatButton.valueAction = 0;
 wait.({ session.attempt == 2 and: { session.state == \running } });
 2.wait;
 session.experimenterWindow.refresh;
-"KF-COVERAGE % %".format(session.coverage.count, session.coverage.fraction).postln;
+"KF-COVERAGE % %\n".postf(session.coverage.count, session.coverage.fraction);
 [session.experimenterWindow.coverageView.absoluteBounds, session.experimenterWindow.window.view.absoluteBounds].do { |b|
-	"KF-BOUNDS % % % %".format(b.left, b.top, b.width, b.height).postln
+	"KF-BOUNDS % % % %\n".postf(b.left, b.top, b.width, b.height)
 };
 session.experimenterWindow.coverageView.refresh;
 // Frozen for the grab, as its help says: a redraw pending at Image.fromWindow hangs sclang (the
@@ -76,7 +76,7 @@ session.experimenterWindow.coverageView.refresh;
 session.experimenterWindow.frozen = true;
 shot.(\experimenter, session.experimenterWindow.window);
 session.experimenterWindow.frozen = false;
-"KF-COVERAGE % %".format(session.coverage.count, session.coverage.fraction).postln;
+"KF-COVERAGE % %\n".postf(session.coverage.count, session.coverage.fraction);
 shot.(\exploring, session.participantWindow.window);
 session.participantWindow.pressKey($ );
 listen.stopRecording;
@@ -93,7 +93,7 @@ session.participantWindow.choose(1);
 session.participantWindow.submit;
 wait.({ session.isOver });
 shot.(\end, session.participantWindow.window);
-"KF-STATE %".format(session.state).postln;
+"KF-STATE %\n".postf(session.state);
 """
 
 

@@ -19,7 +19,7 @@ def test_threads_are_named_and_realtime_above_the_audio_thread(jack):
         rt.addBoard(emulate: true);
         s.sync;
         0.5.wait;
-        ("ps -L -o cls=,rtprio=,comm= -p " ++ s.pid).unixCmdGetStdOut.split($\n).do { |l| ("KF-PS " ++ l).postln };
+        ("ps -L -o cls=,rtprio=,comm= -p " ++ s.pid).unixCmdGetStdOut.split($\n).do { |l| ("KF-PS " ++ l ++ "\n").post };
         [rt, normal].do { |d| ~kfPostStatus.(d, "KF-STATUS") };
         rt.status;
         s.sync;

@@ -10,7 +10,7 @@ from kfstudy import readers
 INTERVAL_S, GAP_S = 0.5, 0.15
 TRIAL_FIELDS = ["trial", "level", "target", "answer", "correct", "startS", "interval1S", "interval2S", "answerS"]
 
-POST_TRIAL = r"""{ |t| ("KF-TRIAL " ++ [%s].collect { |k| t[k] }.join(" ")).postln }""" % ", ".join(
+POST_TRIAL = r"""{ |t| ("KF-TRIAL " ++ [%s].collect { |k| t[k] }.join(" ") ++ "\n").post }""" % ", ".join(
     "\\" + f for f in TRIAL_FIELDS)
 
 
@@ -65,17 +65,17 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         dev.record("{force_path}");
         e = FrictionThreshold.force(FrictionConstantStimuli([0.1, 0.4], 2, seed: 1), 0.3, {INTERVAL_S}, {GAP_S}, seed: 3);
         estimate = e.run(dev, FrictionObserver(0.2, 3.5, 0.02, seed: 4), {POST_TRIAL});
-        "KF-FORCE-ESTIMATE %".format(estimate.threshold.notNil).postln;
+        "KF-FORCE-ESTIMATE %\n".postf(estimate.threshold.notNil);
         dev.record(nil);
         0.2.wait;
         dev.record("{grating_path}");
         e = FrictionThreshold.grating(FrictionStaircase(2, 2, [0.2], \log, 10, 3), 2, 0.5, 0.2, 0.3,
             {INTERVAL_S}, {GAP_S}, seed: 5);
         e.run(dev, FrictionObserver(1, 3.5, 0.02, seed: 6), {POST_TRIAL.replace("KF-TRIAL", "KF-GRATING")},
-            {{ |est| "KF-ONEND %".format(est.threshold.round(1e-9)).postln }});
+            {{ |est| "KF-ONEND %\n".postf(est.threshold.round(1e-9)) }});
         dev.record(nil);
         0.2.wait;
-        "KF-EVENT %".format(e.asEvent[\kind]).postln;
+        "KF-EVENT %\n".postf(e.asEvent[\kind]);
         e = FrictionThreshold.asynchrony(FrictionQuestPlus([5, 10, 20, 40], maxTrials: 2), \mapping2, 0.3,
             {INTERVAL_S}, {GAP_S}, seed: 7);
         e.run(dev, FrictionObserver(15, 3.5, 0.02, seed: 8), {POST_TRIAL.replace("KF-TRIAL", "KF-ASYNC")});
@@ -149,7 +149,7 @@ def test_answers_from_keys_and_from_the_puck_buttons(jack):
         keys = fork {{
             loop {{
                 0.1.wait;
-                defer {{ "KF-WINDOWS %".format(Window.allWindows.count {{ |w| w.name == "Which interval? 1 or 2" }}).postln }};
+                defer {{ "KF-WINDOWS %\n".postf(Window.allWindows.count {{ |w| w.name == "Which interval? 1 or 2" }}) }};
                 e.answer(1)
             }}
         }};
@@ -183,11 +183,11 @@ def test_forces_the_device_cannot_render_are_refused_not_clamped(jack):
     run = sclang.require_ok(sclang.run_with_server(on_tempo_clock(rf"""
         var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80));
         var refused = {{ |tag, f|
-            try {{ f.value; "KF-ACCEPTED %".format(tag).postln }} {{ |e| "KF-REFUSED % %".format(tag, e.errorString).postln }}
+            try {{ f.value; "KF-ACCEPTED %\n".postf(tag) }} {{ |e| "KF-REFUSED % %\n".postf(tag, e.errorString) }}
         }};
         var ran = {{ |procedure, base|
             FrictionThreshold.force(procedure, base, {INTERVAL_S}, {GAP_S}, seed: 1).run(dev, FrictionObserver(0.1),
-                {{ |t| "KF-TRIAL-RAN %".format(t[\level]).postln }})
+                {{ |t| "KF-TRIAL-RAN %\n".postf(t[\level]) }})
         }};
         refused.(\negativeBase, {{ ran.(FrictionStaircase(0.1), -0.3) }});
         refused.(\baseAboveMax, {{ ran.(FrictionConstantStimuli([0.1], 1), 5) }});
@@ -196,7 +196,7 @@ def test_forces_the_device_cannot_render_are_refused_not_clamped(jack):
         refused.(\unboundedStaircase, {{ ran.(FrictionStaircase(1.5, 2, [0.2], \log, 10, 2), 0.3) }});
         refused.(\nanTime, {{ FrictionStudyCondition(\a, (mapping: \mapping1), "", [], 0/0) }});
         s.sync;
-        "KF-NODES %".format(s.numSynths).postln;
+        "KF-NODES %\n".postf(s.numSynths);
         refused.(\inRange, {{ ran.(FrictionConstantStimuli([0.1, 1.1], 1, seed: 2), 0.3) }});
         dev.close;
     """), jack, name="threshold-refused", timeout=120))
@@ -228,7 +228,7 @@ def test_a_buffer_allocated_as_a_run_ends_keeps_its_number(jack):
         0.3.wait;  // the run's bundle has run
         b.updateInfo({ info.test = true; info.signal });
         info.wait;
-        "KF-AFTER-RUN %".format(b.numFrames).postln;
+        "KF-AFTER-RUN %\n".postf(b.numFrames);
         b.free;
         dev.close;
     """), jack, name="threshold-buffer", timeout=120))

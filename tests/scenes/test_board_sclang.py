@@ -1,12 +1,12 @@
 """sclang side of the friction board: FrictionCalibration (validation, file round trip, the
 inverse the server computes), FrictionDevice's board messages, and a Score's board refused (a
 board runs in real time only)."""
-from kfharness import nrt, paths, sclang
+from kfharness import nrt, paths, sclang_session
 
 
 def test_calibration_tables_validate_round_trip_and_invert():
     path = paths.work_dir() / "sclang-calibration.txt"
-    out = sclang.run_script(f"""
+    out = sclang_session.run(f"""
         var table = FrictionCalibration([[0, 0.14], [0.2, 0.14], [0.5, 0.6], [0.8, 1.3], [1, 1.3]], "KF-7");
         var back, errors = List.new;
         table.write("{path}");
@@ -43,7 +43,7 @@ def test_calibration_tables_validate_round_trip_and_invert():
 
 
 def test_board_messages_for_scores():
-    out = sclang.run_script("""
+    out = sclang_session.run("""
         var dev = FrictionDevice.describeSim(3);
         var table = FrictionCalibration.linear(0.14, 1.4);
         var errors = List.new;

@@ -4,7 +4,7 @@ and a row with bytes changed are each skipped and named (file, line); every whol
 and after them, is read; the next row appended after a cut one is whole."""
 import zlib
 
-from kfharness import sclang
+from kfharness import sclang, sclang_session
 from kfstudy import checked_csv
 
 HEADER = ["participant", "answer", "level"]
@@ -18,7 +18,7 @@ def append(path, rows):
     code = "".join(f"FrictionStudyFiles.appendCsv({sclang.sc_string(str(path))}, "
                    f"[{', '.join(sclang.sc_string(v) for v in row)}], {HEADER!r}.collect(_.asSymbol));\n"
                    .replace("'", "\"") for row in rows)
-    sclang.run_script(code, name="checked-csv")
+    sclang_session.run(code)
 
 
 def as_dicts(rows):
@@ -66,12 +66,12 @@ def test_a_file_without_checks_is_read_as_plain_csv(tmp_path):
 
 def sclang_reads(path):
     """FrictionStudyFiles.readCsv's rows (the answer field's bytes as hex) and damaged lines."""
-    out = sclang.run_script(f"""
+    out = sclang_session.run(f"""
 var damaged = List.new, rows = FrictionStudyFiles.readCsv({sclang.sc_string(str(path))}, damaged);
 rows.do {{ |r| "KF-ROW % % % %".format(r[\\participant], r[\\answer].collectAs({{ |c| (c.ascii % 256).asHexString(2) }},
     Array).join, r[\\level], r.size).postln }};
 "KF-DAMAGED %".format(damaged.join(" ")).postln;
-""", name="checked-csv-read")
+""")
     rows = [line.split()[1:] for line in out.splitlines() if line.startswith("KF-ROW ")]
     damaged = [line.split()[1:] for line in out.splitlines() if line.startswith("KF-DAMAGED")]
     return [dict(participant=p, answer=bytes.fromhex(h).decode("utf-8"), level=level, size=int(n))

@@ -2,7 +2,7 @@
 record and replay, and closed slots."""
 import numpy as np
 
-from kfharness import nrt, paths, sclang
+from kfharness import nrt, paths, sclang_session
 from kfstudy import readers
 
 SR = 48000
@@ -160,7 +160,7 @@ def test_same_score_renders_the_same_file_sample_for_sample():
 
 
 def test_bad_device_arguments_give_clear_errors():
-    out = sclang.run_script("""
+    out = sclang_session.run("""
         var errors = List.new;
         [
             { FrictionHand.path([[0, 0], [-1, 3]]) },
@@ -185,7 +185,7 @@ def test_bad_device_arguments_give_clear_errors():
 
 
 def test_specs_names_carry_units_old_names_still_work_and_audio_delay_is_one_ms():
-    out = sclang.run_script("""
+    out = sclang_session.run("""
         var d = FrictionDevice.describeSim(0), e = FrictionDevice.describeSim(1, nil, (maxForce: 1.0, tactileLatencyS: 0.003));
         [\\countMm, \\updateRateHz, \\maxSpeedMmPerS, \\minForceN, \\maxForceN, \\audioLatencyS, \\tactileLatencyS].do { |k|
             "UNIT % %".format(k, d.specs[k]).postln };

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pytest
 
-from kfharness import nrt, reference, sclang
+from kfharness import nrt, reference, sclang_session
 
 
 def render_in_and_force(name, source, sample_rate, args="", seconds=0.5):
@@ -84,7 +84,7 @@ def test_window_changes_while_running_up_to_max_window():
 
 
 def test_control_rate_and_bad_arguments():
-    out = sclang.run_script("""
+    out = sclang_session.run("""
         var errors = List.new;
         SynthDef(\\kr, { Out.kr(0, LoudnessToFriction.kr(SinOsc.kr(1), 0.01)) }).add;
         [

@@ -5,11 +5,11 @@ import re
 
 import numpy as np
 
-from kfharness import nrt, paths, sclang
+from kfharness import nrt, paths, sclang_session
 
 
 def test_mouse_messages_and_specs():
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         var d = FrictionDevice.describeMouse(2, "0458:0138", \evdev, (countMm: 0.02), true);
         "KF-MSG %".format(d.openMsg).postln;
         "KF-MOUSEMSG %".format(d.mouseMsg == d.openMsg).postln;
@@ -34,7 +34,7 @@ def test_mouse_messages_and_specs():
 
 def test_stroke_and_profile_round_trip():
     path = paths.work_dir() / "gila-profile.txt"
-    out = sclang.run_script(f"""
+    out = sclang_session.run(f"""
         var x = FrictionDevice.countMmFromStroke(-4731, 100), y = FrictionDevice.countMmFromStroke(4690, 100);
         var p, d;
         FrictionDevice.writeMouseProfile("{path}", (name: "Genius Gila", vendorId: "0458", productId: "0138",
@@ -55,7 +55,7 @@ def test_stroke_and_profile_round_trip():
 
 
 def test_bad_mouse_arguments_give_clear_errors():
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         [
             { FrictionDevice.describeMouse(0, nil, \usb) },
             { FrictionDevice.describeMouse(0, 3.5) },

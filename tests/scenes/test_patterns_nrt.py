@@ -4,7 +4,7 @@ position FrictionMouseIn gave it (kfharness.patterns)."""
 import numpy as np
 import pytest
 
-from kfharness import nrt, patterns, sclang
+from kfharness import nrt, patterns, sclang_session
 
 LO, HI = 0.14, 0.5
 # name, FrictionPattern code on x (and h, a height signal), reference level from (x, h, rate)
@@ -237,7 +237,7 @@ def test_texture2d_along_a_line_at_an_angle_is_its_definition():
 
 
 def test_literal_arguments_are_checked_when_the_synthdef_is_built():
-    out = sclang.run_script("""
+    out = sclang_session.run("""
         var errors = List.new;
         SynthDef(\\good, { Out.ar(0, FrictionPattern.texture2D(DC.ar(0), DC.ar(0), 0.5, 3, 1)) }).add;
         [

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from kfharness import nrt, paths, sclang
+from kfharness import nrt, paths, sclang_session
 from kfharness import pilot as P
 
 SR = 48000
@@ -192,7 +192,7 @@ def test_audio_reaches_the_output_audio_delay_after_the_force_reaches_the_device
 
 
 def test_pilot_class_signal_mappings_and_clear_errors():
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         var sig = FrictionPilot.signal, expectError;
         expectError = { |name, fn|
             var msg = nil;

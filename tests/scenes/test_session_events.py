@@ -5,18 +5,18 @@ import re
 
 import numpy as np
 
-from kfharness import paths, sclang
+from kfharness import paths, sclang_session
 from kfstudy import session_folder
 
 
 def test_sclang_and_python_name_the_same_events():
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
 "KF-CONDITION %".format(FrictionStudySession.conditionEvents.join(" ")).postln;
 "KF-SESSION %".format(FrictionStudySession.sessionEvents.join(" ")).postln;
 try { FrictionStudySession.checkEvent(\strat) } { |e| "KF-REFUSED %".format(e.what).postln };
 try { FrictionStudySession.checkEvent(\prepare, true) } { |e| "KF-REFUSED-SESSION %".format(e.what).postln };
 "KF-ACCEPTED % %".format(FrictionStudySession.checkEvent(\prepare), FrictionStudySession.checkEvent(\finish, true)).postln;
-""", name="session-events")
+""")
     lines = {line.split()[0]: line.split()[1:] for line in out.splitlines() if line.startswith("KF-")}
     assert tuple(lines["KF-CONDITION"]) == session_folder.CONDITION_EVENTS
     assert tuple(lines["KF-SESSION"]) == session_folder.SESSION_EVENTS
@@ -40,12 +40,12 @@ def test_every_event_named_in_the_code_is_in_the_vocabulary():
 
 def test_the_coverage_map_logged_reads_back_as_the_cells_covered():
     # FrictionStudyCoverage.mapString, the coverageMap event's detail, read by Condition.live_cells.
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
 var c = FrictionStudyCoverage([0, 6], 5, 300, 10, 6, 0.5);
 c.add(0, 2.9, 20); c.add(4.5, 6, 250); c.add(7, 9, 20);
 "KF-MAP %".format(c.mapString).postln;
 c.cells.do { |row, p| row.do { |covered, v| if(covered) { "KF-CELL % %".format(p, v).postln } } };
-""", name="coverage-map")
+""")
     detail = next(line.split()[1] for line in out.splitlines() if line.startswith("KF-MAP"))
     covered = {tuple(map(int, line.split()[1:])) for line in out.splitlines() if line.startswith("KF-CELL")}
     # 20 mm/s is the third speed part of six from 5 to 300 mm/s (log), 250 mm/s the sixth; the

@@ -10,7 +10,7 @@ import re
 import numpy as np
 import pytest
 
-from kfharness import paths, psignifit_cli, questplus_ref, sclang, thresholds
+from kfharness import paths, psignifit_cli, questplus_ref, sclang_session, thresholds
 from kfstudy import psychometric
 
 OBS = thresholds.OBSERVER
@@ -24,7 +24,7 @@ def _levels(out, tag):
 def test_staircase_rules_step_by_step():
     # Scripted answers; the levels written out by hand from the rules (log10 steps 0.2 then 0.1;
     # a reversal is a change of direction, and the step after i reversals is stepSizes[i]).
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         var s = FrictionStaircase(1, 2, [0.2, 0.1], \log, 4, 100), l;
         [true, true, false, true, true, false, false, true, true].do { |a|
             l = s.next; "KF-L %".format(l).postln; s.respond(l, a) };
@@ -55,7 +55,7 @@ def test_staircase_rules_step_by_step():
 def test_observer_answers_follow_its_function():
     # 4000 answers at each level: the share right is binomial, sd sqrt(p (1 - p) / 4000) <= 0.0079;
     # 4 sd (0.032) fails by chance once in 16000. The same seed gives the same answers.
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         var o = FrictionObserver(0.2, 3, 0.04, 0.5, 11);
         [0.05, 0.1, 0.2, 0.3, 1].do { |x|
             var right = 0; 4000.do { if(o.answer(x)) { right = right + 1 } };
@@ -201,7 +201,7 @@ def test_report_section_from_a_trials_csv(runs):
 
 
 def test_bad_arguments_are_refused():
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         [
             { FrictionObserver(0) }, { FrictionObserver(1, -1) }, { FrictionObserver(1, 2, 0.6) },
             { FrictionStaircase(1, 0) }, { FrictionStaircase(1, 2, []) }, { FrictionStaircase(1, 2, stepType: \db) },
@@ -226,7 +226,7 @@ def test_each_procedure_continues_from_stored_trials():
     # levels as trials.csv holds them (asString), given to a new experiment and a new observer of
     # the same seeds; what follows must be the straight run's trials, level for level, and its
     # estimate. k = 7 puts QUEST+ past its first choices and the staircase past reversals.
-    out = sclang.run_script(r"""
+    out = sclang_session.run(r"""
         var makers = [
             \staircase -> { FrictionStaircase(0.4, 2, [0.2, 0.1, 0.05], \log, 10, 40) },
             \questplus -> { FrictionQuestPlus(Array.geom(12, 0.02, 1.4), maxTrials: 24) },
@@ -250,7 +250,7 @@ def test_each_procedure_continues_from_stored_trials():
             try { experiment.(pair.value).continueFrom(stored) } { |e| "KF-PART % %".format(pair.key, e.errorString)
                 .postln };
         };
-    """, name="threshold-continue")
+    """)
     lines = [line.split() for line in out.splitlines() if line.startswith("KF-CONT ")]
     assert lines == [["KF-CONT", name, "7", "true", "true"] for name in ("staircase", "questplus", "constant")], \
         out[-3000:]
