@@ -20,7 +20,7 @@ cpu = { |pid|
 measure = { |name|
 	var t0 = Main.elapsedTime, s0 = cpu.(s.pid), l0 = cpu.(thisProcess.pid), loads = List.new;
 	@PHASE@.do { 1.wait; loads.add(s.avgCPU) };
-	"KF-COST % % % % %".format(name, Main.elapsedTime - t0, cpu.(s.pid) - s0, cpu.(thisProcess.pid) - l0, loads.mean).postln;
+	"KF-COST % % % % %\n".postf(name, Main.elapsedTime - t0, cpu.(s.pid) - s0, cpu.(thisProcess.pid) - l0, loads.mean);
 };
 // Back and forth across the fragment (10 .. 58 mm) for 60 s.
 hand = FrictionHand.speeds(([[40, 1.5], [-40, 1.5]] ! 20).flatten(1));
@@ -33,7 +33,7 @@ v = pilot.view(bounds: Rect(40, 40, 1000, 700));
 v.rangeMm = [-20, 120];
 2.wait;
 measure.("pilot+view");
-"KF-FRAMES % %".format(v.frameCount, v.timeS).postln;
+"KF-FRAMES % %\n".postf(v.frameCount, v.timeS);
 def = v.synth.defName;
 v.free;
 s.sync;

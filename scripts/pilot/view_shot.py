@@ -27,7 +27,7 @@ while { v.positionMm < 75 and: { Main.elapsedTime - t0 < 20 } } { 0.05.wait };
 v.paused = true;  // the window shows the last picture drawn: let it settle, then grab it
 0.3.wait;
 Image.fromWindow(v.window).write(@PATH@);
-"KF-VIEW-SHOT % mm % frames".format(v.drawn.positionMm, v.frameCount).postln;
+"KF-VIEW-SHOT % mm % frames\n".postf(v.drawn.positionMm, v.frameCount);
 v.free; pilot.free; dev.close;
 s.sync;
 """

@@ -25,13 +25,13 @@ sessions = @PARTICIPANTS@.collect { |i|
 		windows: false, participantOut: 4 * i, experimenterOut: 4 * i + 2, deviceIndex: i)
 };
 while { sessions.any { |session| session.isOver.not } } { 0.1.wait };
-"KF-STUDY-SESSIONS % s".format((Main.elapsedTime - t0).round(0.1)).postln;
-sessions.do { |session| "KF-STUDY-SESSION % %".format(session.participant, session.state).postln };
+"KF-STUDY-SESSIONS % s\n".postf((Main.elapsedTime - t0).round(0.1));
+sessions.do { |session| "KF-STUDY-SESSION % %\n".postf(session.participant, session.state) };
 sessions.do { |session|
 	if(session.state != \finished) { Error("session % ended %".format(session.participant, session.state)).throw }
 };
 t0 = Main.elapsedTime;
-"KF-STUDY-REPORT % % s".format(FrictionStudy.report(root, @OUT@), (Main.elapsedTime - t0).round(0.1)).postln;
+"KF-STUDY-REPORT % % s\n".postf(FrictionStudy.report(root, @OUT@), (Main.elapsedTime - t0).round(0.1));
 """
 
 

@@ -38,8 +38,8 @@ def baseline(jack, seconds):
         synths = {VOICES}.collect {{ |i| {{ SinOsc.ar(220 * (i + 1), 0, 0.05) }}.play }};
         s.sync;
         while {{ Main.elapsedTime - t0 < {seconds} }} {{
-            "KF-RSS % %".format(Main.elapsedTime - t0, ~rssOf.(s.pid)).postln;
-            "KF-CPU % % %".format(Main.elapsedTime - t0, s.avgCPU, s.peakCPU).postln;
+            "KF-RSS % %\n".postf(Main.elapsedTime - t0, ~rssOf.(s.pid));
+            "KF-CPU % % %\n".postf(Main.elapsedTime - t0, s.avgCPU, s.peakCPU);
             10.wait;
         }};
         synths.do(_.free);
@@ -61,8 +61,8 @@ def devices(jack, seconds, record, thread_priority):
         2.wait;
         t0 = Main.elapsedTime;
         while {{ Main.elapsedTime - t0 < {seconds} }} {{
-            "KF-RSS % %".format(Main.elapsedTime - t0, ~rssOf.(s.pid)).postln;
-            "KF-CPU % % %".format(Main.elapsedTime - t0, s.avgCPU, s.peakCPU).postln;
+            "KF-RSS % %\n".postf(Main.elapsedTime - t0, ~rssOf.(s.pid));
+            "KF-CPU % % %\n".postf(Main.elapsedTime - t0, s.avgCPU, s.peakCPU);
             devs.do(_.status);
             10.wait;
         }};
