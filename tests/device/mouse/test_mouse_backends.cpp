@@ -391,6 +391,11 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.endS = 6.5;
+  // The recording holds what comes after startRecording returns, so the first report must come
+  // later: under TSan beside device_tests it returned after the default 50 ms lead (the file's
+  // first report 65 ms after the plug-in, 67 of 69 recorded, every one delivered). 1 s is over ten
+  // times that, and the CHECK below says so if a machine ever holds the open up longer.
+  script.leadS = 1.0;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   MouseOpenOptions options;
@@ -442,6 +447,11 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.endS = 6.5;
+  // The recording holds what comes after startRecording returns, so the first report must come
+  // later: under TSan beside device_tests it returned after the default 50 ms lead (the file's
+  // first report 65 ms after the plug-in, 67 of 69 recorded, every one delivered). 1 s is over ten
+  // times that, and the CHECK below says so if a machine ever holds the open up longer.
+  script.leadS = 1.0;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   DeviceSpec spec;
@@ -452,14 +462,15 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   REQUIRE(device);
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
   REQUIRE(device->startRecording(path, error));
-  // Until the device has handed over every report played (all due 0.55 s after the plug-in), with a
+  CHECK(api->timeline->nowSincePlugS() < script.leadS);  // recording before the first report is due
+  // Until the device has handed over every report played (all due 0.5 s after the lead), with a
   // hang guard: its mouse thread, held up on a loaded machine, reads them late (under TSan beside
   // three realtime tests, a fresh clone at a1c995c closed at 0.8 s with 55 of 69 read and recorded).
   const Sums expected = sumOfPlayed(*api->timeline);
   std::vector<MouseReport> delivered;
   MouseReport buffer[64];
   const auto guard = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while ((api->timeline->nowSincePlugS() < 0.8 || sumOf(delivered).reports < expected.reports) &&
+  while ((api->timeline->nowSincePlugS() < script.leadS + 0.75 || sumOf(delivered).reports < expected.reports) &&
          std::chrono::steady_clock::now() < guard) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     const int n = device->popReports(buffer, 64);
