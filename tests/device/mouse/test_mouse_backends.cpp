@@ -391,11 +391,6 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
   script.endS = 6.5;
-  // The recording holds what comes after startRecording returns, so the first report must come
-  // later: under TSan beside device_tests it returned after the default 50 ms lead (the file's
-  // first report 65 ms after the plug-in, 67 of 69 recorded, every one delivered). 1 s is over ten
-  // times that, and the CHECK below says so if a machine ever holds the open up longer.
-  script.leadS = 1.0;
   auto api = std::make_shared<FakeHidApi>(script);
   std::string error;
   MouseOpenOptions options;
