@@ -66,8 +66,7 @@ check_pyflakes() {
   git ls-files '*.py' | xargs "$KF_PYTHON" -m pyflakes
 }
 
-# configure_and_build <dir> <cmake args...> [-- <build args...>]
-# configure_and_build <dir> [cmake -D...] [-- build arguments]. The test command's builds of
+# configure_and_build <dir> <cmake args...> [-- <build args...>]. The test command's builds of
 # the libraries are unity builds (-DCMAKE_UNITY_BUILD=ON; the tests' and the plugin's files stay
 # one by one, tests/ and plugins/CMakeLists.txt): build-asan/ from nothing took 164 CPU-s against
 # 201 file by file, build/ 342 against 433 (-j2, measured side by side). A file that lacks an

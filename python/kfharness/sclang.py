@@ -283,10 +283,10 @@ def run_and_kill(code, jack, ready, name="killed", timeout=120, server_options=N
         server_left_s=5.0 if orphaned is None else 60.0)))
     thread.start()
     deadline = time.monotonic() + wait_s
-    while time.monotonic() < deadline and not (_whole_line(pids) and ready()):
+    while time.monotonic() < deadline and not (written_lines(pids) and ready()):
         time.sleep(0.02)
-    assert _whole_line(pids) and ready(), f"{name}: what the kill waits for never came"
-    sclang_pid, scsynth_pid = (int(v) for v in pids.read_text().split())
+    assert written_lines(pids) and ready(), f"{name}: what the kill waits for never came"
+    sclang_pid, scsynth_pid = (int(v) for v in written_lines(pids).split())
     if orphaned is None:
         os.kill(scsynth_pid, signal.SIGKILL)
     os.kill(sclang_pid, signal.SIGKILL)
@@ -298,13 +298,15 @@ def run_and_kill(code, jack, ready, name="killed", timeout=120, server_options=N
     return result["run"]
 
 
-def _whole_line(path):
-    """Whether `path` holds a line sclang has finished writing: File.use makes the file before it
-    writes, and a harness that read it in between got no pids (a fresh clone at 1a6ef7c)."""
+def written_lines(path):
+    """The text of a file sclang writes with File.use, once whole ("" before): File.use makes the
+    file before it writes, and sclang has no rename, so a file is whole once it ends with a line
+    break (a harness that read it in between got no pids, a fresh clone at 1a6ef7c)."""
     try:
-        return path.read_text().endswith("\n")
+        text = path.read_text()
     except FileNotFoundError:
-        return False
+        return ""
+    return text if text.endswith("\n") else ""
 
 
 def _send_quit(port):

@@ -54,7 +54,7 @@ Routine {
 
 
 class SclangSession:
-    """A running sclang that takes code through run(); start() on first use, stop() to end it."""
+    """A running sclang that takes code through run(), started on first use; stop() ends it."""
 
     def __init__(self, name="session"):
         self.name = name
@@ -98,7 +98,7 @@ class SclangSession:
         (self.dir / f"{n}.go").touch()
         done = self.dir / f"{n}.done"
         deadline = time.monotonic() + timeout
-        while not self._read_done(done).endswith("\n"):
+        while not (status := sclang.written_lines(done).strip()):
             if self.proc.poll() is not None:
                 raise AssertionError(f"sclang (session) ended ({self.proc.returncode}) during piece {n}:\n"
                                      f"{self._log()[-4000:]}")
@@ -107,19 +107,9 @@ class SclangSession:
                 raise AssertionError(f"sclang (session): piece {n} took over {timeout} s; stopped:\n"
                                      f"{self._log()[-4000:]}")
             time.sleep(POLL_S)
-        status = done.read_text().strip()
         output = self._piece_output(n)
         assert status == "ok", f"sclang (session) piece {n}: {status}:\n{output[-4000:]}"
         return output
-
-    @staticmethod
-    def _read_done(done):
-        """<n>.done's text, "" before sclang made it: whole once it ends with a line break (sclang
-        has no rename to make it appear at once)."""
-        try:
-            return done.read_text()
-        except FileNotFoundError:
-            return ""
 
     def _log(self):
         return self.log_path.read_text(errors="replace")
