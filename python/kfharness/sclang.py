@@ -64,6 +64,23 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 """
 
 
+# What sclang posts when its class library did not compile (a syntax error in a class file, a class
+# found twice, as when the extension is both linked and installed into the user's Extensions). It
+# then runs no script and does not exit: it waits for input. The runners stop it at this line, with
+# the reason, instead of at their timeout (the study job waited out its 530 s).
+LIBRARY_FAILED = "Library has not been compiled successfully"
+
+
+def library_failed(output):
+    """The class library's errors as sclang posted them (every line from the first ERROR up to
+    LIBRARY_FAILED), or None when the library compiled (or has not finished compiling)."""
+    end = output.find(LIBRARY_FAILED)
+    if end < 0:
+        return None
+    start = output.find("ERROR")
+    return output[start if 0 <= start < end else 0:end + len(LIBRARY_FAILED)]
+
+
 def _script_files(code, name):
     key = f"{name}-{os.getpid()}-{random.randrange(16 ** 6):06x}"
     code_path = paths.work_dir() / f"{key}.code.scd"
@@ -87,13 +104,46 @@ def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="scri
             run_env.pop(name, None)
         else:
             run_env[name] = value
-    proc = subprocess.run(["sclang", "-l", str(config(include_paths)), str(script)],
-                          stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          env=run_env, timeout=timeout, text=True, errors="replace")
-    out = proc.stdout
+    log_path = paths.work_dir() / f"{key}.log"
+    with open(log_path, "w") as log:
+        proc = subprocess.Popen(["sclang", "-l", str(config(include_paths)), str(script)],
+                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, env=run_env)
+        try:
+            failed = wait_for_sclang(proc, log_path, timeout)
+            timed_out = proc.poll() is None and not failed
+        finally:
+            procs.stop_pid(proc.pid, grace_s=2.0)
+            proc.wait()
+    out = log_path.read_text(errors="replace")
+    assert not failed, f"sclang's class library did not compile:\n{failed[-4000:]}"
+    if timed_out:
+        raise subprocess.TimeoutExpired(proc.args, timeout, out)
     if expect_ok:
         assert "KF-SCRIPT-OK" in out and proc.returncode == 0, f"sclang failed:\n{out[-4000:]}"
     return out
+
+
+# sclang posts this once its class library has compiled: from then on it runs the script.
+LIBRARY_COMPILED = "*** Welcome to SuperCollider"
+
+
+def wait_for_sclang(proc, log_path, timeout, on_poll=None):
+    """Waits until sclang (`proc`, posting into `log_path`) ends, `timeout` s pass, or its class
+    library fails: then returns the library's errors (library_failed), else None. The log is read
+    every 0.1 s until the library has compiled; `on_poll()` is called at each poll."""
+    deadline = time.monotonic() + timeout
+    compiling = True
+    while proc.poll() is None and time.monotonic() < deadline:
+        if compiling:
+            text = log_path.read_text(errors="replace")
+            failed = library_failed(text)
+            if failed:
+                return failed
+            compiling = LIBRARY_COMPILED not in text
+        if on_poll is not None:
+            on_poll()
+        time.sleep(0.1)
+    return None
 
 
 class SclangRun:
@@ -208,13 +258,15 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             proc = subprocess.Popen(["sclang", "-l", str(config(include_paths)), str(script)],
                                     stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                     env=run_env, cwd=paths.work_dir())
-            deadline = time.monotonic() + timeout
-            while proc.poll() is None and time.monotonic() < deadline:
+            def on_poll():
                 known_children.update(procs.descendants(proc.pid))
                 if booted is not None and not booted.is_set() and "KF-SERVER-UP" in log_path.read_text(errors="replace"):
                     booted.set()
-                time.sleep(0.1)
-            if proc.poll() is None:
+
+            failed = wait_for_sclang(proc, log_path, timeout, on_poll)
+            if failed:
+                log.write("\nKF-HARNESS: sclang's class library did not compile (above); stopped\n")
+            elif proc.poll() is None:
                 known_children.update(procs.descendants(proc.pid))
                 log.write("\nKF-HARNESS: sclang timed out; killed\n")
         finally:

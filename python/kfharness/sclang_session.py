@@ -102,6 +102,9 @@ class SclangSession:
             if self.proc.poll() is not None:
                 raise AssertionError(f"sclang (session) ended ({self.proc.returncode}) during piece {n}:\n"
                                      f"{self._log()[-4000:]}")
+            if n == 0 and (failed := sclang.library_failed(self._log())):
+                self.stop()
+                raise AssertionError(f"sclang (session): its class library did not compile:\n{failed[-4000:]}")
             if time.monotonic() > deadline:
                 self.stop()
                 raise AssertionError(f"sclang (session): piece {n} took over {timeout} s; stopped:\n"

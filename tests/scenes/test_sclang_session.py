@@ -1,9 +1,13 @@
 """The harness's shared sclang (kfharness.sclang_session), which writes every scene's Score: each
 piece's output is its own, a failing piece fails its test with sclang's error and leaves the next
 one working, a piece's environment does not reach the next, and a session whose sclang is gone
-starts again."""
+starts again. And sclang whose class library did not compile (it then waits for input, running
+nothing): the runner stops it with the library's errors rather than at its timeout."""
+import shutil
+
 import pytest
 
+from kfharness import paths, sclang
 from kfharness.sclang_session import SclangSession
 
 
@@ -35,3 +39,13 @@ def test_a_session_whose_sclang_ended_starts_again(session):
     session.stop()
     assert "again" in session.run('"again".postln;')
     assert session.proc.pid != first
+
+
+def test_a_class_library_that_does_not_compile_stops_the_run_with_its_errors(tmp_path):
+    """The extension's classes twice (as when it is both linked and installed into a user's
+    Extensions): the run ends with sclang's errors well before its timeout, which would raise
+    TimeoutExpired instead (the study job once waited out 530 s so)."""
+    twice = tmp_path / "Classes"
+    shutil.copytree(paths.extension_dir() / "Classes", twice)
+    with pytest.raises(AssertionError, match=r"(?s)class library did not compile.*duplicate Class found: 'FrictionDevice'"):
+        sclang.run_script('"never run".postln;', timeout=60, include_paths=[paths.extension_dir() / "Classes", twice])
