@@ -8,7 +8,8 @@
 #   fuzz       every libFuzzer target for KF_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh), built
 #              in build-asan/ (sanitize-build alone: that build without running anything)
 #   sanitize-plugin
-#              the scene and realtime tests against the plugin built with both sanitizers
+#              the scene tests and the realtime tests with plugin lines of their own
+#              (tests/realtime/CMakeLists.txt) against the plugin built with both sanitizers
 #              (build-asan-plugin/, tests named sanitized/...), their runtimes preloaded into every
 #              scsynth the tests start (KF_SERVER_PRELOAD); any finding fails. KF_SANITIZED_TESTS: a
 #              ctest regex to run fewer of them. scripts/test.sh runs its halves,
