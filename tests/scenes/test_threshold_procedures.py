@@ -152,9 +152,10 @@ def dense_maximum(levels, correct, guess=0.5):
     x, right, total = psychometric.grouped(levels, correct)
     log_t = np.linspace(np.log(x.min() / 2) - 2, np.log(x.max() * 2) + 2, 300)[:, None, None]
     slope = np.exp(np.linspace(np.log(0.2), np.log(20), 80))[None, :, None]
+    rising = 1 - np.exp(-np.exp(slope * (np.log(x) - log_t)))  # the Weibull, the same for every lapse rate
     best = -np.inf
     for lapse in np.linspace(0, psychometric.MAX_LAPSE, 11):
-        p = np.clip(guess + (1 - guess - lapse) * (1 - np.exp(-(x / np.exp(log_t)) ** slope)), 1e-12, 1 - 1e-12)
+        p = np.clip(guess + (1 - guess - lapse) * rising, 1e-12, 1 - 1e-12)
         best = max(best, float(np.max(np.sum(right * np.log(p) + (total - right) * np.log1p(-p), axis=-1))))
     return best
 
