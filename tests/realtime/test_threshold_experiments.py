@@ -37,6 +37,12 @@ def intervals_of(path):
     reports = np.array([r for tag, r in records if tag == "R"])
     frames = np.array([f for tag, f in records if tag == "F"])
     x_mm = np.interp(frames[:, 0], reports[:, 0], np.cumsum(reports[:, 2]) * count_mm)
+    return split_intervals(frames, x_mm)
+
+
+def split_intervals(frames, x_mm):
+    """intervals_of's split, of force frames (rows: host time s, -, force N, commanded N) and the
+    puck's x at each."""
     # A frame is the mean over 1 ms: one straddling an interval's edge is partly active.
     active = np.concatenate([[False], frames[:, 2] > 0.17, [False]])
     edges = np.flatnonzero(np.diff(active.astype(int)))
@@ -55,6 +61,37 @@ def check_span(kind, i, times, stall_s, tolerance_s):
     span_s = times[-1] - times[0] + 1e-3
     print(f"KF-FIGURE threshold_{kind}_interval_{i}_span_s {span_s:.4f} stall_s {stall_s:.4f}")
     assert span_s < INTERVAL_S + tolerance_s and span_s + stall_s > INTERVAL_S - tolerance_s, (kind, i, span_s, stall_s)
+
+
+def test_a_stall_excuses_a_short_interval_and_nothing_else():
+    """The stall credit of check_span, on frames made here: two 0.5 s intervals at 1 ms frames, the
+    second with 0.3 s of no frames at its start (jackd stopped: what a fresh clone at c795d56 saw)."""
+    def frames_of(*spans):
+        t, rows = 0.0, []
+        for force_n, duration_s, gap_s in spans:
+            t += gap_s
+            for _ in range(round(duration_s * 1000)):
+                rows.append([t, 0, force_n, force_n])
+                t += 1e-3
+        return np.array(rows)
+
+    def checked(frames):
+        parts = split_intervals(frames, np.zeros(len(frames)))
+        for i, (times, _, _, stall_s) in enumerate(parts):
+            check_span("made", i, times, stall_s, 0.075)
+        return [round(p[3], 3) for p in parts]
+
+    assert checked(frames_of((0.14, 0.2, 0), (0.3, 0.5, 0), (0.14, 0.15, 0), (0.3, 0.5, 0), (0.14, 0.1, 0))) == [0, 0]
+    # The stall at the second interval's start: 0.2 s of it left, 0.3 s of gap credited.
+    stalled = frames_of((0.14, 0.2, 0), (0.3, 0.5, 0), (0.14, 0.15, 0), (0.3, 0.2, 0.3), (0.14, 0.1, 0))
+    assert checked(stalled) == [0, 0.3]
+    # Without a stall, a 0.2 s interval fails; so does a long one, stall or not.
+    for spans in [((0.3, 0.2, 0), (0.14, 0.1, 0)), ((0.3, 0.6, 0), (0.14, 0.1, 0)), ((0.3, 0.6, 0.3), (0.14, 0.1, 0))]:
+        try:
+            checked(frames_of((0.14, 0.2, 0), *spans))
+        except AssertionError:
+            continue
+        raise AssertionError(f"{spans} passed check_span")
 
 
 def on_tempo_clock(code):
