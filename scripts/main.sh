@@ -8,4 +8,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/env.sh
-"$KF_PYTHON" scripts/pilot/main_job.py "$@"
+# exec: a signal sent to this script reaches the job, which stops what it started.
+exec "$KF_PYTHON" scripts/pilot/main_job.py "$@"

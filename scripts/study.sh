@@ -19,4 +19,5 @@ scripts/setup.sh
 source scripts/packages.sh
 kf_install_missing python3-scipy python3-pandas
 source scripts/env.sh
-"$KF_PYTHON" scripts/study/study_job.py "$@"
+# exec: a signal sent to this script reaches the job, which stops what it started.
+exec "$KF_PYTHON" scripts/study/study_job.py "$@"

@@ -73,6 +73,15 @@ def descendants(pid):
     return found
 
 
+def finish_on_sigterm():
+    """A job ended by SIGTERM (kill, timeout, a closed session) ends as Ctrl-C ends it: its finally
+    blocks run, and the jackd, sclang and servers it started are stopped rather than left running
+    (Python's default for SIGTERM is to die at once)."""
+    def finish(signum, frame):
+        raise SystemExit(128 + signum)
+    signal.signal(signal.SIGTERM, finish)
+
+
 def stop_pid(pid, grace_s=5.0):
     """SIGTERM, then SIGKILL after grace_s; only the one process given."""
     if pid is None or not pid_alive(pid):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import nrt, paths, trace_csv
+from kfharness import nrt, paths, procs, trace_csv
 from kfharness import patterns as K
 from kfharness import pilot as P
 
@@ -215,6 +215,7 @@ def surfaces_and_steering_section(out_dir):
 
 
 def main():
+    procs.finish_on_sigterm()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rate", type=int, default=48000)
     ap.add_argument("--out", default=str(paths.REPO_DIR / "out" / "gallery"))

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import paths
+from kfharness import paths, procs
 from kfharness import pilot as P
 from kfharness import trace_csv
 from view_shot import write_view_shot
@@ -172,6 +172,7 @@ def summary(scenes, results, rate, out_dir, elapsed):
 
 
 def main():
+    procs.finish_on_sigterm()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rate", type=int, default=48000, help="render sample rate (Hz); the paper used 192000")
     ap.add_argument("--out", default=str(paths.REPO_DIR / "out" / "pilot"))

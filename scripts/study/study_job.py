@@ -11,7 +11,7 @@ import shutil
 import time
 from pathlib import Path
 
-from kfharness import paths, sclang
+from kfharness import paths, procs, sclang
 from kfharness.jack import performer_jack
 
 # The participants run at once, each on a device slot of its own (deviceIndex) and output pairs of
@@ -63,6 +63,7 @@ def run_study(out_dir, participants=5, explore_s=None, trials=40, interval_s=1.5
 
 
 def main():
+    procs.finish_on_sigterm()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=str(paths.REPO_DIR / "out" / "study"))
     parser.add_argument("--participants", type=int, default=5)

@@ -1,0 +1,51 @@
+"""A main job stopped by SIGTERM (kill, timeout, a session manager) stops what it started, as one
+stopped with Ctrl-C does: scripts/study.sh killed while its participant plays leaves no jackd,
+sclang or scsynth running. (Python's default for SIGTERM is to die at once, its finally blocks
+unrun: the three played on, the server at a fifth of a core, until killed by hand.)"""
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+from kfharness import paths, procs
+
+
+def name_of(pid):
+    try:
+        return Path(f"/proc/{pid}/comm").read_text().strip()
+    except OSError:
+        return None
+
+
+def test_the_study_job_stopped_by_sigterm_leaves_nothing_running():
+    out = paths.work_dir() / "stopped-study"
+    log_path = paths.work_dir() / "stopped-study.log"
+    seen = {}  # pid -> name: every process below the job while it ran
+    with open(log_path, "w") as log:
+        job = subprocess.Popen(["bash", str(paths.REPO_DIR / "scripts" / "study.sh"), "--out", str(out),
+                                "--participants", "1", "--explore-s", "60", "--trials", "0"],
+                               stdout=log, stderr=subprocess.STDOUT)
+    try:
+        # Until its server has played a while (set-up, sclang's start and the boot come first).
+        deadline, playing_since = time.monotonic() + 240, None
+        while job.poll() is None and time.monotonic() < deadline:
+            for pid in procs.descendants(job.pid):
+                seen.setdefault(pid, name_of(pid))
+            if playing_since is None and "scsynth" in seen.values():
+                playing_since = time.monotonic()
+            if playing_since is not None and time.monotonic() - playing_since > 3:
+                break
+            time.sleep(0.2)
+        running = sorted(set(seen.values()) - {None})
+        assert {"jackd", "sclang", "scsynth"} <= set(running), (running, log_path.read_text()[-3000:])
+        job.send_signal(signal.SIGTERM)
+        # The job stops sclang (2 s to quit), its server (5 s) and jackd before it exits.
+        code = job.wait(timeout=30)
+        left = [(pid, name) for pid, name in seen.items() if procs.pid_alive(pid) and name_of(pid) == name]
+        assert not left, f"still running after the job ended ({code}): {left}"
+        assert code == 128 + signal.SIGTERM, (code, log_path.read_text()[-3000:])
+    finally:
+        procs.stop_pid(job.pid)
+        for pid, name in seen.items():
+            if procs.pid_alive(pid) and name_of(pid) == name:
+                procs.stop_pid(pid)
