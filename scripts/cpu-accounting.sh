@@ -4,6 +4,7 @@
 # sums them by process name and, for each ctest in the command's output, by test (a test's process
 # tree). It found the texture model, run in Python by three tests, at a tenth of the test command's
 # Python time, and Qt WebEngine's helper processes at 49 CPU-s. Not part of the test command.
+# It turns off any system-wide accounting that was on (accton has one file at a time).
 # Usage: scripts/cpu-accounting.sh COMMAND... (e.g. scripts/cpu-accounting.sh scripts/test.sh)
 #        output in build/cpu-accounting.log, the report in build/cpu-accounting.txt
 set -uo pipefail
@@ -15,10 +16,13 @@ kf_install_missing acct
 mkdir -p build
 records=$PWD/build/cpu-accounting.pacct
 rm -f "$records" && touch "$records"
-accton "$records" > /dev/null
+accton "$records" > /dev/null || exit 1
+# Off however the command ends (Ctrl-C included): the kernel would go on writing to the file.
+trap 'accton off > /dev/null' EXIT
 "$@" 2>&1 | tee build/cpu-accounting.log
 code=${PIPESTATUS[0]}
 accton off > /dev/null
+trap - EXIT
 dump-acct "$records" | /usr/bin/python3 scripts/accounting/report.py build/cpu-accounting.log > build/cpu-accounting.txt
 echo "== CPU by process and by test: build/cpu-accounting.txt"
 head -30 build/cpu-accounting.txt

@@ -47,6 +47,13 @@ class JackServer:
         with open(self.log_path, "w") as log:
             self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
                                          stderr=subprocess.STDOUT, env=self.env)
+        try:
+            return self._wait_up(timeout_s)
+        except BaseException:  # not up, or interrupted meanwhile (Ctrl-C, a job's SIGTERM): not left running
+            self.stop()
+            raise
+
+    def _wait_up(self, timeout_s):
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
@@ -57,7 +64,6 @@ class JackServer:
             if probe.returncode == 0 and "system:playback_1" in probe.stdout:
                 return self
             time.sleep(0.2)
-        self.stop()
         raise RuntimeError(f"jackd did not come up in {timeout_s} s:\n{self.log()}")
 
     def alive(self):

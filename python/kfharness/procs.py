@@ -74,12 +74,16 @@ def descendants(pid):
 
 
 def finish_on_sigterm():
-    """A job ended by SIGTERM (kill, timeout, a closed session) ends as Ctrl-C ends it: its finally
-    blocks run, and the jackd, sclang and servers it started are stopped rather than left running
-    (Python's default for SIGTERM is to die at once)."""
+    """A job ended by SIGTERM (kill, timeout) or SIGHUP (its terminal closed) ends as Ctrl-C ends
+    it: its finally blocks run, and the jackd, sclang and servers it started are stopped rather
+    than left running (Python's default for both is to die at once). Once: a second signal during
+    the clean-up would cut it short."""
     def finish(signum, frame):
+        for sig in (signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, signal.SIG_IGN)
         raise SystemExit(128 + signum)
-    signal.signal(signal.SIGTERM, finish)
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, finish)
 
 
 def stop_pid(pid, grace_s=5.0):

@@ -28,11 +28,15 @@ class Xvfb:
             proc = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", self.size, "-dpi", "96", "-nolisten", "tcp"],
                                     stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             deadline = time.monotonic() + timeout_s
-            while time.monotonic() < deadline and proc.poll() is None:
-                if Path(f"/tmp/.X11-unix/X{number}").exists():
-                    self.proc, self.display = proc, f":{number}"
-                    return self
-                time.sleep(0.1)
+            try:
+                while time.monotonic() < deadline and proc.poll() is None:
+                    if Path(f"/tmp/.X11-unix/X{number}").exists():
+                        self.proc, self.display = proc, f":{number}"
+                        return self
+                    time.sleep(0.1)
+            except BaseException:  # interrupted (Ctrl-C, a job's SIGTERM): not left running
+                procs.stop_pid(proc.pid)
+                raise
             procs.stop_pid(proc.pid)  # lost a race for the number, or did not come up: try the next
             proc.wait()
         raise RuntimeError(f"Xvfb did not start on any display :{self.first}..:{self.first + 49}")

@@ -4,7 +4,8 @@ for each ctest in the log given, by test: scripts/cpu-accounting.sh.
 A record names a process by the thread that ended last: sclang's are named after Qt WebEngine's
 threads (sandbox_ipc_thr, ThreadPoolForeg...), counted here as sclang. Records carry no arguments,
 so a ctest's test is told by its duration: each child of ctest is matched to the test in the log
-whose duration is nearest (within 1 s), longest first."""
+whose duration is nearest (within 1 s), longest first. Processes are told apart by pid: a run of
+more processes than pid_max (32768 here) may join two into one tree."""
 import collections
 import re
 import sys
@@ -33,7 +34,7 @@ def logged_tests(log_path):
         if re.match(r"\s*Test project ", line):
             current = []
             runs.append(current)
-        m = re.match(r"\s*\d+/\d+ Test\s+#\d+: (.+?) \.+\s*\**\w+\s+([\d.]+) sec", line)
+        m = re.match(r"\s*\d+/\d+ Test\s+#\d+: (.+?) \.+\s*\**[^0-9]*?\s([\d.]+) sec", line)
         if m and current is not None:
             current.append((m.group(1), float(m.group(2))))
     return runs

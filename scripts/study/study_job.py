@@ -53,8 +53,8 @@ def run_study(out_dir, participants=5, explore_s=None, trials=40, interval_s=1.5
     # five participants' server fell to about 500 force frames a second in a fresh clone's run
     # (the audio thread waiting for the CPU), and the binds statistic with it.
     jack = performer_jack()
-    jack.start()
     try:
+        jack.start()
         run = sclang.run_with_server(code, jack, timeout=timeout_s, name="study",
                                      server_options={"numOutputBusChannels": 4 * participants})
     finally:

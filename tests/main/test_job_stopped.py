@@ -30,7 +30,8 @@ def test_the_study_job_stopped_by_sigterm_leaves_nothing_running():
         deadline, playing_since = time.monotonic() + 240, None
         while job.poll() is None and time.monotonic() < deadline:
             for pid in procs.descendants(job.pid):
-                seen.setdefault(pid, name_of(pid))
+                # The latest name: scsynth starts as a shell that execs it (Server.program).
+                seen[pid] = name_of(pid) or seen.get(pid)
             if playing_since is None and "scsynth" in seen.values():
                 playing_since = time.monotonic()
             if playing_since is not None and time.monotonic() - playing_since > 3:
@@ -45,7 +46,13 @@ def test_the_study_job_stopped_by_sigterm_leaves_nothing_running():
         assert not left, f"still running after the job ended ({code}): {left}"
         assert code == 128 + signal.SIGTERM, (code, log_path.read_text()[-3000:])
     finally:
-        procs.stop_pid(job.pid)
+        if job.poll() is None:  # the test failed before its SIGTERM, or the job did not end after it
+            job.terminate()
+            try:
+                job.wait(30)
+            except subprocess.TimeoutExpired:
+                job.kill()
+                job.wait()
         for pid, name in seen.items():
             if procs.pid_alive(pid) and name_of(pid) == name:
                 procs.stop_pid(pid)
