@@ -4,7 +4,7 @@ import os
 import subprocess
 import time
 
-from . import paths, sclang, sclang_session
+from . import paths, procs, sclang, sclang_session
 from kfstudy import readers
 
 
@@ -37,6 +37,12 @@ def render(score_path, out_path, sample_rate=48000, channels=1, block_size=64, t
     cmd = [server(), "-N", str(score_path), "_", str(out_path), str(sample_rate), "WAV", sample_format,
            "-o", str(channels), "-i", "0", "-z", str(block_size), "-U", plugin_path(plugin_dirs),
            "-m", str(memory_kb), *map(str, extra_args)]
+    if server() == "supernova":
+        # supernova -N names its shared memory after its UDP port (0 unless given; it binds none in
+        # NRT) and replaces one of that name: two renders at once, as two scene tests make, failed
+        # with "boost::interprocess::bad_alloc" (5 of 60 in 15 rounds of 4 at once; none with a
+        # port each). A port no server holds, one per render.
+        cmd += ["-u", str(procs.free_udp_port())]
     env = dict(os.environ)
     preload = sclang.server_preload()
     if preload:
