@@ -124,8 +124,10 @@ def test_zero_rebases_every_reader_at_once(jack):
         dev.setPosition(100, 0);
         "KF-SET-DONE %\n".postf(Main.elapsedTime);
         1.0.wait;
-        // The readers go first: a closed slot reads 0, which is not the puck's position.
-        [a, b, cmp].do(_.free);
+        // The comparison goes first (a reader freed a block before it leaves its bus at 0, and a
+        // fresh clone at 92a7700 read that as a difference of 130 mm), then the readers: a closed
+        // slot reads 0, which is not the puck's position.
+        [cmp, a, b].do(_.free);
         s.sync;
         dev.close;
         ~rows.do { |row| ("KF-POS " ++ row.join(" ") ++ "\n").post };
