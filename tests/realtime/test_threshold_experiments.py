@@ -168,6 +168,11 @@ def test_force_and_grating_experiments_with_an_observer(jack):
     # Each interval played the grating: intervalS long, the force switching between its low and
     # high force as the puck moved (its period against position: tests/scenes/test_threshold_stimuli_nrt.py).
     parts = intervals_of(grating_path)
+    # Each part's start and span, posted before the count is judged (a fresh clone at 92a7700 found
+    # 5 parts, not 6, against the sanitized plugin, and said no more).
+    for times, _, _, stall_s in parts:
+        print(f"KF-FIGURE threshold_grating_part_start_s {times[0]:.4f} span_s {times[-1] - times[0] + 1e-3:.4f} "
+              f"stall_s {stall_s:.4f}")
     assert len(parts) == 6
     for i, (times, commanded, x, stall_s) in enumerate(parts):
         check_span("grating", i, times, stall_s, span_tolerance_s)
