@@ -76,6 +76,10 @@
 	prLost { |reason|
 		if(this.isOver) { ^this };
 		state = \failed;
+		// Called from another routine (the watch's), the session's stops first: what follows may
+		// wait (the device's commands, in a Routine, wait for their answers), and meanwhile the
+		// session's routine would run on, storing the trial in flight.
+		if(thisThread !== routine) { routine.stop };
 		this.log(\lost, reason);
 		this.prSessionLog(\error, reason);
 		"FrictionStudySession %: %; the session failed (what it stored is kept)".format(participant, reason).error;

@@ -94,20 +94,22 @@ FrictionThreshold {
 		answered = Condition(false);
 		this.prStartAnswers(answers, device);
 		server.sync;
-		server.bind { runSynth = Synth(def.name, [\out, out, \bufnum, runBuffer !? _.bufnum ? 0]) };
+		server.bind { runSynth = Synth(def.name, [\out, out, \bufnum, runBuffer !? _.bufnum ? 0,
+			\intervalS, intervalS, \gapS, gapS]) };
 		startS = thisThread.seconds;
 		// On any way out, a refused force or onTrial's Error included, nothing of the run stays.
 		protect { while { (level = procedure.next).notNil } {
-			var target = rng.next({ [1, 2].choose }), trial = (trial: procedure.trials.size + 1, level: level,
-				target: target, startS: thisThread.seconds - startS);
+			var target = rng.next({ [1, 2].choose }), trial;
 			this.prCheckForces(device.specs, [level], device);
-			[1, 2].do { |interval|
-				trial[("interval" ++ interval ++ "S").asSymbol] = thisThread.seconds - startS;
-				server.bind { runSynth.set(\level, if(interval == target) { level } { 0 }, \active, 1) };
-				intervalS.wait;
-				server.bind { runSynth.set(\active, 0) };
-				gapS.wait
-			};
+			this.prCatchUp(server);
+			trial = (trial: procedure.trials.size + 1, level: level, target: target,
+				startS: thisThread.seconds - startS);
+			trial[\interval1S] = trial[\startS];
+			trial[\interval2S] = trial[\startS] + intervalS + gapS;
+			// One bundle: the server plays both intervals (FrictionThresholdStimuli.trialControls).
+			server.bind { runSynth.set(\level1, if(target == 1) { level } { 0 },
+				\level2, if(target == 2) { level } { 0 }, \trial, 1) };
+			this.prWaitS(2 * (intervalS + gapS));
 			trial[\answer] = this.prAwaitAnswer(answers, level, target);
 			trial[\answerS] = thisThread.seconds - startS;
 			trial[\correct] = trial[\answer] == target;
@@ -115,11 +117,23 @@ FrictionThreshold {
 			onTrial.value(trial)
 		} } { this.stop };
 		// The bundles play server.latency after they are sent: the synth is gone when run returns.
-		(server.latency ? 0).wait;
+		this.prWaitS(server.latency ? 0);
 		estimate = procedure.estimate;
 		onEnd.value(estimate);
 		^estimate
 	}
+
+	// A trial's bundle is stamped server.latency after sclang's logical time. If sclang stood still
+	// longer than half of that (a garbage collection, a long evaluation, a loaded machine), the
+	// trial would start late at the server, after the start its Event says, maybe while the trial
+	// before still plays: the logical time catches up with the clock's first.
+	prCatchUp { |server|
+		var lateS = Main.elapsedTime - thisThread.seconds;
+		if(lateS > ((server.latency ? 0) / 2)) { this.prWaitS(lateS) }
+	}
+
+	// Waits s seconds on the clock of the Routine run runs in, whatever its tempo.
+	prWaitS { |s| (thisThread.clock.secs2beats(thisThread.seconds + s) - thisThread.beats).wait }
 
 	// Continues from trials stored by an earlier run (a session that crashed and is resumed): an
 	// Array of Events with level and correct (Booleans, or "true"/"false" as trials.csv holds

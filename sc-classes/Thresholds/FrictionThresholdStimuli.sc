@@ -1,9 +1,10 @@
-// What a FrictionThreshold interval plays, per experiment: a SynthDef whose \level control is 0 in
-// the reference interval and the trial's level in the target's, and \active 1 during an interval,
-// 0 between them (the force requested 0 N: the device's minimum; no sound). One synth plays a
-// whole run: a FrictionOut that stopped and started for each interval would turn the magnet off
-// and on between them. Only what a trial needs: the force, the pilot's sound and friction, or a
-// grating, on the device the puck moves on.
+// What a FrictionThreshold trial plays, per experiment: a SynthDef whose \trial trigger starts a
+// trial's two intervals, timed on the server (trialControls): \intervalS long each, \gapS after
+// each, the first with \level1, the second with \level2 (0 in the reference, the trial's level
+// in the target). Between intervals the force requested is 0 N (the device's minimum) and nothing
+// is heard. One synth plays a whole run: a FrictionOut that stopped and started for each interval
+// would turn the magnet off and on between them. Only what a trial needs: the force, the pilot's
+// sound and friction, or a grating, on the device the puck moves on.
 FrictionThresholdStimuli {
 	// The longest asynchrony (s) the asynchrony experiment's delay line holds.
 	classvar <maxAsynchronyS = 0.25;
@@ -16,7 +17,11 @@ FrictionThresholdStimuli {
 		^switch(kind,
 			// (a) the reference's force, and the level (N) added in the target.
 			\force, {
-				SynthDef(name, { FrictionOut.ar(index, \active.kr(0) * (settings[\baseForceN] + \level.kr(0))) })
+				SynthDef(name, {
+					var active, level;
+					#active, level = this.trialControls;
+					FrictionOut.ar(index, active * (settings[\baseForceN] + level))
+				})
 			},
 			// (b) the pilot: the sound delayed by the device's audioDelay (with the force) plus the
 			// level (ms) in the target: sound that far behind the force.
@@ -24,8 +29,10 @@ FrictionThresholdStimuli {
 				var delayS = if(device.isKindOf(FrictionDevice)) { device.audioDelay } {
 					FrictionPilot.paperAudioDelayS };
 				SynthDef(name, {
-					var active = \active.kr(0), delay = (delayS + (\level.kr(0) / 1000)).clip(0, maxAsynchronyS);
-					var p = FrictionPilot.ar(index, \bufnum.kr(0), settings[\samplesPerMm], 0, active,
+					var active, level, delay, p;
+					#active, level = this.trialControls;
+					delay = (delayS + (level / 1000)).clip(0, maxAsynchronyS);
+					p = FrictionPilot.ar(index, \bufnum.kr(0), settings[\samplesPerMm], 0, active,
 						settings[\amp] * active, delay, maxAudioDelay: maxAsynchronyS);
 					Out.ar(\out.kr(0), p[\delayedAudio] ! 2)
 				})
@@ -33,12 +40,24 @@ FrictionThresholdStimuli {
 			// (c) a grating of the reference's period, plus the level (mm) in the target.
 			\grating, {
 				SynthDef(name, {
-					var x = FrictionMouseIn.ar(index)[0];
-					FrictionOut.ar(index, \active.kr(0) * FrictionPattern.grating(x, settings[\periodMm] + \level.kr(0),
+					var x = FrictionMouseIn.ar(index)[0], active, level;
+					#active, level = this.trialControls;
+					FrictionOut.ar(index, active * FrictionPattern.grating(x, settings[\periodMm] + level,
 						settings[\duty], 0.1, settings[\loForceN], settings[\hiForceN]))
 				})
 			}
 		)
+	}
+
+	// Inside a synth: [active (1 during an interval, 0 between), level (\level1 from the trial's
+	// start, \level2 from its second interval's)]. The server times the intervals, so that sclang
+	// standing still while a trial plays (a garbage collection, a long evaluation, a loaded machine)
+	// changes nothing in them. active is never above 1, even for a \trial sent while one plays.
+	*trialControls {
+		var trial = \trial.tr(0), intervalS = \intervalS.kr(1.5), gapS = \gapS.kr(0.5);
+		var second = TDelay.kr(trial, intervalS + gapS);
+		^[max(Trig1.kr(trial, intervalS), Trig1.kr(second, intervalS)),
+			Select.kr(SetResetFF.kr(second, trial), [\level1.kr(0), \level2.kr(0)])]
 	}
 
 	// Inside a synth: sends /kfThresholdButton 1 when the puck's left button goes down, 2 for its

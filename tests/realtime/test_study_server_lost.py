@@ -143,10 +143,11 @@ var study, session, path = @ROOT@ +/+ "C1/trials.csv";
 var rows = { if(File.exists(path)) { File.readAllString(path).split($\n).reject(_.isEmpty).size - 1 } { 0 } };
 study = FrictionStudy("silent", [
 	FrictionStudyCondition.threshold(\forceStep, {
-		FrictionThreshold.force(FrictionConstantStimuli([0.3, 0.5], 20, seed: 3), 0.3, 0.15, 0.05, seed: 2)
+		FrictionThreshold.force(FrictionConstantStimuli([0.3, 0.5], 20, seed: 3), 0.3, 2.5, 0.05, seed: 2)
 	}, "Which interval held more friction?", [], 120, \keys, { |seed| FrictionObserver(0.1, 3.5, 0.02, seed: seed) })]);
 session = study.run("C1", @ROOT@, s, simulated: FrictionStudySimParticipant(4, 2), windows: false);
-while { rows.value < 2 } { 0.01.wait };
+// The first trial stored, the second starts: its first interval plays for 2.5 s from server.latency on.
+while { rows.value < 1 } { 0.01.wait };
 "KF-TIMEOUT %\n".postf(FrictionStudySession.clientTimeoutS);
 // sclang falls silent (as a crashed or killed one would), its synths playing on in the server.
 "kill -STOP %; sleep @STOPPED@; kill -CONT %".format(thisProcess.pid, thisProcess.pid).systemCmd;
@@ -156,8 +157,8 @@ while { session.isOver.not } { 0.05.wait };
 
 
 def test_a_silent_client_turns_the_force_off(jack):
-    """sclang stopped (SIGSTOP) for 4 s mid-threshold-condition, its stimulus synth holding the 0.3 N
-    reference (or a target) it was last told to: the server turns the magnet off once no heartbeat has
+    """sclang stopped (SIGSTOP) for 4 s mid-threshold-condition, in a trial's first interval (2.5 s
+    long), its stimulus synth holding the 0.3 N reference or a target: the server turns the magnet off once no heartbeat has
     come for clientTimeoutS (the off's cause "client" in the device recording), and records and
     drives nothing more until sclang is heard again (the old server held the force for as long as
     it ran)."""

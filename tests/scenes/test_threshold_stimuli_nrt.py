@@ -8,7 +8,7 @@ from kfharness import nrt, paths
 from kfstudy import readers
 
 RATE = 48000
-ON_S = 0.5  # \active set to 1
+ON_S = 0.5  # the asynchrony synths' trial starts
 
 
 def _period_mm(path):
@@ -38,11 +38,11 @@ def test_grating_period_and_sound_delay_follow_the_level():
             [0.0] ++ defs.collect {{ |d| ['/d_recv', d.asBytes] }},
             [0.0] ++ (0..3).collect {{ |i| ['/cmd', \\kfOpenSim, i] ++ hand.asCommandArgs }},
             [0.0, ['/cmd', \\kfRecord, 0, "{rec[0]}"], ['/cmd', \\kfRecord, 1, "{rec[1]}"]],
-            [0.1, Synth.basicNew(defs[0].name, nil, 1000).newMsg(nil, [\\level, 0, \\active, 1]),
-                Synth.basicNew(defs[1].name, nil, 1001).newMsg(nil, [\\level, 1, \\active, 1]),
-                Synth.basicNew(defs[2].name, nil, 1002).newMsg(nil, [\\level, 0, \\out, 0, \\bufnum, 0]),
-                Synth.basicNew(defs[3].name, nil, 1003).newMsg(nil, [\\level, 10, \\out, 2, \\bufnum, 0])],
-            [{ON_S}, ['/n_set', 1002, \\active, 1], ['/n_set', 1003, \\active, 1]],
+            [0.1, Synth.basicNew(defs[0].name, nil, 1000).newMsg(nil, [\\level1, 0, \\intervalS, 9, \\trial, 1]),
+                Synth.basicNew(defs[1].name, nil, 1001).newMsg(nil, [\\level1, 1, \\intervalS, 9, \\trial, 1]),
+                Synth.basicNew(defs[2].name, nil, 1002).newMsg(nil, [\\level1, 0, \\out, 0, \\bufnum, 0]),
+                Synth.basicNew(defs[3].name, nil, 1003).newMsg(nil, [\\level1, 10, \\out, 2, \\bufnum, 0])],
+            [{ON_S}, ['/n_set', 1002, \\trial, 1], ['/n_set', 1003, \\trial, 1]],
             [2.5, ['/c_set', 0, 0]]]);
     """, channels=4)
     assert "FAILURE" not in log, log[-2000:]
@@ -61,3 +61,38 @@ def test_grating_period_and_sound_delay_follow_the_level():
     assert first[1] - first[0] == round(0.010 * RATE), first
     for channel, start in zip((0, 2), first):
         assert np.abs(data[start:start + 4800, channel]).max() > 0.1, "the pilot's sound plays"
+
+
+def test_the_server_times_a_trials_intervals():
+    """A trial's two intervals come from its one \\trial (FrictionThresholdStimuli.trialControls):
+    intervalS each, gapS after the first, \\level1 in the first and \\level2 in the second; a
+    \\trial sent while one plays starts the next at once and never doubles the force."""
+    rec = paths.work_dir() / "stimuli-trial.kfs"
+    starts_s = [0.5, 1.4]  # the second inside the first trial's second interval (1.15 to 1.65 s)
+    _, log = nrt.score_and_render("threshold-trial", f"""
+        var def = FrictionThresholdStimuli.synthDef(\\force, 0, (baseForceN: 0.3));
+        score = Score([
+            [0.0, ['/d_recv', def.asBytes], ['/cmd', \\kfOpenSim, 0] ++ FrictionHand.speeds([[40, 3]]).asCommandArgs,
+                ['/cmd', \\kfRecord, 0, "{rec}"]],
+            [0.1, Synth.basicNew(def.name, nil, 1000).newMsg(nil, [\\intervalS, 0.5, \\gapS, 0.15])],
+            [{starts_s[0]}, ['/n_set', 1000, \\level1, 0, \\level2, 0.2, \\trial, 1]],
+            [{starts_s[1]}, ['/n_set', 1000, \\level1, 0.1, \\level2, 0.1, \\trial, 1]],
+            [3.0, ['/c_set', 0, 0]]]);
+    """)
+    assert "FAILURE" not in log, log[-2000:]
+    frames = readers.Session(rec).frames
+    audio_s, commanded_n = frames[:, 1], frames[:, 3]
+    # What each span asks (s from, s to, N): the first trial's reference, gap, target; the second
+    # trial from its start (the first's target cut short), its gap, its second interval. Between
+    # intervals 0 N is asked, the simulated device's minimum (the paper's 0.14 N) commanded.
+    off_n = 0.14
+    first, second = (nrt.bundle_start_sample(t) / RATE for t in starts_s)
+    spans = [(first, first + 0.5, 0.3), (first + 0.5, first + 0.65, off_n), (first + 0.65, second, 0.5),
+             (second, second + 0.5, 0.4), (second + 0.5, second + 0.65, off_n), (second + 0.65, second + 1.15, 0.4),
+             (second + 1.15, 3.0, off_n)]
+    # The edges fall on control blocks (1.3 ms) and a frame is the mean of 1 ms: 3 ms from each
+    # edge every frame asks the span's force.
+    for lo_s, hi_s, want_n in spans:
+        inside = commanded_n[(audio_s > lo_s + 0.003) & (audio_s < hi_s - 0.003)]
+        assert len(inside) > 100 and np.all(np.abs(inside - want_n) < 1e-6), (lo_s, hi_s, want_n, np.unique(inside))
+    assert commanded_n.max() < 0.5 + 1e-6
