@@ -76,9 +76,8 @@
 	prLost { |reason|
 		if(this.isOver) { ^this };
 		state = \failed;
-		// Called from another routine (the watch's), the session's stops first: what follows may
-		// wait (the device's commands, in a Routine, wait for their answers), and meanwhile the
-		// session's routine would run on, storing the trial in flight.
+		// Called from another routine (the watch's), the session's stops first: nothing of it runs
+		// once the session failed, the trial in flight never stored.
 		if(thisThread !== routine) { routine.stop };
 		this.log(\lost, reason);
 		this.prSessionLog(\error, reason);
@@ -95,9 +94,10 @@
 	// answers, the synths, the audio recording, the device's recording, the simulated device
 	// (which the next session may then open). Without waiting for the server, which may be why it
 	// failed: from AppClock outside a Routine the device's commands do not wait for their answers
-	// (a refusal is posted), and the audio is closed in a Routine of its own.
+	// (a refusal is posted), and the audio is closed in a Routine of its own. (Scheduled: from the
+	// watch's or the session's Routine, defer would run it there and then, waiting.)
 	prFreeAfterFailure {
-		{
+		AppClock.sched(0, {
 			if(server.serverRunning) {
 				experiment !? _.stop;
 				[monitor, listenSynth, buttonsResponder, buttonsSynth, pilot].do { |x| x !? { x.free } };
@@ -109,8 +109,9 @@
 						if(simulated.notNil) { conditionDevice.close }
 					}
 				}
-			}
-		}.defer
+			};
+			nil
+		})
 	}
 
 	// A person's device gets back the client watch it had before the session (the session gave

@@ -109,7 +109,9 @@ FrictionThreshold {
 			// One bundle: the server plays both intervals (FrictionThresholdStimuli.trialControls).
 			server.bind { runSynth.set(\level1, if(target == 1) { level } { 0 },
 				\level2, if(target == 2) { level } { 0 }, \trial, 1) };
-			this.prWaitS(2 * (intervalS + gapS));
+			// The answer is taken once both intervals played (server.latency after the bundle was
+			// sent) and the gap after them passed.
+			this.prWaitS(2 * intervalS + gapS + max(gapS, server.latency ? 0));
 			trial[\answer] = this.prAwaitAnswer(answers, level, target);
 			trial[\answerS] = thisThread.seconds - startS;
 			trial[\correct] = trial[\answer] == target;
@@ -126,10 +128,14 @@ FrictionThreshold {
 	// A trial's bundle is stamped server.latency after sclang's logical time. If sclang stood still
 	// longer than half of that (a garbage collection, a long evaluation, a loaded machine), the
 	// trial would start late at the server, after the start its Event says, maybe while the trial
-	// before still plays: the logical time catches up with the clock's first.
+	// before still plays: the logical time catches up with the clock's first. (AppClock's logical
+	// time is when it woke the routine: a wait of 0 brings it to now. With no latency the bundles
+	// have no time stamp.)
 	prCatchUp { |server|
 		var lateS = Main.elapsedTime - thisThread.seconds;
-		if(lateS > ((server.latency ? 0) / 2)) { this.prWaitS(lateS) }
+		if(server.latency.notNil and: { lateS > (server.latency / 2) }) {
+			if(thisThread.clock === AppClock) { 0.wait } { this.prWaitS(lateS) }
+		}
 	}
 
 	// Waits s seconds on the clock of the Routine run runs in, whatever its tempo.

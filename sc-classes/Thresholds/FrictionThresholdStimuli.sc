@@ -52,12 +52,13 @@ FrictionThresholdStimuli {
 	// Inside a synth: [active (1 during an interval, 0 between), level (\level1 from the trial's
 	// start, \level2 from its second interval's)]. The server times the intervals, so that sclang
 	// standing still while a trial plays (a garbage collection, a long evaluation, a loaded machine)
-	// changes nothing in them. active is never above 1, even for a \trial sent while one plays.
+	// changes nothing in them. A \trial while one plays starts the next at once.
 	*trialControls {
 		var trial = \trial.tr(0), intervalS = \intervalS.kr(1.5), gapS = \gapS.kr(0.5);
-		var second = TDelay.kr(trial, intervalS + gapS);
-		^[max(Trig1.kr(trial, intervalS), Trig1.kr(second, intervalS)),
-			Select.kr(SetResetFF.kr(second, trial), [\level1.kr(0), \level2.kr(0)])]
+		var sinceS = Sweep.kr(trial), started = PulseCount.kr(trial) > 0;
+		var second = sinceS >= (intervalS + gapS);
+		^[started * ((sinceS < intervalS) + (second * (sinceS < (2 * intervalS + gapS)))),
+			Select.kr(second, [\level1.kr(0), \level2.kr(0)])]
 	}
 
 	// Inside a synth: sends /kfThresholdButton 1 when the puck's left button goes down, 2 for its

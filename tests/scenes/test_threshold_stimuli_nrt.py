@@ -51,7 +51,7 @@ def test_grating_period_and_sound_delay_follow_the_level():
     assert abs(_period_mm(rec[0]) / 2 - 1) < 0.05
     assert abs(_period_mm(rec[1]) / 3 - 1) < 0.05
     # The sound: silent until switched on, then delayed by the paper's 1 ms (a slot index has the
-    # paper's audioDelay) plus the level. \active is a control: the sound's amplitude ramps from 0
+    # paper's audioDelay) plus the level. active is a control-rate signal: the sound's amplitude ramps from 0
     # over the block of the bundle (SC interpolates a control into an audio product), whose first
     # sample is still 0, so the sound starts delay + 1 samples after that block begins; DelayL
     # delays by a whole number of samples here. The level's 10 ms is exactly 480 samples.
@@ -66,9 +66,11 @@ def test_grating_period_and_sound_delay_follow_the_level():
 def test_the_server_times_a_trials_intervals():
     """A trial's two intervals come from its one \\trial (FrictionThresholdStimuli.trialControls):
     intervalS each, gapS after the first, \\level1 in the first and \\level2 in the second; a
-    \\trial sent while one plays starts the next at once and never doubles the force."""
+    \\trial sent while one plays starts the next at once, whole, and never doubles the force."""
     rec = paths.work_dir() / "stimuli-trial.kfs"
-    starts_s = [0.5, 1.4]  # the second inside the first trial's second interval (1.15 to 1.65 s)
+    # The second inside the first trial's second interval (1.15 to 1.65 s), the third in the
+    # second's gap (1.9 to 2.05 s).
+    starts_s = [0.5, 1.4, 1.95]
     _, log = nrt.score_and_render("threshold-trial", f"""
         var def = FrictionThresholdStimuli.synthDef(\\force, 0, (baseForceN: 0.3));
         score = Score([
@@ -77,22 +79,24 @@ def test_the_server_times_a_trials_intervals():
             [0.1, Synth.basicNew(def.name, nil, 1000).newMsg(nil, [\\intervalS, 0.5, \\gapS, 0.15])],
             [{starts_s[0]}, ['/n_set', 1000, \\level1, 0, \\level2, 0.2, \\trial, 1]],
             [{starts_s[1]}, ['/n_set', 1000, \\level1, 0.1, \\level2, 0.1, \\trial, 1]],
-            [3.0, ['/c_set', 0, 0]]]);
+            [{starts_s[2]}, ['/n_set', 1000, \\level1, 0.2, \\level2, 0.05, \\trial, 1]],
+            [3.5, ['/c_set', 0, 0]]]);
     """)
     assert "FAILURE" not in log, log[-2000:]
     frames = readers.Session(rec).frames
     audio_s, commanded_n = frames[:, 1], frames[:, 3]
     # What each span asks (s from, s to, N): the first trial's reference, gap, target; the second
-    # trial from its start (the first's target cut short), its gap, its second interval. Between
-    # intervals 0 N is asked, the simulated device's minimum (the paper's 0.14 N) commanded.
+    # trial from its start (the first's target cut short), its gap; the third from its start, whole.
+    # Between intervals 0 N is asked, the simulated device's minimum (the paper's 0.14 N) commanded.
     off_n = 0.14
-    first, second = (nrt.bundle_start_sample(t) / RATE for t in starts_s)
+    first, second, third = (nrt.bundle_start_sample(t) / RATE for t in starts_s)
     spans = [(first, first + 0.5, 0.3), (first + 0.5, first + 0.65, off_n), (first + 0.65, second, 0.5),
-             (second, second + 0.5, 0.4), (second + 0.5, second + 0.65, off_n), (second + 0.65, second + 1.15, 0.4),
-             (second + 1.15, 3.0, off_n)]
+             (second, second + 0.5, 0.4), (second + 0.5, third, off_n),
+             (third, third + 0.5, 0.5), (third + 0.5, third + 0.65, off_n), (third + 0.65, third + 1.15, 0.35),
+             (third + 1.15, 3.5, off_n)]
     # The edges fall on control blocks (1.3 ms) and a frame is the mean of 1 ms: 3 ms from each
-    # edge every frame asks the span's force.
+    # edge every frame (one a ms) asks the span's force.
     for lo_s, hi_s, want_n in spans:
         inside = commanded_n[(audio_s > lo_s + 0.003) & (audio_s < hi_s - 0.003)]
-        assert len(inside) > 100 and np.all(np.abs(inside - want_n) < 1e-6), (lo_s, hi_s, want_n, np.unique(inside))
+        assert len(inside) >= (hi_s - lo_s - 0.006) * 1000 - 1 and np.all(np.abs(inside - want_n) < 1e-6), (lo_s, hi_s, want_n, np.unique(inside))
     assert commanded_n.max() < 0.5 + 1e-6

@@ -18,6 +18,7 @@
 // SYN_REPORT, all stamped with the report's due time in whole microseconds (as input_event).
 #pragma once
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -81,6 +82,14 @@ class FakeTimeline {
   double plugS() const { return plugS_; }  // monotonic
   double nowSincePlugS() const { return plugS_ == 0.0 ? 0.0 : monotonicNowS() - plugS_; }
   bool present(double sinceS) const { return sinceS < script_.unplugAtS || sinceS >= script_.replugAtS; }
+  // When a read first found the mouse gone (since plug-in; -1: never): the backend's own moment
+  // of seeing the unplug. A test polling the backend's state sees it later by its own wake-up,
+  // which a loaded machine delays (a fresh clone's ASan run: 152 ms).
+  void noteGone(double sinceS) {
+    double never = -1.0;
+    goneSincePlugS_.compare_exchange_strong(never, sinceS);
+  }
+  double goneSincePlugS() const { return goneSincePlugS_.load(); }
   void sleepUntilSincePlug(double sinceS) const {
     const double waitS = sinceS - nowSincePlugS();
     if (waitS > 0) std::this_thread::sleep_for(std::chrono::duration<double>(waitS));
@@ -126,6 +135,7 @@ class FakeTimeline {
   FakeMouseScript script_;
   double plugS_ = 0.0;
   std::vector<Due> played_;
+  std::atomic<double> goneSincePlugS_{-1.0};
 };
 
 // One reader's place in the timeline, and what both kinds of handle do alike: the stall,
@@ -153,6 +163,7 @@ class FakeReader {
       const double nowS = timeline_->nowSincePlugS();
       // A handle opened before an unplug stays dead after the replug (a new node, a new open).
       if (nowS >= s.unplugAtS && openedS_ < s.unplugAtS) {
+        timeline_->noteGone(nowS);
         onGone();
         return -1;
       }
