@@ -99,13 +99,12 @@ FrictionThreshold {
 		startS = thisThread.seconds;
 		// On any way out, a refused force or onTrial's Error included, nothing of the run stays.
 		protect { while { (level = procedure.next).notNil } {
-			var target = rng.next({ [1, 2].choose }), trial;
+			var target = rng.next({ [1, 2].choose }), trial, t;
 			this.prCheckForces(device.specs, [level], device);
 			this.prCatchUp(server);
-			trial = (trial: procedure.trials.size + 1, level: level, target: target,
-				startS: thisThread.seconds - startS);
-			trial[\interval1S] = trial[\startS];
-			trial[\interval2S] = trial[\startS] + intervalS + gapS;
+			t = thisThread.seconds - startS;
+			trial = (trial: procedure.trials.size + 1, level: level, target: target, startS: t, interval1S: t,
+				interval2S: t + intervalS + gapS);
 			// One bundle: the server plays both intervals (FrictionThresholdStimuli.trialControls).
 			server.bind { runSynth.set(\level1, if(target == 1) { level } { 0 },
 				\level2, if(target == 2) { level } { 0 }, \trial, 1) };

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from kfharness import bids_check, paths, profile
-from kfstudy import bids, psychometric, readers, report_tables, session_folder
+from kfstudy import bids, psychometric, readers, report_statistics, report_tables, session_folder
 
 OUT = Path(os.environ["KF_STUDY_JOB_OUT"])
 PILOT = ["mapping1-off", "mapping1-on", "mapping2-off", "mapping2-on", "mapping3-off", "mapping3-on"]
@@ -175,7 +175,7 @@ def check_binds():
         # the puck was up to FORCE_LAG_S before, outside the fragment, where nothing sounds (a part
         # 2 to 2.5 mm from the end was low, its reports up to 274 mm/s). So a low part lies within
         # the distance its fastest report of friction on covers in FORCE_LAG_S (a part further in
-        # would need a speed far above any measured); every other part is raised.
+        # would need a speed far above any measured), plus a part; every other part is raised.
         ends = (float(judged[mapping][0]["from_mm"]), float(judged[mapping][-1]["to_mm"]))
         on = samples[(samples.mapping == mapping) & samples.friction.astype(bool)]
         x_mm, speed = on.x_mm.to_numpy(float), np.abs(on.v_mm_s.to_numpy(float))
@@ -184,7 +184,8 @@ def check_binds():
             if p["raised"] == "True":
                 continue
             a, b = float(p["from_mm"]), float(p["to_mm"])
-            reach_mm = FORCE_LAG_S * np.nanmax(speed[(x_mm >= a) & (x_mm < b)], initial=0.0) + 0.5
+            fastest = np.nanmax(speed[(x_mm >= a) & (x_mm < b)], initial=0.0)
+            reach_mm = FORCE_LAG_S * fastest + report_statistics.BIND_BIN_MM
             assert a < ends[0] + reach_mm or b > ends[1] - reach_mm, (mapping, ends, (a, b), reach_mm, frame_rates())
     lo = np.array([float(p["from_mm"]) for p in judged["mapping3"]])
     hi = np.array([float(p["to_mm"]) for p in judged["mapping3"]])

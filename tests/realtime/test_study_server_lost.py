@@ -158,10 +158,10 @@ while { session.isOver.not } { 0.05.wait };
 
 def test_a_silent_client_turns_the_force_off(jack):
     """sclang stopped (SIGSTOP) for 4 s mid-threshold-condition, in a trial's first interval (2.5 s
-    long), its stimulus synth holding the 0.3 N reference or a target: the server turns the magnet off once no heartbeat has
-    come for clientTimeoutS (the off's cause "client" in the device recording), and records and
-    drives nothing more until sclang is heard again (the old server held the force for as long as
-    it ran)."""
+    long), its stimulus synth holding the 0.3 N reference or a target: the server turns the magnet
+    off once no heartbeat has come for clientTimeoutS (the off's cause "client" in the device
+    recording), and records and drives nothing more until sclang is heard again (the old server
+    held the force for as long as it ran)."""
     root = paths.work_dir() / "study-silent-client"
     shutil.rmtree(root, ignore_errors=True)
     stopped_s = 4

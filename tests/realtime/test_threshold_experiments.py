@@ -123,8 +123,9 @@ def test_force_and_grating_experiments_with_an_observer(jack):
         var dev = FrictionDevice.sim(s, 0, FrictionThreshold.hand(60, 40, 80)), e, estimate;
         dev.record("{force_path}");
         e = FrictionThreshold.force(FrictionConstantStimuli([0.1, 0.4], 2, seed: 1), 0.3, {INTERVAL_S}, {GAP_S}, seed: 3);
-        // sclang stands still for {STALL_S} s from the end of the second trial's first interval, past the
-        // third trial's start (as a garbage collection, a long evaluation or a loaded machine stalls it).
+        // sclang stands still for {STALL_S} s from the end of the second trial's first interval, past
+        // the third trial's start (as a garbage collection, a long evaluation or a loaded machine
+        // stalls it).
         estimate = e.run(dev, FrictionObserver(0.2, 3.5, 0.02, seed: 4), {{ |t|
             {POST_TRIAL}.value(t);
             if(t[\trial] == 1) {{ SystemClock.sched({INTERVAL_S}, {{
