@@ -5,3 +5,8 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/kf-xdg-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 KF_PYTHON=/usr/bin/python3
 export PYTHONPATH="$(pwd)/python${PYTHONPATH:+:$PYTHONPATH}"
+# Ninja builds a new build folder (setup.sh installs it; an existing folder keeps the generator it
+# was configured with, as CMake ignores CMAKE_GENERATOR then): build/ --all from nothing took
+# 351 CPU-s and 177 s with it against 368 CPU-s and 188 s with Make, which starts a cmake for each
+# target's dependencies and progress (-j2, one after the other, at 6a5c03f).
+if command -v ninja >/dev/null; then export CMAKE_GENERATOR="${CMAKE_GENERATOR:-Ninja}"; fi

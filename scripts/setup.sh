@@ -18,7 +18,7 @@ fi
 # What the main job and the gallery run: the compiler and the plugin's libraries, SuperCollider,
 # jackd and Xvfb (the live view's screenshot), the Debian python with numpy, matplotlib and soundfile.
 MAIN_PACKAGES=(
-  g++ cmake make pkg-config
+  g++ cmake make ninja-build pkg-config
   supercollider-dev supercollider-server supercollider-language
   libhidapi-dev libusb-1.0-0-dev jackd2
   python3 python3-numpy python3-matplotlib python3-soundfile xvfb
@@ -42,6 +42,7 @@ else
   kf_install_missing "${MAIN_PACKAGES[@]}"
 fi
 
+source scripts/env.sh  # the generator
 # build/KineticFriction whatever an earlier configure cached (README's -DKF_EXTENSION_DIR=user).
 configure=(-DCMAKE_BUILD_TYPE=Release -DKF_EXTENSION_DIR="$PWD/build/KineticFriction")
 if $all; then

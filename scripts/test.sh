@@ -10,13 +10,13 @@
 # against the same sources built without the sanitizers' checks, whose -O3 build the supernova
 # scenes, the realtime tests, the help files and the main jobs load (the quick tier runs them).
 # ctest shares the machine by resources (build/ctest-resources.json, tests/CMakeLists.txt): a busy
-# test takes a core, a realtime test, which mostly waits on the audio clock, a lane of three (the
-# help examples, three servers, two), whichever build's, so each has beside it two busy tests (the
-# two hogs they are built to hold) and at most two realtime tests; the QEMU guest a core and every
-# lane, first. (One realtime test at a time per build made the two chains the stage's critical
-# path: 938 s in a fresh clone at 85c5ca9, the last 410 s with nothing else to run. Three lanes with
-# the help examples in one failed once, at 89c9cd8: a block's refusal came after the runner had
-# moved on to the next; beside the help examples there is now one realtime test, as before.)
+# test takes a core, a realtime test, which mostly waits on the audio clock, a lane of three,
+# whichever build's, so each has beside it two busy tests (the two hogs they are built to hold) and
+# at most two realtime tests; the QEMU guest a core and every lane, first. (One realtime test at a
+# time per build made the two chains the stage's critical path: 938 s in a fresh clone at 85c5ca9,
+# the last 410 s with nothing else to run. Three lanes with the help examples' three servers in one
+# failed once, at 89c9cd8: a block's refusal came after the runner had moved on to the next. At
+# most four servers play: the class help files' two servers take one lane, tests/realtime.)
 # Nothing runs beside the ctest. (The other checks' builds beside it under SCHED_IDLE once slowed
 # the help examples from 163-203 s to 301 s and three of their claims failed; the cross builds
 # alone beside it, started with it, left every test passing in the ctest stage alone here, but in

@@ -9,9 +9,16 @@
 
 namespace kf::fuzz {
 
+// Removed when the fuzzer exits (libFuzzer ends a bounded run with exit(), which runs static
+// destructors): each run left one file per target in /tmp. After a crash it stays, as the input.
+struct ScratchFile {
+  std::string path = "/tmp/kf-fuzz-input-" + std::to_string(::getpid());
+  ~ScratchFile() { std::remove(path.c_str()); }
+};
+
 inline const std::string& scratchPath() {
-  static const std::string path = "/tmp/kf-fuzz-input-" + std::to_string(::getpid());
-  return path;
+  static const ScratchFile file;
+  return file.path;
 }
 
 inline const std::string& writeScratch(const uint8_t* data, size_t size) {
