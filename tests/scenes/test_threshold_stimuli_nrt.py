@@ -3,6 +3,7 @@ devices whose hands move at a steady speed: the grating's period against the puc
 the reference's, plus the level in the target; the asynchrony experiment's sound starts the
 device's audio delay plus the level (ms) after it is switched on."""
 import numpy as np
+import pytest
 
 from kfharness import nrt, paths, profile
 from kfstudy import readers
@@ -63,11 +64,14 @@ def test_grating_period_and_sound_delay_follow_the_level():
         assert np.abs(data[start:start + 4800, channel]).max() > 0.1, "the pilot's sound plays"
 
 
-def test_the_server_times_a_trials_intervals():
+@pytest.mark.parametrize("rate", [44100, 48000, 192000])
+def test_the_server_times_a_trials_intervals(rate):
     """A trial's two intervals come from its one \\trial (FrictionThresholdStimuli.trialControls):
     intervalS each, gapS after the first, \\level1 in the first and \\level2 in the second; a
-    \\trial sent while one plays starts the next at once, whole, and never doubles the force."""
-    rec = paths.work_dir() / "stimuli-trial.kfs"
+    \\trial sent while one plays starts the next at once, whole, and never doubles the force. At
+    the lowest, the usual and the highest sample rate a study may run at (its timer counts seconds
+    at control rate, whose block is 1.45 to 0.33 ms long)."""
+    rec = paths.work_dir() / f"stimuli-trial-{rate}.kfs"
     # The second inside the first trial's second interval (1.15 to 1.65 s), the third in the
     # second's gap (1.9 to 2.05 s).
     starts_s = [0.5, 1.4, 1.95]
@@ -81,7 +85,7 @@ def test_the_server_times_a_trials_intervals():
             [{starts_s[1]}, ['/n_set', 1000, \\level1, 0.1, \\level2, 0.1, \\trial, 1]],
             [{starts_s[2]}, ['/n_set', 1000, \\level1, 0.2, \\level2, 0.05, \\trial, 1]],
             [3.5, ['/c_set', 0, 0]]]);
-    """)
+    """, sample_rate=rate)
     assert "FAILURE" not in log, log[-2000:]
     frames = readers.Session(rec).frames
     audio_s, commanded_n = frames[:, 1], frames[:, 3]
@@ -89,12 +93,12 @@ def test_the_server_times_a_trials_intervals():
     # trial from its start (the first's target cut short), its gap; the third from its start, whole.
     # Between intervals 0 N is asked, the simulated device's minimum (the paper's) commanded.
     off_n = profile.device()["minForceN"]
-    first, second, third = (nrt.bundle_start_sample(t) / RATE for t in starts_s)
+    first, second, third = (nrt.bundle_start_sample(t, rate) / rate for t in starts_s)
     spans = [(first, first + 0.5, 0.3), (first + 0.5, first + 0.65, off_n), (first + 0.65, second, 0.5),
              (second, second + 0.5, 0.4), (second + 0.5, third, off_n),
              (third, third + 0.5, 0.5), (third + 0.5, third + 0.65, off_n), (third + 0.65, third + 1.15, 0.35),
              (third + 1.15, 3.5, off_n)]
-    # The edges fall on control blocks (1.3 ms) and a frame is the mean of 1 ms: 3 ms from each
+    # The edges fall on control blocks (up to 1.45 ms) and a frame is the mean of 1 ms: 3 ms from each
     # edge every frame (one a ms) asks the span's force.
     for lo_s, hi_s, want_n in spans:
         inside = commanded_n[(audio_s > lo_s + 0.003) & (audio_s < hi_s - 0.003)]
