@@ -102,6 +102,13 @@ METER = not os.environ.get("KF_SERVER_PRELOAD")
 METER_CLAIMS = ("sound", "silence", "no jump")
 # A boot takes ~1 s here; a server not back after this is a failure.
 BOOT_WAIT_MAX_S = 30.0
+# A piece's time lasts until what judges it has come in: a reading of the meter in its last 0.15 s
+# (it sends 20 a second) and, when its force is polled, FORCE_READINGS readings from 0.1 s after its
+# start (4 come in the 0.3 s pause). Beside two CPU hogs and four servers, sclang stood still
+# through a whole piece's pause: nothing came in it (no meter reading, 0 of the force) and its
+# claim was judged on nothing (a fresh clone at 6c6d957). At most this long more.
+READINGS_WAIT_MAX_S = 2.0
+FORCE_READINGS = 3
 # After a guide's clean-up: how long the runner listens for synths still running.
 CLEANUP_WATCH_S = 1.0
 # Nodes are freed after each file, not after each block: the guides are sessions (a pilot started
@@ -118,7 +125,7 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
-var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince, pollForce;
+var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince, pollForce, waitForReadings;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -308,6 +315,15 @@ pollForce = {
 	[forces, routine]
 };
 
+// Waits (READINGS_WAIT_MAX_S at most) until a piece started at t has what judges it.
+waitForReadings = { |t, polled|
+	var waited = 0, missing = {
+		(%(meter)s and: { s.serverRunning } and: { meterLevels.every { |l| l[0] < (Main.elapsedTime - 0.15) } })
+		or: { polled.notNil and: { polled[0].count { |f| f[0] >= (t + 0.1) } < %(force_readings)d } }
+	};
+	while { missing.() and: { waited < %(readings_wait)f } } { 0.05.wait; waited = waited + 0.05 };
+};
+
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
 pieceStack = runPiece.({ nil })[\stack];
 files.do { |path, f|
@@ -349,6 +365,7 @@ files.do { |path, f|
 				waitLikeAPerson.(known, path, b, run !? { run[\value] });
 				// The last piece's time runs to the block's end.
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
+				waitForReadings.(pieceStart, polled);
 				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
 					var forces = polled[0].select { |f| f[0] >= (pieceStart + 0.1) }.collect(_[1]);
@@ -569,6 +586,7 @@ def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
                          guides=", ".join(str(is_guide(f)).lower() for f in files),
                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
                          boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
+                         readings_wait=READINGS_WAIT_MAX_S, force_readings=FORCE_READINGS,
                          free_each_block=str(FREE_EACH_BLOCK).lower(), soak=str(soak).lower(), meter=str(METER).lower(),
                          soak_runs="(" + ", ".join(f"{k}: {v}" for k, v in SOAK_RUNS.items()) + ")")
     run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
@@ -923,8 +941,8 @@ fork {
 	~kfPush = { FrictionOut.ar(0, DC.ar(0.3)); Silent.ar }.play;
 };
 )
-// the force reaches 0.3 N
-1 + 1;
+// the force reaches 0.3 N (sclang then stands still through the piece's pause, as beside hogs)
+AppClock.sched(0.05, { var t = Main.elapsedTime; while { Main.elapsedTime - t < 0.5 } { }; nil });
 // the force stays at 0.5 N (but it is 0.3 N)
 2 + 2;
 // the force stays between 0.14 and 0.2 N (but it is 0.3 N)
@@ -986,7 +1004,8 @@ def test_broken_examples_are_reported(tmp_path):
     for name, block in GOOD:
         assert not [p for p in problems if p.startswith(f"{named[name]} block {block} ")], problems
     # Block 6's first piece sounds as it says, block 10's second commands the force it says: only
-    # the piece after each is reported.
+    # the piece after each is reported. (Block 10's second stalls sclang through its pause: judged
+    # on no reading, 0 of them, without waitForReadings.)
     for block, piece in ((6, 0), (10, 1)):
         assert not [p for p in problems if p.startswith(f"{named['BrokenGuide']} block {block} ") and
                     f"piece {piece}" in p], problems
