@@ -322,6 +322,7 @@ waitForReadings = { |t, polled|
 		or: { polled.notNil and: { polled[0].count { |f| f[0] >= (t + 0.1) } < %(force_readings)d } }
 	};
 	while { missing.() and: { waited < %(readings_wait)f } } { 0.05.wait; waited = waited + 0.05 };
+	if(waited > 0) { "KF-HELP-READINGS-WAITED %% s meter %% force %%\n".postf(waited, meterLevels.size, polled !? { polled[0].size }) };
 };
 
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
