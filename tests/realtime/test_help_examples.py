@@ -61,7 +61,8 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                meter's three claims are checked in the release pass: METER)
 
 Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
-A block's output is what is posted from its start to the end of its file: an NRT render or a
+A piece's time lasts until what judges it has come in (READINGS_WAIT_MAX_S): on a loaded machine
+sclang may stand still through a whole pause. A block's output is what is posted from its start to the end of its file: an NRT render or a
 server reply may come after the block's time on a loaded machine. The test markers of earlier
 versions ("// posts:", "// expect error:", "// writes:") are refused, so that none is left unread.
 test_broken_examples_are_reported shows that each rule fails a broken example.
