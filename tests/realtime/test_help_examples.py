@@ -62,8 +62,9 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
 
 Numbers in <value> and <text> match to the precision written ("0.56" matches 0.5612, not 0.57).
 A piece's time lasts until what judges it has come in (READINGS_WAIT_MAX_S): on a loaded machine
-sclang may stand still through a whole pause. A block's output is what is posted from its start to the end of its file: an NRT render or a
-server reply may come after the block's time on a loaded machine. The test markers of earlier
+sclang may stand still through a whole pause. A block's output is what is posted from its start to
+the end of its file: an NRT render or a server reply may come after the block's time on a loaded
+machine. The test markers of earlier
 versions ("// posts:", "// expect error:", "// writes:") are refused, so that none is left unread.
 test_broken_examples_are_reported shows that each rule fails a broken example.
 """
@@ -126,7 +127,8 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
-var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince, pollForce, waitForReadings;
+var runPiece, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
+var waitForReadings;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -296,9 +298,10 @@ if(%(meter)s) {
 // it), held until it falls under half the sound's own change per sample: a 0.1 step over a
 // 0.0016 one (the LiveCoding guide's Pmono) in 0.14 s at 60 dB per 0.2 s. -1: no
 // reading in the time (a peak or a jump with nothing to judge).
+meterAtEnd = { meterLevels.select { |l| l[0] >= (Main.elapsedTime - 0.15) } };
 levelsSince = { |t|
-	var now = Main.elapsedTime, after = meterLevels.select { |l| l[0] >= (t + 0.1) };
-	[after.collect(_[1]).maxItem ? 0, meterLevels.select { |l| l[0] >= (now - 0.15) }.collect(_[2]).maxItem ? -1,
+	var after = meterLevels.select { |l| l[0] >= (t + 0.1) };
+	[after.collect(_[1]).maxItem ? 0, meterAtEnd.().collect(_[2]).maxItem ? -1,
 		meterLevels.select { |l| l[0] >= (t + 0.5) }.collect(_[3]).maxItem ? -1]
 };
 
@@ -315,15 +318,19 @@ pollForce = {
 	}.play(SystemClock);
 	[forces, routine]
 };
+// The force readings of a piece started at t: from 0.1 s after it (before, the piece before's).
+forcesSince = { |polled, t| polled[0].select { |f| f[0] >= (t + 0.1) }.collect(_[1]) };
 
 // Waits (READINGS_WAIT_MAX_S at most) until a piece started at t has what judges it.
 waitForReadings = { |t, polled|
 	var waited = 0, missing = {
-		(%(meter)s and: { s.serverRunning } and: { meterLevels.every { |l| l[0] < (Main.elapsedTime - 0.15) } })
-		or: { polled.notNil and: { polled[0].count { |f| f[0] >= (t + 0.1) } < %(force_readings)d } }
+		(%(meter)s and: { s.serverRunning } and: { meterAtEnd.().isEmpty })
+		or: { polled.notNil and: { forcesSince.(polled, t).size < %(force_readings)d } }
 	};
 	while { missing.() and: { waited < %(readings_wait)f } } { 0.05.wait; waited = waited + 0.05 };
-	if(waited > 0) { "KF-HELP-READINGS-WAITED %% s meter %% force %%\n".postf(waited, meterLevels.size, polled !? { polled[0].size }) };
+	if(waited > 0) {
+		"KF-HELP-READINGS-WAITED %% s meter %% force %%\n".postf(waited, meterLevels.size, polled !? { polled[0].size })
+	};
 };
 
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
@@ -370,7 +377,7 @@ files.do { |path, f|
 				waitForReadings.(pieceStart, polled);
 				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
-					var forces = polled[0].select { |f| f[0] >= (pieceStart + 0.1) }.collect(_[1]);
+					var forces = forcesSince.(polled, pieceStart);
 					polled[1].stop;
 					"KF-HELP-FORCE %% %% %% %% %% %%\n".postf(path, b, p, forces.size, forces.minItem, forces.maxItem);
 				};
@@ -731,8 +738,10 @@ def remove_numbered_folders(files, temp_dir, since):
     random number (a study's root: "kf-study-guide-" ++ 1e6.rand): each run made new ones, 3 MB
     each, where the files of fixed names are overwritten by the next run. Kept when a run failed."""
     prefixes = [re.escape(name) for f in files for name in temp_names(f) if name.endswith("-")]
+    if not prefixes:
+        return
     numbered = re.compile(f"({'|'.join(prefixes)})[0-9]+")
-    for folder in Path(temp_dir).iterdir() if prefixes else []:
+    for folder in Path(temp_dir).iterdir():
         if numbered.fullmatch(folder.name) and folder.is_dir() and folder.stat().st_mtime >= since:
             shutil.rmtree(folder, ignore_errors=True)
 

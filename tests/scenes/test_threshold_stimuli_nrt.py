@@ -53,8 +53,8 @@ def test_grating_period_and_sound_delay_follow_the_level():
     assert abs(_period_mm(rec[1]) / 3 - 1) < 0.05
     # The sound: silent until switched on, then delayed by the paper's 1 ms (a slot index has the
     # paper's audioDelay) plus the level. active is a control-rate signal: the sound's amplitude
-    # ramps from 0 over the block of the bundle (SC interpolates a control into an audio product), whose first
-    # sample is still 0, so the sound starts delay + 1 samples after that block begins; DelayL
+    # ramps from 0 over the block of the bundle (SC interpolates a control into an audio product),
+    # whose first sample is still 0, so the sound starts delay + 1 samples after that block begins; DelayL
     # delays by a whole number of samples here. The level's 10 ms is exactly 480 samples.
     on = nrt.bundle_start_sample(ON_S)
     first = [int(np.flatnonzero(np.abs(data[:, channel]) > 1e-7)[0]) for channel in (0, 2)]
@@ -98,8 +98,8 @@ def test_the_server_times_a_trials_intervals(rate):
              (second, second + 0.5, 0.4), (second + 0.5, third, off_n),
              (third, third + 0.5, 0.5), (third + 0.5, third + 0.65, off_n), (third + 0.65, third + 1.15, 0.35),
              (third + 1.15, 3.5, off_n)]
-    # The edges fall on control blocks (up to 1.45 ms) and a frame is the mean of 1 ms: 3 ms from each
-    # edge every frame (one a ms) asks the span's force.
+    # The edges fall on control blocks (up to 1.45 ms) and a frame is the mean of 1 ms: 3 ms from
+    # each edge every frame (one a ms) asks the span's force.
     for lo_s, hi_s, want_n in spans:
         inside = commanded_n[(audio_s > lo_s + 0.003) & (audio_s < hi_s - 0.003)]
         assert len(inside) >= (hi_s - lo_s - 0.006) * 1000 - 1, (lo_s, hi_s, len(inside))
