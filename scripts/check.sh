@@ -139,7 +139,7 @@ check_sanitize_plugin() {
   echo "== scene and realtime tests against the plugin under ASan + UBSan"
   local rc=0
   # As scripts/test.sh runs ctest: the machine shared by resources (tests/CMakeLists.txt).
-  ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 2))" \
+  ctest --test-dir build-asan-plugin --output-on-failure --no-tests=error -j "$(($(nproc) + 3))" \
     --resource-spec-file "$PWD/build-asan-plugin/ctest-resources.json" \
     -R "${KF_SANITIZED_TESTS:-^sanitized/(scenes|realtime)/}" || rc=$?
   sanitized_plugin_findings || rc=1
