@@ -108,7 +108,7 @@ if ((rc != 0)); then
 fi
 source scripts/env.sh
 if $quick; then
-  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 3))" \
+  stage ctest-quick ctest --test-dir build --output-on-failure -j "$(($(nproc) + 2))" \
     --resource-spec-file "$PWD/build/ctest-resources.json" \
     -R '^(dsp/|device/|host/|scenes/|realtime/test_device_realtime$)' "$@"
 else
@@ -132,10 +132,13 @@ else
     printf 'add_test([=[cross/%s suites]=] "%s" "cross-suites-%s")\n' "$suites" "$PWD/scripts/check.sh" "$suites"
     printf 'set_tests_properties([=[cross/%s suites]=] PROPERTIES RESOURCE_GROUPS "cores:1" DEPENDS kernel/guest COST 500 TIMEOUT 600)\n' "$suites"
   done >> build/with-sanitized/CTestTestfile.cmake
-  # As many tests at once as the cores and the three realtime lanes hold (the resources decide).
-  # At -j cores + 2, three realtime tests left room for one busy test: in a fresh clone at cd9594d
-  # the machine was 72 to 89 % busy while the help examples played (150 s of the ctest's 888).
-  stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 3))" \
+  # Three realtime tests and one busy test at most, or two busy tests and one realtime test (the
+  # resources decide the rest). The machine was 72 to 89 % busy for the 150 s the help examples
+  # played beside one busy test (a fresh clone at cd9594d), but at -j cores + 3, a second busy test
+  # beside the three realtime tests, a fresh clone failed twice: a device test's 1 kHz sender fell
+  # to 47 set-points in 100 ms (its normal-priority thread under the servers' SCHED_FIFO ones), and
+  # sclang's collector broke in the guides' session ("grey count error", ARCHITECTURE.md).
+  stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 2))" \
     --resource-spec-file "$PWD/build/ctest-resources.json" -E '^scenes/test_' "$@"
   stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
 fi
