@@ -132,9 +132,9 @@ else
     printf 'add_test([=[cross/%s suites]=] "%s" "cross-suites-%s")\n' "$suites" "$PWD/scripts/check.sh" "$suites"
     printf 'set_tests_properties([=[cross/%s suites]=] PROPERTIES RESOURCE_GROUPS "cores:1" DEPENDS kernel/guest COST 500 TIMEOUT 600)\n' "$suites"
   done >> build/with-sanitized/CTestTestfile.cmake
-  # Three realtime tests and one busy test at most, or two busy tests and one realtime test (the
-  # resources decide the rest). The machine was 72 to 89 % busy for the 150 s the help examples
-  # played beside one busy test (a fresh clone at cd9594d), but at -j cores + 3, a second busy test
+  # Four tests at once, the resources deciding which: beside three realtime tests, one busy test.
+  # The machine was 72 to 89 % busy for the 150 s the help examples played beside one busy test
+  # (a fresh clone at cd9594d), but at -j cores + 3, a second busy test
   # beside the three realtime tests, a fresh clone failed twice: a device test's 1 kHz sender fell
   # to 47 set-points in 100 ms (its normal-priority thread under the servers' SCHED_FIFO ones), and
   # sclang's collector broke in the guides' session ("grey count error", ARCHITECTURE.md).
