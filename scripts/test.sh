@@ -134,10 +134,10 @@ else
   done >> build/with-sanitized/CTestTestfile.cmake
   # Four tests at once, the resources deciding which: beside three realtime tests, one busy test.
   # The machine was 72 to 89 % busy for the 150 s the help examples played beside one busy test
-  # (a fresh clone at cd9594d), but at -j cores + 3, a second busy test
-  # beside the three realtime tests, a fresh clone failed twice: a device test's 1 kHz sender fell
-  # to 47 set-points in 100 ms (its normal-priority thread under the servers' SCHED_FIFO ones), and
-  # sclang's collector broke in the guides' session ("grey count error", ARCHITECTURE.md).
+  # (a fresh clone at cd9594d), but at -j cores + 3, a second busy test beside the three realtime
+  # tests, a fresh clone failed twice: a device test's 1 kHz sender fell to 47 set-points in 100 ms
+  # (its normal-priority thread under the servers' SCHED_FIFO ones; that test now asks no pace),
+  # and sclang's collector broke in the guides' session ("grey count error", ARCHITECTURE.md).
   stage ctest ctest --test-dir build/with-sanitized --output-on-failure -j "$(($(nproc) + 2))" \
     --resource-spec-file "$PWD/build/ctest-resources.json" -E '^scenes/test_' "$@"
   stage sanitize-plugin-findings scripts/check.sh sanitize-plugin-findings
