@@ -1,5 +1,6 @@
-// What the board driver's tests share: a bounded wait, a driver opened on an emulated bus, the
-// device's part in arming when the driver runs without one, and a witness of the machine's stalls.
+// What the board driver's tests share: a bounded wait (../WaitFor.hpp), a driver opened on an
+// emulated bus, the device's part in arming when the driver runs without one, and a witness of the
+// machine's stalls.
 #pragma once
 
 #include <atomic>
@@ -9,21 +10,11 @@
 #include <string>
 #include <thread>
 
+#include "../WaitFor.hpp"
 #include "board/EmulatedUsb.hpp"
 #include "board/UsbBoardBackend.hpp"
 
 namespace kf::test {
-
-// Waits until `done` holds; false after `limit` (which only a failing test reaches).
-template <class Done>
-bool waitFor(Done done, std::chrono::milliseconds limit = std::chrono::milliseconds(3000)) {
-  const auto start = std::chrono::steady_clock::now();
-  while (!done()) {
-    if (std::chrono::steady_clock::now() - start > limit) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
 
 inline std::shared_ptr<UsbBoardBackend> openBoard(const std::shared_ptr<board::EmulatedUsb>& bus,
                                                   BoardOptions options = {}) {

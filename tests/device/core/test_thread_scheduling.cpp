@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "../WaitFor.hpp"
 #include "DeviceFactory.hpp"
 #include "core/threads/DeviceMessages.hpp"
 #include "core/threads/ThreadScheduling.hpp"
@@ -156,11 +157,11 @@ TEST_CASE("refused realtime: normal priority, one message with the fix, and a wo
     // Working: pumping, the puck reporting. At normal priority the pace is the machine's: after a
     // fixed 60 ms a fresh clone's run beside the other busy tests saw too few (exit 14), so it
     // waits for them, 3 s at most (a device that never pumps or reports still fails).
-    TelemetrySnapshot t = first->telemetry();
-    for (int waitedMs = 0; (t.pumps < 20 || t.reports < 3) && waitedMs < 3000; waitedMs += 10) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    TelemetrySnapshot t;
+    test::waitFor([&] {
       t = first->telemetry();
-    }
+      return t.pumps >= 20 && t.reports >= 3;
+    });
     if (t.deviceThread.priority != 0) _exit(13);  // normal priority
     if (t.pumps < 20 || t.reports < 3) _exit(14);
     if (gMessageCount != 1) _exit(15);  // one message for both devices
