@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import nrt, paths, procs, trace_csv
+from kfharness import nrt, paths, procs, scratch, trace_csv
 from kfharness import patterns as K
 from kfharness import pilot as P
 
@@ -308,4 +308,5 @@ def write_summary(out_dir, rows, figures, folding, grid, rate, elapsed):
 
 
 if __name__ == "__main__":
-    main()
+    with scratch.for_job():  # its scratch folder removed when it passed
+        main()

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kfharness import paths, procs
+from kfharness import paths, procs, scratch
 from kfharness import pilot as P
 from kfharness import trace_csv
 from view_shot import write_view_shot
@@ -206,4 +206,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    with scratch.for_job():  # its scratch folder removed when it passed
+        main()

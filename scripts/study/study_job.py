@@ -11,7 +11,7 @@ import shutil
 import time
 from pathlib import Path
 
-from kfharness import paths, procs, sclang
+from kfharness import paths, procs, sclang, scratch
 from kfharness.jack import performer_jack
 
 # The participants run at once, each on a device slot of its own (deviceIndex) and output pairs of
@@ -85,4 +85,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    with scratch.for_job():  # its scratch folder removed when it passed
+        main()

@@ -1,6 +1,7 @@
 """scripts/main.sh, the README's first command, with one mapping: it sets up, builds and writes
 the pilot's outputs (audio and force WAVs, CSVs, plots, recordings, the summary, the live view's
-screenshot) into KF_MAIN_JOB_OUT."""
+screenshot) into KF_MAIN_JOB_OUT, and removes its scratch folder (kfharness.scratch: 113 MB in /tmp
+each run while it kept them)."""
 import os
 import shutil
 import subprocess
@@ -14,10 +15,17 @@ OUT = Path(os.environ["KF_MAIN_JOB_OUT"])
 
 def test_the_main_job_writes_the_pilot():
     shutil.rmtree(OUT, ignore_errors=True)
+    # Its scratch folder in a temporary folder of this test's (tempfile follows TMPDIR), as a user's job makes it.
+    tmp = paths.work_dir() / "main-job-tmp"
+    tmp.mkdir(exist_ok=True)
+    env = {**os.environ, "TMPDIR": str(tmp)}
+    env.pop("KF_TEST_WORK_DIR", None)
     run = subprocess.run(["bash", str(paths.REPO_DIR / "scripts" / "main.sh"), "--out", str(OUT),
                           "--mappings", "mapping1"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                         timeout=840)
+                         timeout=840, env=env)
     assert run.returncode == 0, run.stdout[-4000:]
+    left = [f"{p.name}: {len(list(p.iterdir()))} files" for p in tmp.glob("kf-work-*")]
+    assert not left, f"the job left its scratch folder in {tmp}: {left}"
     assert "== pilot done" in run.stdout
     for friction in ("off", "on"):
         base = f"mapping1-friction-{friction}"
