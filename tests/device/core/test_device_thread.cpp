@@ -37,12 +37,20 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   });
   std::vector<MouseReport> reports;
   MouseReport buffer[32];
+  const auto popAll = [&] {
+    int n;
+    while ((n = device.popReports(buffer, 32)) > 0) reports.insert(reports.end(), buffer, buffer + n);
+  };
   const auto start = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - start < 300ms) {
-    const int n = device.popReports(buffer, 32);
-    reports.insert(reports.end(), buffer, buffer + n);
+    popAll();
     std::this_thread::sleep_for(2ms);
   }
+  // And what came while this thread last slept: at normal priority it can wake long after the
+  // window's end (beside three realtime servers, a fresh clone's libc++ suite kept 20 reports,
+  // 160 ms of them, and left the rest in the queue).
+  popAll();
+  const double windowS = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stop = true;
   audio.join();
   // Let the thread take the last frames (bounded wait, for loaded machines).
@@ -53,9 +61,12 @@ TEST_CASE("realtime device thread: 125 Hz reports, frames reach the magnet, tele
   const TelemetrySnapshot telemetry = device.telemetry();
   device.close();
 
-  // ~0.3 s at 125 Hz; generous bounds for a loaded machine.
+  // ~0.3 s at 125 Hz (37.5 reports); generous bounds for a loaded machine. The window is longer
+  // when this thread woke late: the upper bound grows by its reports (one each 8 ms).
+  INFO("reports popped " << reports.size() << " in " << windowS << " s; the device's: " << telemetry.reports
+                         << ", its missed deadlines " << telemetry.missedDeadlines);
   CHECK(reports.size() >= 30);
-  CHECK(reports.size() <= 45);
+  CHECK(reports.size() <= 45 + static_cast<size_t>((windowS - 0.3) / 0.008));
   CHECK(telemetry.reports >= reports.size());
   CHECK(telemetry.reportIntervalMeanS == Approx(0.008).epsilon(1e-6));
   CHECK(telemetry.reportIntervalJitterS < 1e-6);
