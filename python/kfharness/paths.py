@@ -18,10 +18,13 @@ def test_data_dir():
     return Path(os.environ.get("KF_TEST_DATA_DIR") or REPO_DIR / "tests" / "data")
 
 
+WORK_DIR_PREFIX = "kf-work-"
+
+
 @functools.lru_cache(maxsize=None)
 def work_dir():
     """A scratch folder for scripts, renders and logs, made on first use: KF_TEST_WORK_DIR or a
     new temporary folder (one per process)."""
-    path = Path(os.environ.get("KF_TEST_WORK_DIR") or tempfile.mkdtemp(prefix="kf-work-"))
+    path = Path(os.environ.get("KF_TEST_WORK_DIR") or tempfile.mkdtemp(prefix=WORK_DIR_PREFIX))
     path.mkdir(parents=True, exist_ok=True)
     return path

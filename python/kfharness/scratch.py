@@ -5,7 +5,8 @@ KF_TEST_WORK_DIR names a folder of one's own: it is left as it is.
 
 Two ways in: a pytest plugin (-p kfharness.scratch: every pytest ctest runs with it,
 tests/CMakeLists.txt), and `with scratch.for_job():` around a job script's main (scripts/main.sh,
-study.sh, gallery.sh)."""
+study.sh, gallery.sh). A test that runs a job finds the job's folder with job_environment and
+job_folders."""
 import contextlib
 import os
 import shutil
@@ -38,3 +39,16 @@ def for_job():
         passed = True
     finally:
         finish(passed)
+
+
+def job_environment(parent):
+    """The environment for a job a test runs, whose scratch folder it is to find in `parent`: the
+    test's own environment, with tempfile's folder moved there and no KF_TEST_WORK_DIR."""
+    env = {**os.environ, "TMPDIR": str(parent)}
+    env.pop("KF_TEST_WORK_DIR", None)
+    return env
+
+
+def job_folders(parent):
+    """The scratch folders jobs run with job_environment(parent) left."""
+    return sorted(parent.glob(paths.WORK_DIR_PREFIX + "*"))

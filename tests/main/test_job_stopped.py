@@ -3,13 +3,12 @@ stopped with Ctrl-C does: scripts/study.sh killed while its participant plays le
 sclang or scsynth running. (Python's default for SIGTERM is to die at once, its finally blocks
 unrun: the three played on, the server at a fifth of a core, until killed by hand.) Its scratch
 folder, with its logs, is kept and named (kfharness.scratch), as for any job that failed."""
-import os
 import signal
 import subprocess
 import time
 from pathlib import Path
 
-from kfharness import paths, procs
+from kfharness import paths, procs, scratch
 
 
 def name_of(pid):
@@ -23,14 +22,12 @@ def test_the_study_job_stopped_by_sigterm_leaves_nothing_running():
     out = paths.work_dir() / "stopped-study"
     log_path = paths.work_dir() / "stopped-study.log"
     seen = {}  # pid -> name: every process below the job while it ran
-    tmp = paths.work_dir() / "stopped-study-tmp"  # its scratch folder's parent (tempfile follows TMPDIR)
+    tmp = paths.work_dir() / "stopped-study-tmp"  # where the job makes its scratch folder
     tmp.mkdir(exist_ok=True)
-    env = {**os.environ, "TMPDIR": str(tmp)}
-    env.pop("KF_TEST_WORK_DIR", None)
     with open(log_path, "w") as log:
         job = subprocess.Popen(["bash", str(paths.REPO_DIR / "scripts" / "study.sh"), "--out", str(out),
                                 "--participants", "1", "--explore-s", "60", "--trials", "0"],
-                               stdout=log, stderr=subprocess.STDOUT, env=env)
+                               stdout=log, stderr=subprocess.STDOUT, env=scratch.job_environment(tmp))
     try:
         # Until its server has played a while (set-up, sclang's start and the boot come first).
         deadline, playing_since = time.monotonic() + 240, None
@@ -51,7 +48,7 @@ def test_the_study_job_stopped_by_sigterm_leaves_nothing_running():
         left = [(pid, name) for pid, name in seen.items() if procs.pid_alive(pid) and name_of(pid) == name]
         assert not left, f"still running after the job ended ({code}): {left}"
         assert code == 128 + signal.SIGTERM, (code, log_path.read_text()[-3000:])
-        kept = list(tmp.glob("kf-work-*"))
+        kept = scratch.job_folders(tmp)
         assert len(kept) == 1 and any(kept[0].glob("jackd-*.log")), f"no scratch folder with the job's logs: {kept}"
         assert f"scratch folder kept: {kept[0]}" in log_path.read_text(), log_path.read_text()[-2000:]
     finally:

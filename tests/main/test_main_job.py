@@ -7,7 +7,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from kfharness import paths
+from kfharness import paths, scratch
 from kfstudy import readers
 
 OUT = Path(os.environ["KF_MAIN_JOB_OUT"])
@@ -15,16 +15,14 @@ OUT = Path(os.environ["KF_MAIN_JOB_OUT"])
 
 def test_the_main_job_writes_the_pilot():
     shutil.rmtree(OUT, ignore_errors=True)
-    # Its scratch folder in a temporary folder of this test's (tempfile follows TMPDIR), as a user's job makes it.
+    # Its scratch folder in a folder of this test's, made as a user's job makes it.
     tmp = paths.work_dir() / "main-job-tmp"
     tmp.mkdir(exist_ok=True)
-    env = {**os.environ, "TMPDIR": str(tmp)}
-    env.pop("KF_TEST_WORK_DIR", None)
     run = subprocess.run(["bash", str(paths.REPO_DIR / "scripts" / "main.sh"), "--out", str(OUT),
                           "--mappings", "mapping1"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                         timeout=840, env=env)
+                         timeout=840, env=scratch.job_environment(tmp))
     assert run.returncode == 0, run.stdout[-4000:]
-    left = [f"{p.name}: {len(list(p.iterdir()))} files" for p in tmp.glob("kf-work-*")]
+    left = [f"{p.name}: {len(list(p.iterdir()))} files" for p in scratch.job_folders(tmp)]
     assert not left, f"the job left its scratch folder in {tmp}: {left}"
     assert "== pilot done" in run.stdout
     for friction in ("off", "on"):

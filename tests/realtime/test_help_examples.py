@@ -127,7 +127,7 @@ LINK = re.compile(r"link::((?:Guides|Overviews)/[^#:]+)::")
 RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
-var runPiece, compileKeepingFrame, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
+var headOf, runPiece, compileKeepingFrame, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
 var waitForReadings;
 var treePending = false;
 codeBlocks = { |node|
@@ -135,14 +135,15 @@ codeBlocks = { |node|
 		(node.children ? []).collect(codeBlocks).flatten(1)
 	}
 };
+// A line's code: without its comment and the white space around.
+headOf = { |line|
+	var trimmed = line.stripWhiteSpace, comment = trimmed.find("//");
+	if(comment.notNil) { trimmed = trimmed.keep(comment).stripWhiteSpace };
+	trimmed
+};
 // The pieces a user evaluates one by one: "(" ... ")" regions and single lines.
 piecesOf = { |code|
 	var lines = code.split($\n), pieces = List.new, i = 0;
-	var headOf = { |line|
-		var trimmed = line.stripWhiteSpace, comment = trimmed.find("//");
-		if(comment.notNil) { trimmed = trimmed.keep(comment).stripWhiteSpace };
-		trimmed
-	};
 	// A line holding only a comment says what the piece after it does: it goes with that piece
 	// (with the last one at the block's end).
 	var pending = "", add = { |piece| pieces.add(pending ++ piece); pending = "" };
@@ -176,10 +177,9 @@ piecesOf = { |code|
 // makes a closure; its value and what it does are the same.
 compileKeepingFrame = { |piece|
 	var keep = "var kfKeptFrame = { kfKeptFrame };", lines = piece.split($\n);
-	var code = { |line| (line.find("//") !? { |at| line.keep(at) } ? line).stripWhiteSpace };
-	var first = lines.detectIndex { |line| code.(line).notEmpty }, next;
-	next = first !? { lines.drop(first + 1).detectIndex { |line| code.(line).notEmpty } !? { |i| first + 1 + i } };
-	if(next.notNil and: { code.(lines[first]) == "(" and: { "^var\\b".matchRegexp(code.(lines[next])) } }) {
+	var first = lines.detectIndex { |line| headOf.(line).notEmpty }, next;
+	next = first !? { lines.drop(first + 1).detectIndex { |line| headOf.(line).notEmpty } !? { |i| first + 1 + i } };
+	if(next.notNil and: { headOf.(lines[first]) == "(" and: { "^var\\b".matchRegexp(headOf.(lines[next])) } }) {
 		lines = lines.insert(first + 1, keep)
 	} {
 		lines = lines.insert(0, keep)
