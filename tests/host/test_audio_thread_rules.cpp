@@ -64,10 +64,10 @@ class Scenario {
   }
   // Runs `ms` of audio, the NRT side served meanwhile: the blocks of that much time at 48 kHz,
   // however long the wall clock takes. What the scenario needs is that the UGens ran that much
-  // audio; an audio thread at normal priority beside other load runs slower than the clock (the
-  // UGens here need about 0.9 ms of CPU per 1.33 ms block, measured, so beside two CPU hogs
-  // on two cores it got under 10 blocks in some 50 ms of wall time). The limit only catches
-  // an audio thread that stopped.
+  // audio; an audio thread at normal priority (realtime refused) beside other load runs slower
+  // than the clock (the UGens here need about 0.9 ms of CPU per 1.33 ms block, measured, so
+  // beside two CPU hogs on two cores it got under 10 blocks in some 50 ms of wall time). The
+  // limit only catches an audio thread that stopped.
   void runAudio(int ms) {
     const int64_t blocks =
         (ms * static_cast<int64_t>(FakeServer::kSampleRate) / FakeServer::kBlockSamples + 999) / 1000;
@@ -137,6 +137,10 @@ void Scenario::run() {
     check(server_.unitDef(name).ctor != nullptr, std::string("the plugin defines ") + name);
   const std::string recording = options_.scratch + "/recording.txt";
   server_.start();
+  if (server_.realtime())
+    std::printf("the audio thread runs SCHED_FIFO %d, as JACK runs scsynth's\n", FakeServer::kAudioPriority);
+  else
+    std::printf("the audio thread runs at normal priority: realtime scheduling was refused\n");
 
   phase("1 no device open: every mode constructed and run");
   Synth* chain = server_.play(chainSynth(server_, chain_));

@@ -47,6 +47,7 @@ class FakeServer {
  public:
   static constexpr double kSampleRate = 48000.0;
   static constexpr int kBlockSamples = 64;
+  static constexpr int kAudioPriority = 5;                   // SCHED_FIFO, where allowed (audioMain)
   static constexpr int kNumBuffers = 4;                      // 0 mono, 1 stereo, 2 never allocated, 3 mono
   static constexpr size_t kRtMemoryBytes = size_t{8} << 20;  // scsynth's default memSize
 
@@ -81,7 +82,8 @@ class FakeServer {
   bool settle(int rounds, std::chrono::milliseconds timeout);
 
   int64_t blocks() const { return blocks_.load(); }
-  int doneCount(const std::string& command) const;  // `/done command` replies so far
+  bool realtime() const { return realtime_.load(); }  // the audio thread runs SCHED_FIFO
+  int doneCount(const std::string& command) const;    // `/done command` replies so far
   const std::vector<Reply>& replies() const { return replies_; }
   int repliesNamed(const std::string& name) const;
   std::vector<std::string> posts() const;
@@ -160,6 +162,7 @@ class FakeServer {
   std::atomic<bool> running_{false};
   std::thread::id nrtThread_;
   std::atomic<bool> audioStarted_{false};
+  std::atomic<bool> realtime_{false};
   std::atomic<int64_t> blocks_{0};
 
   // Each message is performed on the receiving side, then freed (FifoMsg::Free) on the sending
