@@ -41,17 +41,11 @@ def server_preload():
 
 def server_program_code():
     """sclang that makes Server.program (booted servers) and Score.program start scsynth at normal
-    priority, with server_preload() if there is one.
-
-    SuperCollider 3.13 starts a booted scsynth from its SystemClock thread (Server:boot's ping
-    times out there), which sclang runs SCHED_FIFO 1 wherever realtime is allowed, so every thread
-    of the server but JACK's audio thread inherits SCHED_FIFO 1: its start, its NRT thread's work.
-    One performer's server may do that; the test command's, side by side on two cores (a sanitized
-    server's start takes 0.7 CPU-s/s for about 2 s, measured with every thread's policy sampled),
-    took both cores from every normal-priority thread for up to the kernel's realtime limit, 950 ms
-    a second: a fresh clone's host test read a report-to-UGen delay of 931 ms, and an sclang got no
-    OSC message in 0.6 s. `chrt --other 0` starts it as everything else on the machine starts;
-    JACK still runs its audio thread SCHED_FIFO and the device threads ask for theirs."""
+    priority, with server_preload() if there is one. SuperCollider 3.13 boots scsynth from its
+    SystemClock thread, SCHED_FIFO 1 where realtime is allowed, and every thread of the server but
+    JACK's audio thread would inherit it: servers side by side then starve every normal thread
+    (ARCHITECTURE.md, Tests and checks). JACK still runs the audio thread SCHED_FIFO, and the device
+    threads ask for theirs."""
     libs = server_preload()
     preload = f"\"env LD_PRELOAD=\" ++ {sc_string(libs)}.shellQuote ++ \" " if libs else "\""
     return (f"Server.program = \"exec chrt --other 0 \" ++ {preload}scsynth\";\n"

@@ -47,8 +47,7 @@ def test_threads_are_named_and_realtime_above_the_audio_thread(jack):
         assert figures[3]["memoryLocked"] == 1  # as root; a user needs the memlock limit
         # The rest of the server at normal priority: booted from sclang's SystemClock thread it
         # would run SCHED_FIFO 1, every thread but JACK's (kfharness.sclang.server_program_code).
-        server_own = [(cls, p) for name, cls, p in listed if name == "scsynth" and (cls, p) != ("FF", audio)]
-        assert listed[0][:2] == ("scsynth", "TS") and ("FF", 1) not in server_own, listed
+        assert listed[0][:2] == ("scsynth", "TS") and ("scsynth", "FF", 1) not in listed, listed
     else:
         assert threads["kf-device-3"][0] == "TS"
         assert figures[3]["deviceThreadPriority"] == 0
