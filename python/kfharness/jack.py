@@ -1,4 +1,5 @@
 """A JACK server on the dummy driver: a real-time audio clock without a sound card."""
+import fcntl
 import os
 import random
 import subprocess
@@ -8,6 +9,35 @@ import time
 from . import paths
 from .jack_registry import reclaim, reclaim_dead_servers, registered_servers
 from .load import realtime_allowed
+
+# JACK's registry holds 8 servers a machine (jack_registry.MAX_SERVERS): a ninth jackd exits with
+# "Too many servers already active". One test command runs up to 4 at once (ctest's lanes), so two
+# commands side by side could ask for 9 (fresh clones 60 and 61). Each JackServer first takes one of
+# SLOTS lock files, one of the 8 left for a server of the user's own; flock frees a lock when its
+# holder exits, however it exits.
+SLOTS = 7
+SLOT_LOCK = "/dev/shm/kf-jack-slot-{}.lock"
+SLOT_WAIT_S = 900.0  # a realtime test holds its server for up to a few minutes, the help examples 10
+
+
+def take_slot(timeout_s=SLOT_WAIT_S):
+    """The open lock file of a free slot (closing it frees the slot); waits for one, saying so."""
+    deadline, said = time.monotonic() + timeout_s, False
+    while True:
+        for i in range(SLOTS):
+            fd = os.open(SLOT_LOCK.format(i), os.O_RDONLY | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                return fd
+            except BlockingIOError:
+                os.close(fd)
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"no JACK server slot came free in {timeout_s:.0f} s ({SLOTS} held by other tests)")
+        if not said:
+            print(f"kfharness: all {SLOTS} JACK server slots are held (another test command?): waiting",
+                  file=sys.stderr)
+            said = True
+        time.sleep(0.5)
 
 
 class JackServer:
@@ -31,6 +61,7 @@ class JackServer:
         self.period = period
         self.realtime_priority = realtime_priority
         self.proc = None
+        self.slot = None  # the lock file descriptor of its slot (take_slot) while it runs
         self.log_path = paths.work_dir() / f"jackd-{self.name}.log"
         self.env = dict(os.environ)
         self.env.update(JACK_DEFAULT_SERVER=self.name, JACK_NO_START_SERVER="1",
@@ -43,11 +74,12 @@ class JackServer:
 
     def start(self, timeout_s=20.0):
         # A killed jackd's slot in JACK's 8-slot registry stays taken (jack_registry.py).
-        reclaim_dead_servers()
-        with open(self.log_path, "w") as log:
-            self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
-                                         stderr=subprocess.STDOUT, env=self.env)
+        self.slot = take_slot()
         try:
+            reclaim_dead_servers()
+            with open(self.log_path, "w") as log:
+                self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
+                                             stderr=subprocess.STDOUT, env=self.env)
             return self._wait_up(timeout_s)
         except BaseException:  # not up, or interrupted meanwhile (Ctrl-C, a job's SIGTERM): not left running
             self.stop()
@@ -71,6 +103,7 @@ class JackServer:
 
     def stop(self):
         if self.proc is None:
+            self._free_slot()
             return
         if self.proc.poll() is None:
             self.proc.terminate()
@@ -83,6 +116,12 @@ class JackServer:
         if self.proc.returncode == -9:  # killed here or by a test: its registry slot stays taken
             reclaim(self.name)
         self.proc = None
+        self._free_slot()
+
+    def _free_slot(self):
+        if self.slot is not None:
+            os.close(self.slot)
+            self.slot = None
 
     def log(self, tail_chars=3000):
         try:

@@ -41,3 +41,33 @@ def test_a_server_killed_in_a_test_leaves_no_slot_behind():
     assert server.name in jack_registry.dead_servers()
     server.stop()
     assert server.name not in [name for _, _, name in jack_registry.registered_servers()]
+
+
+def test_a_server_waits_for_a_slot_when_other_test_commands_hold_them_all():
+    """Two test commands side by side asked JACK for more than its 8 servers (fresh clones 60 and
+    61). A JackServer takes one of jack.SLOTS lock files first: with every slot held it waits, and
+    it goes on once one is freed."""
+    import time
+    from kfharness import jack
+    held = []
+    deadline = time.monotonic() + 60  # other tests of this command free theirs within a test's time
+    while len(held) < jack.SLOTS and time.monotonic() < deadline:
+        try:
+            held.append(jack.take_slot(timeout_s=0.1))
+        except RuntimeError:
+            pass
+    try:
+        assert len(held) == jack.SLOTS
+        started = time.monotonic()
+        try:
+            jack.take_slot(timeout_s=1.0)
+            raise AssertionError("a slot was taken while every one was held")
+        except RuntimeError as error:
+            assert "no JACK server slot came free" in str(error) and time.monotonic() - started >= 1.0
+        os.close(held.pop())
+        with JackServer() as server:
+            assert server.alive() and server.slot is not None
+        assert server.slot is None
+    finally:
+        for fd in held:
+            os.close(fd)
