@@ -226,11 +226,24 @@ restart = {
 // A boot is finished once ServerTree has run after it.
 ServerBoot.add({ treePending = true }, s);
 ServerTree.add({ treePending = false }, s);
-// The routines waiting on the clocks fork and Routine.play use (TempoClock.default, SystemClock).
+// The routines waiting on the clocks fork and Routine.play use (TempoClock.default, SystemClock),
+// and on AppClock those a piece's code made or s.waitForBoot's body: with the server running,
+// ServerStatusWatcher runs that body in a Routine on AppClock, which a person waits for as for a
+// fork (FrictionPilot's first block sets ~pilot so, and the next uses it). A class's own routine
+// there (a study session's run, which the next block may abort) is not waited for.
 routinesQueued = {
-	var found = IdentitySet.new;
-	[TempoClock.default.queue, thisProcess.prSchedulerQueue].do { |queue|
-		if(queue.size > 1) { forBy(1, queue.size - 1, 3) { |i| if(queue[i + 1].isKindOf(Routine)) { found.add(queue[i + 1]) } } }
+	var found = IdentitySet.new, appClockQueue = AppClock.classVars[0].queue.prInternalArray;  // its Scheduler
+	var madeHere = { |routine|
+		var def = routine.instVarAt(\func).tryPerform(\def);
+		// The outermost definition: a Method (a class's code) or the interpreted piece's.
+		while { def.notNil and: { def.isKindOf(Method).not } and: { def.context.notNil } } { def = def.context };
+		def.isKindOf(Method).not or: { def.ownerClass == ServerStatusWatcher }
+	};
+	[TempoClock.default.queue, thisProcess.prSchedulerQueue, appClockQueue].do { |queue|
+		if(queue.size > 1) { forBy(1, queue.size - 1, 3) { |i|
+			var item = queue[i + 1];
+			if(item.isKindOf(Routine) and: { queue !== appClockQueue or: { madeHere.(item) } }) { found.add(item) }
+		} }
 	};
 	found
 };
@@ -932,6 +945,11 @@ code::
 fork { 1.0.wait; ~kfDone = true };
 )
 "waited: %".format(~kfDone).postln;  // posts "waited: true"
+(
+~kfBooted = false;
+s.waitForBoot { 1.0.wait; ~kfBooted = true };  // the server runs: its body runs on AppClock
+)
+"booted: %".format(~kfBooted).postln;  // posts "booted: true"
 ::
 
 code::
