@@ -21,6 +21,8 @@
 //                                   watch; Device::watchClient)
 //   kfSimFail    index             (a simulated realtime device's thread fails, as a driver that
 //                                   lost its device would: to rehearse what a study does then)
+//   kfSimRelease index             (a simulated device opened with handHeld 1: its hand starts
+//                                   its script now, SimDevice::releaseHand)
 //
 // Replies follow the server's conventions (CommandRunner.hpp): `/done cmdName` when a command
 // succeeded; when it failed, no /done but `/kfFail` to the notified clients, and the reason is
@@ -400,6 +402,29 @@ void simFailCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
   if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, simFailStage);
 }
 
+// --- kfSimRelease --------------------------------------------------------------------------
+
+bool simReleaseStage(World*, void* raw) {  // NRT
+  auto* data = static_cast<CommandData*>(raw);
+  if (data->device == nullptr) {
+    failWith(data, "kfSimRelease: no device is open at index %d", data->args.index);
+    return false;
+  }
+  auto* sim = dynamic_cast<kf::SimDevice*>(&data->device->mouseBackend());
+  if (sim == nullptr || sim->params().handHeld == 0.0) {
+    failWith(data, "kfSimRelease: device %d is not a simulated device opened with its hand held (handHeld 1)",
+             data->args.index);
+    return false;
+  }
+  sim->releaseHand();
+  return true;
+}
+
+void simReleaseCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
+  CommandData* data = newCommand(world, "kfSimRelease", CommandShape::kIndex, args);
+  if (data != nullptr) run(world, replyAddr, data, nrtHop, lookUpDeviceStage, simReleaseStage);
+}
+
 }  // namespace
 
 void registerDeviceCommands() {
@@ -413,4 +438,5 @@ void registerDeviceCommands() {
   DefinePlugInCmd("kfZero", zeroCmd, nullptr);
   DefinePlugInCmd("kfHeartbeat", heartbeatCmd, nullptr);
   DefinePlugInCmd("kfSimFail", simFailCmd, nullptr);
+  DefinePlugInCmd("kfSimRelease", simReleaseCmd, nullptr);
 }

@@ -15,14 +15,15 @@ SimDevice::SimDevice(const DeviceSpec& spec, const SimParams& params, const Hand
       puck_(params.puckMassKg),
       magnet_(spec.magnetLagS, params.stepS, spec.minForceN),
       sensor_(spec, params, 0.0),
-      buffer_(kReportBufferCapacity) {}
+      buffer_(kReportBufferCapacity),
+      handHeld_(params.handHeld != 0.0) {}
 
 SimDevice::Push SimDevice::handPush(double timeS) const {
   if (hand_.isIdle()) return {};
   if (hand_.isForce()) return {hand_.constantForceN(), 0.0};
   // A spring-damper between hand and puck on each axis, the push limited in magnitude to what a
   // fingertip pushes (along x alone: clamped to +-handMaxForceN, as before there was a y).
-  const HandTarget target = hand_.at(timeS);
+  const HandTarget target = hand_.at(handTimeS(timeS));
   auto spring = [&](double targetMm, double puckMm, double targetMmPerS, double puckMmPerS) {
     // Metres first, then the gains: the 1D model's rounding, so that x alone stays bit for bit.
     return params_.handStiffnessNPerM * ((targetMm - puckMm) * 1e-3) +
@@ -39,8 +40,14 @@ SimDevice::Push SimDevice::handPush(double timeS) const {
 void SimDevice::step() {
   const double startS = timeS();
   const double startMm = positionMm(), startYMm = positionYMm();
-  const Push push =
-      exploring_ ? Push{explorer_.push(startS, params_.stepS, startMm, speedMmPerS()), 0.0} : handPush(startS);
+  if (handHeld_ && releaseRequested_.load(std::memory_order_acquire)) {
+    handHeld_ = false;
+    handStartS_ = startS;
+  }
+  Push push;  // a held hand pushes nothing
+  if (!handHeld_)
+    push = exploring_ ? Push{explorer_.push(handTimeS(startS), params_.stepS, startMm, speedMmPerS()), 0.0}
+                      : handPush(startS);
   handForceN_ = push.xN;
   handForceYN_ = push.yN;
   puck_.step(params_.stepS, push.xN, push.yN, magnet_.forceN());

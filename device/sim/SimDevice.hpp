@@ -36,6 +36,10 @@ class SimDevice : public MouseBackend, public ForceBackend {
   // The next pollReports throws, as a driver that lost its device would: for rehearsing what a
   // study or a performance does when its device fails (kfSimFail). From any thread.
   void failNextPoll() { failNextPoll_.store(true, std::memory_order_release); }
+  // A held hand (SimParams::handHeld) starts its script at the next step: the scene's movement
+  // starts with what the scene plays (kfSimRelease). From any thread; no effect on a free hand.
+  void releaseHand() { releaseRequested_.store(true, std::memory_order_release); }
+  bool handIsHeld() const { return handHeld_; }
   // Advances to timeS first, so the command takes effect from then on (late commands: now).
   void commandForce(double timeS, float forceN) override;
   void driveOff() override;
@@ -50,7 +54,7 @@ class SimDevice : public MouseBackend, public ForceBackend {
   double speedYMmPerS() const { return puck_.speedYMPerS() * 1000.0; }
   double handForceN() const { return handForceN_; }    // last push on the puck (along x)
   double handForceYN() const { return handForceYN_; }  // and along y
-  HandTarget handTarget() const { return hand_.at(timeS()); }
+  HandTarget handTarget() const { return hand_.at(handTimeS(timeS())); }
   uint64_t droppedReports() const { return sensor_.droppedReports(); }
   uint64_t bufferOverflows() const { return bufferOverflows_; }  // reports nobody polled
   const DeviceSpec& spec() const { return spec_; }
@@ -62,6 +66,7 @@ class SimDevice : public MouseBackend, public ForceBackend {
     double xN = 0.0, yN = 0.0;
   };
   Push handPush(double timeS) const;
+  double handTimeS(double timeS) const { return timeS - handStartS_; }  // the script's time
   void storeReport(const MouseReport& report);
 
   DeviceSpec spec_;
@@ -81,6 +86,9 @@ class SimDevice : public MouseBackend, public ForceBackend {
   int bufferCount_ = 0;
   uint64_t bufferOverflows_ = 0;
   std::atomic<bool> failNextPoll_{false};
+  bool handHeld_;
+  double handStartS_ = 0.0;  // the device time the hand's script starts at
+  std::atomic<bool> releaseRequested_{false};
 };
 
 }  // namespace kf

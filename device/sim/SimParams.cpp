@@ -20,6 +20,7 @@ constexpr Field kFields[] = {
     {"handMaxForceN", &SimParams::handMaxForceN},
     {"puckMassKg", &SimParams::puckMassKg},
     {"stepS", &SimParams::stepS},
+    {"handHeld", &SimParams::handHeld},
     {"reportJitterS", &SimParams::reportJitterS},
     {"dropProbability", &SimParams::dropProbability},
     {"clockDriftPpm", &SimParams::clockDriftPpm},

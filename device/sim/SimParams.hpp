@@ -21,6 +21,9 @@ struct SimParams {
   double handMaxForceN = 1.5;      // a fingertip push; above maxForceN so the puck never jams
   double puckMassKg = 0.1;
   double stepS = 1e-4;  // fixed integration step
+  // 1: the hand rests on the puck without pushing until released (SimDevice::releaseHand), and
+  // its script's time starts then, so that a scene's movement starts with what it plays.
+  double handHeld = 0.0;
 
   // Sensor imperfections (all off by default).
   double reportJitterS = 0.0;    // standard deviation of report times, clipped to +-0.45 period

@@ -197,6 +197,10 @@ FrictionDevice {
 	simulateFailure { this.prSendAnswered(\kfSimFail, this.simulateFailureMsg) }
 	simulateFailureMsg { ^['/cmd', \kfSimFail, index] }
 
+	// A simulated device opened with (handHeld: true): its hand starts its movement now.
+	releaseHand { this.prSendAnswered(\kfSimRelease, this.releaseHandMsg) }
+	releaseHandMsg { ^['/cmd', \kfSimRelease, index] }
+
 	// A 4-channel control Bus of the puck's [x, y, speedX, speedY] (mm, mm/s), made on first
 	// use and written by one reader synth at the head of the server: for GUIs and re-centring
 	// (positionBus.getn(4, action)); it comes back after Cmd-. and a reboot.

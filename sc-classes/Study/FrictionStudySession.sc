@@ -214,8 +214,10 @@ FrictionStudySession {
 		File.mkdir(conditionDir);
 		this.log(\prepare, condition.name);
 		state = \preparing;
+		// A simulated participant's hand waits until the condition starts (prStartRunning): the
+		// set-up before it takes 0.06 to 1.5 s, the more the busier the machine.
 		conditionDevice = if(simulated.notNil) {
-			FrictionDevice.sim(server, deviceIndex, simulated.handFor(condition), replace: true)
+			FrictionDevice.sim(server, deviceIndex, simulated.handFor(condition), (handHeld: true), replace: true)
 		} { device };
 		conditionDevice.record(conditionDir +/+ "device.kfsession");
 		this.log(\recordDevice);
@@ -277,6 +279,8 @@ FrictionStudySession {
 		conditionT0 = Main.elapsedTime;
 		state = \running;
 		this.log(\start, condition.name);
+		// After the line: no report of the hand's movement can then come before it.
+		if(simulated.notNil) { conditionDevice.releaseHand };
 	}
 
 	// The questions after a condition, each answer written and flushed as it is given.

@@ -50,6 +50,7 @@ def test_the_study_job_writes_five_sessions_and_their_report():
             # every 0.05 s; 1 s for sclang's clock to wake up late on a busy machine).
             assert c.ended_by == "participant" and 0.5 < c.duration_s < EXPLORE_S + 1.0, (s.participant, c.name)
             assert (c.folder / "audio.wav").stat().st_size > 0 and (c.folder / "device.kfsession").stat().st_size > 0
+            check_rests_until_start(c)
         for c in s.conditions[6:]:
             # Ended by the procedure after its trials, each a line of trials.csv; the participant's
             # model observer logged with its known threshold, the one its manifest holds.
@@ -213,6 +214,20 @@ def check_binds():
     # e64f5f0: -2.1 to -5.2 mm/s), for P4 in two (down to -10.5), and its mean over the five once
     # (-1.15). That the friction binds the puck is checked where it does: check_held.
     check_held()
+
+
+def check_rests_until_start(c):
+    """The simulated participant's hand starts with the condition: no report before the start
+    line moved the puck (its device opens held, FrictionDevice.releaseHand at the start). Once the
+    set-up before a condition's friction took 0.06 to 1.5 s, the more the busier the machine, and
+    the hand explored without the friction. A report is placed by its device time from the first
+    (session_folder.track), which came at most one report period after recordDevice was logged,
+    and the release is sent after the start line: one moving before start minus that period is
+    the hand's early."""
+    r = c.recording.reports
+    t = r[:, 1] - r[0, 1] + c.event_time("recordDevice")
+    early = t < c.start_s - 1.0 / profile.device()["updateRateHz"]
+    assert early.sum() >= 2 and not r[early, 2].any(), (c.folder, t[early][r[early, 2] != 0][:5])
 
 
 def check_held():

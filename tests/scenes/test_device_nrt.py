@@ -236,3 +236,24 @@ def test_a_device_opened_later_in_a_score_starts_its_time_at_the_open():
     np.testing.assert_allclose(late[shift:shift + n, 0], early[:n, 0], atol=0.021)
     speed_differs = np.abs(late[shift:shift + n, 2] - early[:n, 2]) > 1e-3
     assert np.mean(speed_differs) < 1e-3
+
+
+def test_a_held_hand_starts_its_movement_at_the_release():
+    """A device opened with (handHeld: true) rests until releaseHand, and its hand then moves the
+    puck as a free one from its open. The release at sample 24192 (0.504 s: whole blocks of 64 and
+    whole reports of 8 ms, so the reports fall at the same moments of the movement)."""
+    hand = "FrictionHand.path([[0, 0], [0.3, 20], [0.6, 5]])"
+    release_sample = 378 * 64
+    # supernova runs a bundle a block after its stamp (nrt.bundle_start_sample).
+    release_s = next(t for t in (0.504, 0.504 - 64 / SR) if nrt.bundle_start_sample(t, SR) == release_sample)
+    free, refused = render_device("hand_free", f"FrictionDevice.describeSim(0, {hand})", 1.2,
+                                  extra_events="[0.1, dev.releaseHandMsg],")
+    assert "kfSimRelease: device 0 is not a simulated device opened with its hand held" in refused
+    held, _ = render_device("hand_held", f"FrictionDevice.describeSim(0, {hand}, (handHeld: true))", 1.8,
+                            extra_events=f"[{release_s!r}, dev.releaseHandMsg],")
+    assert np.all(held[:release_sample, [0, 2]] == 0), "the puck rests until the release"
+    n = int(1.1 * SR)
+    assert np.max(np.abs(free[:n, 0])) > 3, "the hand moved the puck"
+    # The same reports at the same moments of the movement: equal but for rounding (under a
+    # two-hundredth of a count of 0.021 mm).
+    np.testing.assert_allclose(held[release_sample:release_sample + n, 0], free[:n, 0], atol=1e-4)

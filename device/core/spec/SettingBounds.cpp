@@ -43,6 +43,7 @@ constexpr SettingBounds kBounds[] = {
     {"handMaxForceN", 0.0, 100.0, false, "N"},
     {"puckMassKg", 1e-3, 10.0, false, "kg"},
     {"stepS", 1e-6, 0.01, false, "s"},  // at most 10^6 steps per simulated second
+    {"handHeld", 0.0, 1.0, true, ""},
     {"reportJitterS", 0.0, 0.1, false, "s"},
     {"dropProbability", 0.0, 1.0, false, ""},
     {"clockDriftPpm", -1e5, 1e5, false, "ppm"},
