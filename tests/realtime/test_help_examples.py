@@ -618,7 +618,15 @@ def check_written(text, temp_dir, since):
     return None
 
 
-def run_examples(files, jack, timeout=240, after=None, booted=None, soak=False):
+# A run's hang guard: sclang is killed after this, so that the report says where it stood (under
+# ctest's TIMEOUT of 600 s, tests/realtime/CMakeLists.txt, which would kill the whole test). Not a
+# bound on its time: the guides' run, the longest, took 220 s of an idle fresh clone (at 23cb9a2)
+# and passed 240 s beside a second test command (fresh clones 65 and 66, killed in the Study guide);
+# 540 s is 2.5 times the idle run.
+RUN_TIMEOUT_S = 540
+
+
+def run_examples(files, jack, timeout=RUN_TIMEOUT_S, after=None, booted=None, soak=False):
     """Runs every example of `files`, in this order, on one server booted against `jack`, once the
     Event `after` (if any) is set; sets `booted` when its server is up. Returns (run, examples,
     problems, notes): problems are the failures and unmet expectations, each naming its example.
