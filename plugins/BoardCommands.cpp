@@ -58,12 +58,6 @@ enum BoardStatusField {
 
 static_assert(kBoardStatusFields <= static_cast<int>(sizeof(CommandData::replyValues) / sizeof(float)));
 
-bool haveDevice(CommandData* data) {
-  if (data->device != nullptr) return true;
-  failWith(data, "%s: no device is open at index %d", data->name, data->args.index);
-  return false;
-}
-
 kf::UsbBoardBackend* boardOf(CommandData* data, std::shared_ptr<kf::ForceBackend>& holder) {
   holder = data->device->board();
   auto* board = dynamic_cast<kf::UsbBoardBackend*>(holder.get());

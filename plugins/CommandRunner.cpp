@@ -111,6 +111,12 @@ bool wrappedStage4(World* world, void* raw) {  // NRT
 
 }  // namespace
 
+bool haveDevice(CommandData* data) {
+  if (data->device != nullptr) return true;
+  failWith(data, "%s: no device is open at index %d", data->name, data->args.index);
+  return false;
+}
+
 void failWith(CommandData* data, const char* format, ...) {
   data->failed = true;
   va_list args;

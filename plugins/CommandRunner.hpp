@@ -47,6 +47,9 @@ struct CommandData {
 
 // Records why the command failed; the stage wrappers post it and answer /kfFail with it.
 void failWith(CommandData* data, const char* format, ...) KF_PRINTF_FORMAT(2, 3);
+// NRT, after lookUpDeviceStage: true when the slot held a device; else the command fails with
+// "<name>: no device is open at index <i>".
+bool haveDevice(CommandData* data);
 // RT: the failure to the notified clients: /kfFail, node 0, reply ID the device (-1 when the
 // device argument itself was wrong, or the command has none), then the reason as character
 // codes, which starts with the command's name ("kfRecord: ...").

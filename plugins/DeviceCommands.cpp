@@ -174,10 +174,7 @@ void openReplayCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 
 bool recordStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
-  if (data->device == nullptr) {
-    failWith(data, "kfRecord: no device is open at index %d", data->args.index);
-    return false;
-  }
+  if (!haveDevice(data)) return false;
   if (data->args.path[0] == '\0') {
     data->device->stopRecording();
     return true;
@@ -363,10 +360,7 @@ void zeroCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 
 bool heartbeatStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
-  if (data->device == nullptr) {
-    failWith(data, "kfHeartbeat: no device is open at index %d", data->args.index);
-    return false;
-  }
+  if (!haveDevice(data)) return false;
   if (data->args.numbers[0] >= 0.0)
     data->device->watchClient(data->args.numbers[0]);
   else
@@ -383,10 +377,7 @@ void heartbeatCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 
 bool simFailStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
-  if (data->device == nullptr) {
-    failWith(data, "kfSimFail: no device is open at index %d", data->args.index);
-    return false;
-  }
+  if (!haveDevice(data)) return false;
   auto* sim = dynamic_cast<kf::SimDevice*>(&data->device->mouseBackend());
   // In lockstep the audio thread pumps the device: an exception there would end the server.
   if (sim == nullptr || data->device->isLockstep()) {
@@ -406,10 +397,7 @@ void simFailCmd(World* world, void*, sc_msg_iter* args, void* replyAddr) {
 
 bool simReleaseStage(World*, void* raw) {  // NRT
   auto* data = static_cast<CommandData*>(raw);
-  if (data->device == nullptr) {
-    failWith(data, "kfSimRelease: no device is open at index %d", data->args.index);
-    return false;
-  }
+  if (!haveDevice(data)) return false;
   auto* sim = dynamic_cast<kf::SimDevice*>(&data->device->mouseBackend());
   if (sim == nullptr || sim->params().handHeld == 0.0) {
     failWith(data, "kfSimRelease: device %d is not a simulated device opened with its hand held (handHeld 1)",

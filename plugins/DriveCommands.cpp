@@ -27,10 +27,7 @@ bool buildStage(World* world, void* raw) {  // NRT
   // The generation first: the RT stage compares both (publishDriveIfSameDevice).
   data->generation = generationOfSlot(data->args.index);
   data->device = peekSlot(data->args.index);
-  if (data->device == nullptr) {
-    failWith(data, "kfDriveCalibrate: no device is open at index %d", data->args.index);
-    return false;
-  }
+  if (!haveDevice(data)) return false;
   if (data->args.path[0] == '\0') return true;  // no chain: the drive is removed
   kf::DriveCircuit circuit;
   std::string error;

@@ -73,9 +73,9 @@ class JackServer:
                 "-p", str(self.period), "-C", "2", "-P", "2"]
 
     def start(self, timeout_s=20.0):
-        # A killed jackd's slot in JACK's 8-slot registry stays taken (jack_registry.py).
         self.slot = take_slot()
         try:
+            # A killed jackd's slot in JACK's 8-slot registry stays taken (jack_registry.py).
             reclaim_dead_servers()
             with open(self.log_path, "w") as log:
                 self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL, stdout=log,
