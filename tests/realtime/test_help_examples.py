@@ -111,6 +111,13 @@ BOOT_WAIT_MAX_S = 30.0
 # claim was judged on nothing (a fresh clone at 6c6d957). At most this long more.
 READINGS_WAIT_MAX_S = 2.0
 FORCE_READINGS = 3
+# A piece that claims "sound on the outputs" and is not yet heard is listened to this long more. A
+# simulated hand pulls its puck through a spring (20 N/m): at a turn of its sweep the puck stands
+# still until the hand's lag has turned from +F/k to -F/k, 2F / (k v). With the pilot's 0.5 N that
+# is 2.0 s at the LiveCoding guide's 25 mm/s and 3.3 s at the Patterns guide's 15 mm/s; measured,
+# the LiveCoding guide's zoom after its reboot was silent for its whole 0.5 s time (the puck held at
+# a turn) beside two CPU hogs.
+SOUND_WAIT_MAX_S = 4.0
 # After a guide's clean-up: how long the runner listens for synths still running.
 CLEANUP_WATCH_S = 1.0
 # Nodes are freed after each file, not after each block: the guides are sessions (a pilot started
@@ -128,7 +135,7 @@ RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
 var headOf, runPiece, compileKeepingFrame, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
-var waitForReadings;
+var waitForReadings, listenForSound;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -364,6 +371,15 @@ waitForReadings = { |t, polled|
 		"KF-HELP-READINGS-WAITED %% s meter %% force %%\n".postf(waited, meterLevels.size, polled !? { polled[0].size })
 	};
 };
+// A piece that claims sound is listened to until it is heard, SOUND_WAIT_MAX_S at most, as a
+// person listens a moment longer for a puck that stands still.
+listenForSound = { |t|
+	var waited = 0;
+	while { s.serverRunning and: { levelsSince.(t)[0] <= %(heard_above)f } and: { waited < %(sound_wait)f } } {
+		0.05.wait; waited = waited + 0.05
+	};
+	if(waited > 0) { "KF-HELP-LISTENED %% s\n".postf(waited) };
+};
 
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
 pieceStack = runPiece.({ nil })[\stack];
@@ -407,6 +423,9 @@ files.do { |path, f|
 				// The last piece's time runs to the block's end.
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 				waitForReadings.(pieceStart, polled);
+				if(%(meter)s and: { piece.find("sound on the outputs").notNil } and: { piece.find("no sound on the outputs").isNil }) {
+					listenForSound.(pieceStart)
+				};
 				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
 					var forces = forcesSince.(polled, pieceStart);
@@ -639,6 +658,7 @@ def run_examples(files, jack, timeout=RUN_TIMEOUT_S, after=None, booted=None, so
                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
                          boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
                          readings_wait=READINGS_WAIT_MAX_S, force_readings=FORCE_READINGS,
+                         heard_above=HEARD_ABOVE, sound_wait=SOUND_WAIT_MAX_S,
                          free_each_block=str(FREE_EACH_BLOCK).lower(), soak=str(soak).lower(), meter=str(METER).lower(),
                          soak_runs="(" + ", ".join(f"{k}: {v}" for k, v in SOAK_RUNS.items()) + ")")
     run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
