@@ -226,7 +226,9 @@ serverAlive = { s.pid.notNil and: { s.pid.pidRunning } };
 restart = {
 	"KF-HELP-SERVER-DIED\n".post;
 	s.quit;
-	1.wait;
+	// SC 3.13's boot waits 1 s for the old process's exit (Server:prWaitForPidRelease) and then
+	// boots nothing, silently: wait for it (its pid is nil once sclang has seen it exit).
+	10.do { if(s.pid.notNil) { 0.5.wait } };
 	s.bootSync;
 	"KF-SCSYNTH-PID %%\n".postf(s.pid);
 };
