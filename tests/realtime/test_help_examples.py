@@ -54,7 +54,8 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                twice the changes beside it; a kink is no jump): a claim for a
                                block's last piece, whose time runs to the block's end
   // sound on the outputs      the speakers (outputs 0 and 1) are heard at some time from this
-                               piece on, until the block's end
+                               piece on, until the block's end (the piece not yet heard is
+                               listened to up to SOUND_WAIT_MAX_S more: a puck held at a turn)
   // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
                                time (until the next piece; the last one's until the block's end)
                                (a line holding only a comment goes with the next piece; the
