@@ -45,7 +45,8 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                during the run; a WAV file has n channels and lasts d s (both
                                optional); a "*" in it stands for a part the example makes up
   // the force reaches <N> N   device slot 0 commands that force (or more) at some time in the
-                               piece's time (polled 20 times a second, from 0.1 s after it starts)
+                               piece's time (polled 20 times a second, from 0.1 s after it starts;
+                               up to SOUND_WAIT_MAX_S more while not reached)
   // the force stays at <N> N  ... and only that force, throughout
   // the force stays between <A> and <B> N
                                ... and only forces from A to B, throughout (a crossfade's bound)
@@ -112,12 +113,16 @@ BOOT_WAIT_MAX_S = 30.0
 # claim was judged on nothing (a fresh clone at 6c6d957). At most this long more.
 READINGS_WAIT_MAX_S = 2.0
 FORCE_READINGS = 3
-# A piece that claims "sound on the outputs" and is not yet heard is listened to this long more. A
+# A piece that claims "sound on the outputs" and is not yet heard is listened to this long more, and
+# one that claims "the force reaches <N> N" not yet reached is polled this long more. A
 # simulated hand pulls its puck through a spring (20 N/m): at a turn of its sweep the puck stands
 # still until the hand's lag has turned from +F/k to -F/k, 2F / (k v). With the pilot's 0.5 N that
 # is 2.0 s at the LiveCoding guide's 25 mm/s and 3.3 s at the Patterns guide's 15 mm/s; measured,
 # the LiveCoding guide's zoom after its reboot was silent for its whole 0.5 s time (the puck held at
-# a turn) beside two CPU hogs.
+# a turn) beside two CPU hogs. A simulated device opened again starts with its puck at rest until
+# the lag reaches F/k (7 mm at the minimum 0.14 N, 0.28 s at 25 mm/s): the guide's pilot played
+# after its reboot commanded its floor, 0.14 N, for all 8 readings of its piece (a fresh clone at
+# bc339b4), the puck resting on a zero of the sine.
 SOUND_WAIT_MAX_S = 4.0
 # After a guide's clean-up: how long the runner listens for synths still running.
 CLEANUP_WATCH_S = 1.0
@@ -136,7 +141,7 @@ RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
 var headOf, runPiece, compileKeepingFrame, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
-var waitForReadings, listenForSound;
+var waitForReadings, listenForSound, feelForForce;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -383,6 +388,14 @@ listenForSound = { |t|
 	};
 	if(waited > 0) { "KF-HELP-LISTENED %% s\n".postf(waited) };
 };
+// A piece that claims a force not yet reached is polled as long, for the same puck.
+feelForForce = { |t, polled, newtons|
+	var waited = 0;
+	while { s.serverRunning and: { (forcesSince.(polled, t).maxItem ? 0) < newtons } and: { waited < %(sound_wait)f } } {
+		0.05.wait; waited = waited + 0.05
+	};
+	if(waited > 0) { "KF-HELP-FELT-FOR %% s\n".postf(waited) };
+};
 
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
 pieceStack = runPiece.({ nil })[\stack];
@@ -429,6 +442,7 @@ files.do { |path, f|
 				if(%(meter)s and: { piece.find("sound on the outputs").notNil } and: { piece.find("no sound on the outputs").isNil }) {
 					listenForSound.(pieceStart)
 				};
+				piece.findRegexp("the force reaches ([0-9.]+) N").at(1) !? { |claim| feelForForce.(pieceStart, polled, claim[1].asFloat) };
 				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
 					var forces = forcesSince.(polled, pieceStart);
