@@ -46,7 +46,7 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                optional); a "*" in it stands for a part the example makes up
   // the force reaches <N> N   device slot 0 commands that force (or more) at some time in the
                                piece's time (polled 20 times a second, from 0.1 s after it starts;
-                               up to SOUND_WAIT_MAX_S more while not reached)
+                               up to CLAIM_WAIT_MAX_S more while not reached)
   // the force stays at <N> N  ... and only that force, throughout
   // the force stays between <A> and <B> N
                                ... and only forces from A to B, throughout (a crossfade's bound)
@@ -56,7 +56,7 @@ user reads as ordinary comments (ANNOTATIONS, anywhere in a // comment):
                                block's last piece, whose time runs to the block's end
   // sound on the outputs      the speakers (outputs 0 and 1) are heard at some time from this
                                piece on, until the block's end (the piece not yet heard is
-                               listened to up to SOUND_WAIT_MAX_S more: a puck held at a turn)
+                               listened to up to CLAIM_WAIT_MAX_S more: a puck held at a turn)
   // silence on the outputs    the speakers get nothing, no DC either, at the end of the piece's
                                time (until the next piece; the last one's until the block's end)
                                (a line holding only a comment goes with the next piece; the
@@ -123,7 +123,7 @@ FORCE_READINGS = 3
 # the lag reaches F/k (7 mm at the minimum 0.14 N, 0.28 s at 25 mm/s): the guide's pilot played
 # after its reboot commanded its floor, 0.14 N, for all 8 readings of its piece (a fresh clone at
 # bc339b4), the puck resting on a zero of the sine.
-SOUND_WAIT_MAX_S = 4.0
+CLAIM_WAIT_MAX_S = 4.0
 # After a guide's clean-up: how long the runner listens for synths still running.
 CLEANUP_WATCH_S = 1.0
 # Nodes are freed after each file, not after each block: the guides are sessions (a pilot started
@@ -141,7 +141,7 @@ RUNNER = r"""
 var files = [%(files)s], guides = [%(guides)s];
 var codeBlocks, piecesOf, serverAlive, restart, routinesQueued, waitLikeAPerson, hasDefaultGroup, nodesBesidesDefault;
 var headOf, runPiece, compileKeepingFrame, pieceStack, startMeter, meterLevels = List.new, levelsSince, meterAtEnd, pollForce, forcesSince;
-var waitForReadings, listenForSound, feelForForce;
+var waitForReadings, waitForClaim;
 var treePending = false;
 codeBlocks = { |node|
 	if(node.id == \CODEBLOCK) { [node.text] } {
@@ -379,22 +379,15 @@ waitForReadings = { |t, polled|
 		"KF-HELP-READINGS-WAITED %% s meter %% force %%\n".postf(waited, meterLevels.size, polled !? { polled[0].size })
 	};
 };
-// A piece that claims sound is listened to until it is heard, SOUND_WAIT_MAX_S at most, as a
-// person listens a moment longer for a puck that stands still.
-listenForSound = { |t|
+// A piece that claims sound not yet heard is listened to, and one that claims a force not yet
+// reached is polled, until `met` holds (CLAIM_WAIT_MAX_S at most), as a person listens or feels a
+// moment longer for a puck that stands still. Posts how long it waited, as KF-HELP-<tag>.
+waitForClaim = { |met, tag|
 	var waited = 0;
-	while { s.serverRunning and: { levelsSince.(t)[0] <= %(heard_above)f } and: { waited < %(sound_wait)f } } {
+	while { s.serverRunning and: { met.().not } and: { waited < %(claim_wait)f } } {
 		0.05.wait; waited = waited + 0.05
 	};
-	if(waited > 0) { "KF-HELP-LISTENED %% s\n".postf(waited) };
-};
-// A piece that claims a force not yet reached is polled as long, for the same puck.
-feelForForce = { |t, polled, newtons|
-	var waited = 0;
-	while { s.serverRunning and: { (forcesSince.(polled, t).maxItem ? 0) < newtons } and: { waited < %(sound_wait)f } } {
-		0.05.wait; waited = waited + 0.05
-	};
-	if(waited > 0) { "KF-HELP-FELT-FOR %% s\n".postf(waited) };
+	if(waited > 0) { "KF-HELP-%% %% s\n".postf(tag, waited) };
 };
 
 "KF-HELP-TEMPDIR %%\n".postf(Platform.defaultTempDir);
@@ -440,9 +433,11 @@ files.do { |path, f|
 				if(p == (pieces.size - 1)) { (%(block_time)f - (Main.elapsedTime - start)).max(0.2).wait };
 				waitForReadings.(pieceStart, polled);
 				if(%(meter)s and: { piece.find("sound on the outputs").notNil } and: { piece.find("no sound on the outputs").isNil }) {
-					listenForSound.(pieceStart)
+					waitForClaim.({ levelsSince.(pieceStart)[0] > %(heard_above)f }, "LISTENED")
 				};
-				piece.findRegexp("the force reaches ([0-9.]+) N").at(1) !? { |claim| feelForForce.(pieceStart, polled, claim[1].asFloat) };
+				piece.findRegexp("the force reaches ([0-9.]+) N").at(1) !? { |claim|
+					waitForClaim.({ (forcesSince.(polled, pieceStart).maxItem ? 0) >= claim[1].asFloat }, "FELT-FOR")
+				};
 				"KF-HELP-LEVELS %% %% %% %% %% %%\n".postf(path, b, p, *levelsSince.(pieceStart));
 				polled !? {
 					var forces = forcesSince.(polled, pieceStart);
@@ -675,7 +670,7 @@ def run_examples(files, jack, timeout=RUN_TIMEOUT_S, after=None, booted=None, so
                          piece_pause=PIECE_PAUSE_S, block_time=BLOCK_TIME_S, fork_wait=FORK_WAIT_MAX_S,
                          boot_wait=BOOT_WAIT_MAX_S, cleanup_watch=CLEANUP_WATCH_S,
                          readings_wait=READINGS_WAIT_MAX_S, force_readings=FORCE_READINGS,
-                         heard_above=HEARD_ABOVE, sound_wait=SOUND_WAIT_MAX_S,
+                         heard_above=HEARD_ABOVE, claim_wait=CLAIM_WAIT_MAX_S,
                          free_each_block=str(FREE_EACH_BLOCK).lower(), soak=str(soak).lower(), meter=str(METER).lower(),
                          soak_runs="(" + ", ".join(f"{k}: {v}" for k, v in SOAK_RUNS.items()) + ")")
     run = sclang.run_with_server(code, jack, name="help", timeout=timeout, booted=booted,
