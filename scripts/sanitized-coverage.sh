@@ -4,7 +4,8 @@
 # the sanitized one), every realtime test file run against it, two at a time, then all the scene
 # tests (the sanitized run has them too), each run's counters in a folder of its own
 # (build-coverage/runs/); then the tests whose plugin lines the others all run
-# (scripts/coverage/sanitized_realtime.py). Run it after a change to the plugin or the realtime
+# (scripts/coverage/sanitized_realtime.py), and whether the sanitized run's selection of help files
+# still runs every line the whole help runs. Run it after a change to the plugin or the realtime
 # tests, and keep tests/realtime/CMakeLists.txt's list to what it says. About 10 minutes; not part
 # of the test command.
 set -euo pipefail
@@ -33,6 +34,10 @@ export -f run
 (cd tests/realtime && ls test_*.py | grep -vx test_jack_registry.py) |
   xargs -P 2 -I{} bash -c 'run tests/realtime "$(basename {} .py)" {}'
 run tests/scenes scenes .
+# The help files the sanitized run takes (tests/realtime/sanitized-help-files.txt), on their own: the
+# report checks that they and the tests kept run every plugin line the whole help runs.
+(export KF_HELP_FILES="$(grep -v '^#' tests/realtime/sanitized-help-files.txt | tr '\n' ' ')"
+ run tests/realtime help_selection test_help_examples.py -k runs_on)
 # Their servers are killed (a server writes its counters at exit): they keep their run.
 "$KF_PYTHON" scripts/coverage/sanitized_realtime.py "$out/data" "$root" \
   test_exit_signals test_study_server_lost test_study_session test_study_resume_threshold

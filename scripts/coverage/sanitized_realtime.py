@@ -3,7 +3,9 @@ run per test file (and one of all the scene tests, which run against the sanitiz
 written by scripts/sanitized-coverage.sh. A realtime test whose plugin lines the others all run
 (scenes included) adds no line for the sanitizers to see; removed one at a time, the longest
 first, until each left has lines of its own. Tests whose servers are killed or signalled write
-no gcov data (a server writes it at its exit), so they stay whatever their lines.
+no gcov data (a server writes it at its exit), so they stay whatever their lines. The sanitized run
+takes a selection of the help files (a run named help_selection): it stands for test_help_examples,
+and the lines the whole help runs that it and the tests kept do not are listed (exit 1).
 Usage: sanitized_realtime.py <gcov data folder> <source folder> [kept test...]"""
 import glob
 import json
@@ -41,6 +43,13 @@ def main():
     for name in coverage:
         log = os.path.join(data_root, "..", f"{name}.seconds")
         seconds[name] = float(open(log).read()) if os.path.exists(log) else 0.0
+    # The sanitized run takes a selection of the help files (help_selection): it stands for
+    # test_help_examples there; every line the whole help runs must still be run.
+    whole_help = coverage.get("test_help_examples", set())
+    if "help_selection" in coverage:
+        coverage["test_help_examples"] = coverage.pop("help_selection")
+        seconds["test_help_examples"] = seconds.pop("help_selection", 0.0)
+        kept = kept + ["test_help_examples"]
     running = set(coverage)
     for name in sorted(coverage, key=lambda n: -len(coverage[n])):
         print(f"{name:32s} {len(coverage[name]):5d} lines {seconds[name]:6.0f} s")
@@ -54,6 +63,13 @@ def main():
         print(f"no line of its own: {longest} ({seconds[longest]:.0f} s)")
     union = set().union(*coverage.values())
     print(f"plugin lines run: {len(union)}; the sanitized run keeps: {' '.join(sorted(running - {'scenes'}))}")
+    missed = sorted(whole_help - set().union(*(coverage[name] for name in running)))
+    if missed:
+        print(f"the help files' selection (tests/realtime/sanitized-help-files.txt) misses {len(missed)} lines the "
+              f"whole help runs: add the files that run them:")
+        for path, line in missed:
+            print(f"  {os.path.relpath(path, source_dir)}:{line}")
+        sys.exit(1)
 
 
 if __name__ == "__main__":
