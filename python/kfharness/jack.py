@@ -18,26 +18,69 @@ from .load import realtime_allowed
 SLOTS = 7
 SLOT_LOCK = "/dev/shm/kf-jack-slot-{}.lock"
 SLOT_WAIT_S = 900.0  # a realtime test holds its server for up to a few minutes, the help examples 10
+# A test that fills JACK's registry takes every slot (take_every_slot), the gate first: while the
+# gate is held, take_slot takes no slot, so that servers starting one after another cannot keep the
+# filler waiting (a loop of servers did for 50 s, taking slot 0 again as soon as it freed it).
+GATE = "gate"
+
+
+def _lock_file(name):
+    return os.open(SLOT_LOCK.format(name), os.O_RDONLY | os.O_CREAT, 0o644)
+
+
+def _locked(fd, kind=fcntl.LOCK_EX):
+    """Whether this open file took the lock (flock, not waiting)."""
+    try:
+        fcntl.flock(fd, kind | fcntl.LOCK_NB)
+        return True
+    except BlockingIOError:
+        return False
+
+
+def _gate_closed():
+    fd = _lock_file(GATE)
+    try:
+        return not _locked(fd, fcntl.LOCK_SH)
+    finally:
+        os.close(fd)
 
 
 def take_slot(timeout_s=SLOT_WAIT_S):
     """The open lock file of a free slot (closing it frees the slot); waits for one, saying so."""
     deadline, said = time.monotonic() + timeout_s, False
     while True:
-        for i in range(SLOTS):
-            fd = os.open(SLOT_LOCK.format(i), os.O_RDONLY | os.O_CREAT, 0o644)
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                return fd
-            except BlockingIOError:
+        if not _gate_closed():
+            for i in range(SLOTS):
+                fd = _lock_file(i)
+                if _locked(fd):
+                    return fd
                 os.close(fd)
         if time.monotonic() > deadline:
-            raise RuntimeError(f"no JACK server slot came free in {timeout_s:.0f} s ({SLOTS} held by other tests)")
+            raise RuntimeError(f"no JACK server slot came free in {timeout_s:.0f} s (held by other tests)")
         if not said:
-            print(f"kfharness: all {SLOTS} JACK server slots are held (another test command?): waiting",
-                  file=sys.stderr)
+            print("kfharness: no JACK server slot is free (another test command?): waiting", file=sys.stderr)
             said = True
         time.sleep(0.5)
+
+
+def take_every_slot(timeout_s=SLOT_WAIT_S):
+    """(gate, slots): the open lock files of the gate and of every slot, for a test that fills
+    JACK's registry: no other test's server starts (or reclaims the entries it fills) until they
+    are closed. One taker at a time (the gate), so two cannot each hold part and wait for the
+    other's; take_slot holds nothing while it waits."""
+    deadline, taken = time.monotonic() + timeout_s, []
+    try:
+        for name in [GATE, *range(SLOTS)]:
+            taken.append(_lock_file(name))
+            while not _locked(taken[-1]):
+                if time.monotonic() > deadline:
+                    raise RuntimeError(f"JACK server slot {name} did not come free in {timeout_s:.0f} s")
+                time.sleep(0.5)
+    except BaseException:
+        for fd in taken:
+            os.close(fd)
+        raise
+    return taken[0], taken[1:]
 
 
 class JackServer:
@@ -48,7 +91,7 @@ class JackServer:
     scheduling (-r), which needs no rights; `realtime_priority` (e.g. 70) runs its and its
     clients' process threads SCHED_FIFO, as a performer would (needs root or an rtprio limit)."""
 
-    def __init__(self, sample_rate=48000, period=64, realtime_priority=None):
+    def __init__(self, sample_rate=48000, period=64, realtime_priority=None, slot=None):
         self.name = f"kfrt{os.getpid()}x{random.randrange(16 ** 6):06x}"
         # scsynth's JACK client name here (ServerOptions.device, kfharness.sclang): JACK names a
         # client's notification socket /dev/shm/jack_<client>_<uid>_0, whatever its server, so two
@@ -61,7 +104,9 @@ class JackServer:
         self.period = period
         self.realtime_priority = realtime_priority
         self.proc = None
-        self.slot = None  # the lock file descriptor of its slot (take_slot) while it runs
+        # The lock file descriptor of its slot while it runs: taken on start (take_slot), or one of
+        # take_every_slot's handed over; closed when it stops.
+        self.slot = slot
         self.log_path = paths.work_dir() / f"jackd-{self.name}.log"
         self.env = dict(os.environ)
         self.env.update(JACK_DEFAULT_SERVER=self.name, JACK_NO_START_SERVER="1",
@@ -73,7 +118,8 @@ class JackServer:
                 "-p", str(self.period), "-C", "2", "-P", "2"]
 
     def start(self, timeout_s=20.0):
-        self.slot = take_slot()
+        if self.slot is None:
+            self.slot = take_slot()
         try:
             # A killed jackd's slot in JACK's 8-slot registry stays taken (jack_registry.py).
             reclaim_dead_servers()
