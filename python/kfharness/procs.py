@@ -1,8 +1,12 @@
-"""Processes by pid (every server a test starts is stopped by its pid) and free UDP ports."""
+"""Processes by pid (every server a test starts is stopped by its pid), free UDP ports and locks
+across test commands."""
+import contextlib
+import fcntl
 import os
 import random
 import signal
 import socket
+import sys
 import time
 from pathlib import Path
 
@@ -121,3 +125,20 @@ def free_udp_port():
                 continue
         return port
     raise RuntimeError("no free UDP port")
+
+
+@contextlib.contextmanager
+def machine_lock(name):
+    """Holds /dev/shm/<name>.lock (flock) for the block: one holder on the machine at a time, whichever
+    test command it is in (ctest's RESOURCE_LOCK orders only its own tests); waits, saying so. The
+    lock is freed however its holder exits."""
+    fd = os.open(f"/dev/shm/{name}.lock", os.O_RDONLY | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            print(f"kfharness: {name} is held (another test command?): waiting", file=sys.stderr)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)

@@ -62,6 +62,14 @@ def config(include_paths=None):
     return conf
 
 
+def command(script, include_paths=None):
+    """sclang running `script` with the classes (config), listening on a free UDP port of its own:
+    at the default 57120 sclang tries ten ports up, and beside a second test command more sclangs
+    than that ran at once, the next without networking ("Primitive '_GetLangPort' failed" as it
+    booted its server; fresh clones 81 and 82)."""
+    return ["sclang", "-u", str(procs.free_udp_port()), "-l", str(config(include_paths)), str(script)]
+
+
 # The code is compiled by a fixed wrapper, so that a syntax error is reported and exits instead
 # of leaving sclang waiting.
 SCRIPT_WRAPPER = """var fn = File.readAllString(%(code)s).compile;
@@ -113,7 +121,7 @@ def run_script(code, timeout=120, expect_ok=True, include_paths=None, name="scri
             run_env[name] = value
     log_path = paths.work_dir() / f"{key}.log"
     with open(log_path, "w") as log:
-        proc = subprocess.Popen(["sclang", "-l", str(config(include_paths)), str(script)],
+        proc = subprocess.Popen(command(script, include_paths),
                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, env=run_env)
         try:
             failed = wait_for_sclang(proc, log_path, timeout)
@@ -262,7 +270,7 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
     known_children = set()
     with open(log_path, "w+") as log:
         try:
-            proc = subprocess.Popen(["sclang", "-l", str(config(include_paths)), str(script)],
+            proc = subprocess.Popen(command(script, include_paths),
                                     stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                     env=run_env, cwd=paths.work_dir())
             def on_poll():

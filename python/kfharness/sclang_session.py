@@ -70,7 +70,7 @@ class SclangSession:
         script.write_text(DAEMON % dict(dir=sclang.sc_string(self.dir), poll=POLL_S, idle=IDLE_EXIT_S))
         self.log_path = self.dir / "sclang.log"
         with open(self.log_path, "w") as log:
-            self.proc = subprocess.Popen(["sclang", "-l", str(sclang.config()), str(script)],
+            self.proc = subprocess.Popen(sclang.command(script),
                                          stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                          env=sclang.environment(), cwd=self.dir)
         self.count = 0

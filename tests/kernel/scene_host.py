@@ -90,7 +90,7 @@ class SceneHost:
                                       port=self.port, mouse=sclang.sc_string(MOUSE),
                                       serial=sclang.sc_string(SERIAL), countMm=COUNT_MM, watchdogS=WATCHDOG_S))
         self.log = open(self.log_path, "w")
-        self.proc = subprocess.Popen(["sclang", "-l", str(sclang.config()), str(script)], stdin=subprocess.DEVNULL,
+        self.proc = subprocess.Popen(sclang.command(script), stdin=subprocess.DEVNULL,
                                      stdout=self.log, stderr=subprocess.STDOUT, env=sclang.environment(),
                                      cwd=paths.work_dir())
         return "ok"

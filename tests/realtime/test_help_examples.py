@@ -81,7 +81,7 @@ from pathlib import Path
 
 import pytest
 
-from kfharness import paths, sclang
+from kfharness import paths, procs, sclang
 from kfstudy import readers
 from conftest import performer_jack
 from kfharness.jack import JackServer
@@ -899,6 +899,11 @@ def test_every_help_example_runs_on_a_realtime_server(part):
     if not shards:
         pytest.skip(f"no {part} among the help files")
     with ExitStack() as stack:
+        # The examples write where a user's would, in /tmp (Platform.defaultTempDir): a second test
+        # command's run of the same part replayed a session file this one was writing (fresh clones
+        # 81 and 82: the NoHardware guide's replay silent, the Pilot guide's "line longer than 4096
+        # characters"). Within one command ctest orders the two builds' runs (RESOURCE_LOCK).
+        stack.enter_context(procs.machine_lock(f"kf-help-temp-files-{part}"))
         # Run as the other realtime tests run (conftest.performer_jack).
         jacks = [stack.enter_context(performer_jack()) for _ in shards]
         # The servers boot one after another: scsynths opening their JACK clients at the same

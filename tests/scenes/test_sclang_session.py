@@ -49,3 +49,12 @@ def test_a_class_library_that_does_not_compile_stops_the_run_with_its_errors(tmp
     shutil.copytree(paths.extension_dir() / "Classes", twice)
     with pytest.raises(AssertionError, match=r"(?s)class library did not compile.*duplicate Class found: '"):
         sclang.run_script('"never run".postln;', timeout=60, include_paths=[paths.extension_dir() / "Classes", twice])
+
+
+def test_each_sclang_listens_on_a_port_of_its_own():
+    """sclang at SC's default port tries 57120 and the nine above it: beside a second test command
+    more sclangs than that ran at once, and the next had no networking (fresh clones 81 and 82).
+    The harness gives each a free port of its own (sclang.command)."""
+    output = sclang.run_script('"KF-LANG-PORT %".format(NetAddr.langPort).postln;')
+    port = int(output.split("KF-LANG-PORT ")[1].split()[0])
+    assert not 57120 <= port < 57130, f"sclang listens on {port}, one of SC's default ports"
