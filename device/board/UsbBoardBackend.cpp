@@ -595,7 +595,6 @@ void UsbBoardBackend::run() {
         unplugged_ = false;
         haltOut_ = haltIn_ = false;
         lastOutDoneS_ = -1.0;
-        connected_.store(true);
         std::lock_guard<PiMutex> telemetryLock(telemetryMutex_);
         ++telemetry_.reopens;
         telemetry_.lastError.clear();
@@ -604,6 +603,10 @@ void UsbBoardBackend::run() {
         if (ids_.serial.empty())
           telemetry_.lastError =
               "a board without a USB serial was plugged in: it may be another board than before; it is disarmed";
+        // Connected only with its status written, under the lock telemetry() reads under: a status
+        // read between the two said connected with no warning (a fresh clone beside a second
+        // test command, the Windows suite under Wine).
+        connected_.store(true);
       } else {
         nextReopenS_ = steadyS() + options_.reopenPeriodS;
       }
