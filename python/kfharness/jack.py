@@ -6,7 +6,7 @@ import subprocess
 import sys
 import time
 
-from . import paths
+from . import paths, procs
 from .jack_registry import reclaim, reclaim_dead_servers, registered_servers
 from .load import realtime_allowed
 
@@ -28,19 +28,10 @@ def _lock_file(name):
     return os.open(SLOT_LOCK.format(name), os.O_RDONLY | os.O_CREAT, 0o644)
 
 
-def _locked(fd, kind=fcntl.LOCK_EX):
-    """Whether this open file took the lock (flock, not waiting)."""
-    try:
-        fcntl.flock(fd, kind | fcntl.LOCK_NB)
-        return True
-    except BlockingIOError:
-        return False
-
-
 def _gate_closed():
     fd = _lock_file(GATE)
     try:
-        return not _locked(fd, fcntl.LOCK_SH)
+        return not procs.try_flock(fd, fcntl.LOCK_SH)
     finally:
         os.close(fd)
 
@@ -52,7 +43,7 @@ def take_slot(timeout_s=SLOT_WAIT_S):
         if not _gate_closed():
             for i in range(SLOTS):
                 fd = _lock_file(i)
-                if _locked(fd):
+                if procs.try_flock(fd):
                     return fd
                 os.close(fd)
         if time.monotonic() > deadline:
@@ -72,7 +63,7 @@ def take_every_slot(timeout_s=SLOT_WAIT_S):
     try:
         for name in [GATE, *range(SLOTS)]:
             taken.append(_lock_file(name))
-            while not _locked(taken[-1]):
+            while not procs.try_flock(taken[-1]):
                 if time.monotonic() > deadline:
                     raise RuntimeError(f"JACK server slot {name} did not come free in {timeout_s:.0f} s")
                 time.sleep(0.5)

@@ -127,6 +127,15 @@ def free_udp_port():
     raise RuntimeError("no free UDP port")
 
 
+def try_flock(fd, kind=fcntl.LOCK_EX):
+    """Whether this open file took the lock (flock, not waiting)."""
+    try:
+        fcntl.flock(fd, kind | fcntl.LOCK_NB)
+        return True
+    except BlockingIOError:
+        return False
+
+
 @contextlib.contextmanager
 def machine_lock(name):
     """Holds /dev/shm/<name>.lock (flock) for the block: one holder on the machine at a time, whichever
@@ -134,9 +143,7 @@ def machine_lock(name):
     lock is freed however its holder exits."""
     fd = os.open(f"/dev/shm/{name}.lock", os.O_RDONLY | os.O_CREAT, 0o644)
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+        if not try_flock(fd):
             print(f"kfharness: {name} is held (another test command?): waiting", file=sys.stderr)
             fcntl.flock(fd, fcntl.LOCK_EX)
         yield
