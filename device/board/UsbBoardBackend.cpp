@@ -358,9 +358,12 @@ bool UsbBoardBackend::nextSubSetPoints(board::MultiSetPoint& frame) {
     frame.drives[g] = last;
   }
   // The writer went round the ring while it was read (never at 8 kHz: the ring holds 8 ms):
-  // those levels are lost, the last level sent holds.
-  if (written_.load(std::memory_order_acquire) > from + kRingSize)
+  // those levels are lost, counted as dropped, and the last level sent holds.
+  if (written_.load(std::memory_order_acquire) > from + kRingSize) {
     std::fill(frame.drives, frame.drives + subSetPoints_, heldLevel_);
+    std::lock_guard<PiMutex> lock(telemetryMutex_);
+    telemetry_.subStepsDropped += static_cast<uint64_t>(groups);
+  }
   heldLevel_ = frame.drives[subSetPoints_ - 1];
   taken_ = from + static_cast<uint64_t>(groups) * per;
   if (groups < subSetPoints_) {
