@@ -7,12 +7,14 @@
 
 namespace kf::test {
 
-// Waits until `done` holds; false after `limit` (which only a failing test reaches).
+// Waits until `done` holds; false after `limit` (which only a failing test reaches), counted in
+// this thread's own 1 ms sleeps, not on the clock: a machine that stands still passes the clock
+// beyond any limit before the thread waited for has run again (two test commands side by side,
+// fresh clone 92: 74 s).
 template <class Done>
 bool waitFor(Done done, std::chrono::milliseconds limit = std::chrono::milliseconds(3000)) {
-  const auto start = std::chrono::steady_clock::now();
-  while (!done()) {
-    if (std::chrono::steady_clock::now() - start > limit) return false;
+  for (long slept = 0; !done(); ++slept) {
+    if (slept > limit.count()) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   return true;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <thread>
 
+#include "../WaitFor.hpp"
 #include "FakeMouseIo.hpp"
 #include "MouseDeviceFactory.hpp"
 #include "mouse/EvdevMouseBackend.hpp"
@@ -87,6 +88,25 @@ Sums sumOf(const std::vector<MouseReport>& reports) {
 double quantile(std::vector<double> values, double q) {
   std::sort(values.begin(), values.end());
   return values[static_cast<size_t>(q * (values.size() - 1))];
+}
+
+// Pops a device's reports until the timeline is `untilS` past plug-in and the device has handed
+// over as many as the fake played, with a hang guard (waitFor's). Its mouse thread, held up on a
+// loaded machine, reads them late: under TSan beside three realtime tests (a fresh clone at
+// a1c995c) 55 of 69 had come by 0.8 s; beside a second test command (fresh 92), with the machine
+// standing still 74 s, none had come when this thread woke past 0.8 s.
+std::vector<MouseReport> popAllPlayed(Device& device, const kf::test::FakeTimeline& timeline, double untilS) {
+  const size_t played = timeline.played().size();
+  std::vector<MouseReport> delivered;
+  MouseReport buffer[64];
+  kf::test::waitFor(
+      [&] {
+        const int n = device.popReports(buffer, 64);
+        delivered.insert(delivered.end(), buffer, buffer + std::max(n, 0));
+        return timeline.nowSincePlugS() >= untilS && delivered.size() >= played;
+      },
+      std::chrono::seconds(10));
+  return delivered;
 }
 
 }  // namespace
@@ -240,7 +260,10 @@ TEST_CASE("evdev backend: packets split between reads are put back together", "[
 TEST_CASE("hidapi backend: a full kernel queue is counted as a loss and flags the next report", "[mouse][hid]") {
   FakeMouseScript script = geniusScript();
   script.startS = 6.0;
-  script.endS = 7.0;
+  // Reports go on for 1 s after the hold, so that one comes after the loss to carry its flag. They
+  // stopped 30 ms after it, and two test commands side by side (fresh clones 91 and 92) woke the
+  // reader later than that: the queue it found full held the last report, and nothing was flagged.
+  script.endS = 8.0;
   script.kernelQueue = 64;  // the kernel's own: this test is about loss
   script.stallAtS = 0.72;   // the reader is held 300 ms: ~110 reports come, 63 fit
   script.stallForS = 0.3;
@@ -295,8 +318,7 @@ TEMPLATE_TEST_CASE("unplug is seen within 100 ms, reports stop, a re-open on req
     backend = EvdevMouseBackend::open(api, "", false, error);
   REQUIRE(backend);
   const auto before = collect(*backend, *api->timeline, 0.3);
-  while (backend->state() == MouseState::kRunning && api->timeline->nowSincePlugS() < 1.0)
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  CHECK(kf::test::waitFor([&] { return backend->state() != MouseState::kRunning; }));
   CHECK(backend->state() == MouseState::kUnplugged);
   // When the backend's read found it gone (its state follows in the same thread).
   const double seenAfterS = api->timeline->goneSincePlugS() - 0.3;
@@ -401,13 +423,7 @@ TEST_CASE("a mouse device: reports reach the audio side's queue, status names th
   auto device = openMouseDevice(options, DeviceSpec{}, error, nullptr, api);
   REQUIRE(device);
   CHECK_FALSE(device->isLockstep());
-  std::vector<MouseReport> got;
-  MouseReport buffer[64];
-  while (api->timeline->nowSincePlugS() < 0.8) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    const int n = device->popReports(buffer, 64);
-    got.insert(got.end(), buffer, buffer + n);
-  }
+  const std::vector<MouseReport> got = popAllPlayed(*device, *api->timeline, 0.8);
   const Sums expected = sumOfPlayed(*api->timeline);
   CHECK(sumOf(got).x == expected.x);
   CHECK(sumOf(got).y == expected.y);
@@ -460,19 +476,9 @@ TEST_CASE("a real mouse's session is recorded like any device's and replays to t
   const std::string path = std::string(KF_TEST_OUTPUT_DIR) + "/mouse-session.txt";
   REQUIRE(device->startRecording(path, error));
   CHECK(api->timeline->nowSincePlugS() < script.leadS);  // recording before the first report is due
-  // Until the device has handed over every report played (all due 0.5 s after the lead), with a
-  // hang guard: its mouse thread, held up on a loaded machine, reads them late (under TSan beside
-  // three realtime tests, a fresh clone at a1c995c closed at 0.8 s with 55 of 69 read and recorded).
+  // Until the device has handed over every report played (all due 0.5 s after the lead).
   const Sums expected = sumOfPlayed(*api->timeline);
-  std::vector<MouseReport> delivered;
-  MouseReport buffer[64];
-  const auto guard = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while ((api->timeline->nowSincePlugS() < script.leadS + 0.75 || sumOf(delivered).reports < expected.reports) &&
-         std::chrono::steady_clock::now() < guard) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    const int n = device->popReports(buffer, 64);
-    delivered.insert(delivered.end(), buffer, buffer + std::max(n, 0));
-  }
+  const std::vector<MouseReport> delivered = popAllPlayed(*device, *api->timeline, script.leadS + 0.75);
   device->close();
   CHECK(sumOf(delivered).reports == expected.reports);
 

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <thread>
 
+#include "../WaitFor.hpp"
 #include "FakeMouseIo.hpp"
 #include "mouse/DescriptorKind.hpp"
 #include "mouse/HidapiMouseBackend.hpp"
@@ -144,13 +145,11 @@ TEST_CASE("a re-open after a replug finds the mouse in its own port, not its twi
   auto api = std::make_shared<FakeHidApi>(script);
   auto backend = HidapiMouseBackend::open(api, "/dev/hidraw7", error);
   REQUIRE(backend);
-  while (backend->state() == MouseState::kRunning && api->timeline->nowSincePlugS() < 1.0)
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  REQUIRE(kf::test::waitFor([&] { return backend->state() != MouseState::kRunning; }));
   REQUIRE(backend->state() == MouseState::kUnplugged);
   api->timeline->sleepUntilSincePlug(0.26);
   backend->requestReopen();
-  while (backend->counters().reopens == 0 && api->timeline->nowSincePlugS() < 1.5)
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  CHECK(kf::test::waitFor([&] { return backend->counters().reopens > 0; }));
   CHECK(backend->counters().reopens == 1);
   CHECK(backend->state() == MouseState::kRunning);
   CHECK(backend->info().path == "/dev/hidraw8");
