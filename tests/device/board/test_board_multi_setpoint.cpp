@@ -265,6 +265,14 @@ std::vector<uint16_t> pushRamp(UsbBoardBackend& backend, int perMs, int frames) 
   return levels;
 }
 
+// Whether the board has played `drive`, waited for (waitFor's bound).
+bool waitUntilPlayed(EmulatedUsb& bus, uint16_t drive) {
+  return waitFor([&] {
+    const auto timeline = bus.timeline();
+    return std::any_of(timeline.begin(), timeline.end(), [&](const auto& change) { return change.drive == drive; });
+  });
+}
+
 }  // namespace
 
 TEST_CASE("board 2.1 driver: the device's 8 kHz levels reach the board in order, none lost unseen",
@@ -281,11 +289,7 @@ TEST_CASE("board 2.1 driver: the device's 8 kHz levels reach the board in order,
   // Closed once the board has played the last level (never dropped: the oldest go), so that every
   // level is played or counted dropped. (A fixed 10 ms and 16 levels' allowance for those still
   // waiting missed those in the two transfers in flight, and a busy machine's late ones.)
-  REQUIRE(waitFor([&] {
-    const auto timeline = bus->timeline();
-    return std::any_of(timeline.begin(), timeline.end(),
-                       [&](const auto& change) { return change.drive == levels.back(); });
-  }));
+  REQUIRE(waitUntilPlayed(*bus, levels.back()));
   const BoardTelemetry t = backend->telemetry();
   backend->close();
   std::vector<uint16_t> played;
@@ -319,10 +323,7 @@ TEST_CASE("board 2.1 driver: a 2.0 board gets each millisecond's mean at 1 kHz",
   // the machine gave its thread. (Counting the means sent asked for a pace: beside realtime
   // servers' SCHED_FIFO threads a fresh clone's run sent 47 in the 100 ms, under the 50 it wanted.)
   const auto lastMean = static_cast<uint16_t>(std::lround(2000 + 7 * (8 * (groups - 1) + 3.5)));
-  REQUIRE(waitFor([&] {
-    const auto timeline = bus->timeline();
-    return std::any_of(timeline.begin(), timeline.end(), [&](const auto& change) { return change.drive == lastMean; });
-  }));
+  REQUIRE(waitUntilPlayed(*bus, lastMean));
   const BoardTelemetry t = backend->telemetry();
   backend->close();
   CHECK(bus->rejectedFrames() == 0);
