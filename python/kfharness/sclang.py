@@ -244,14 +244,15 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 
 
 def run_with_server(code, jack, timeout=120, name="script", port=None, include_paths=None, env=None,
-                    server_options=None, booted=None, server_left_s=5.0):
+                    server_options=None, booted=None, server_left_s=5.0, progress=None):
     """Runs `code` (sclang statements, evaluated in a Routine on AppClock: `.wait`, `s.sync` and
     GUI work) with `s` booted against `jack`. Returns an SclangRun; the scsynth and sclang
     processes are gone when it returns, whatever happened. `env`: extra environment variables;
     `server_options`: ServerOptions to set over the defaults, e.g. {"memSize": 524288};
     `booted`: a threading.Event, set once the server is up or the run is over (so that runs side
     by side can boot one after another); `server_left_s`: how long a server left running after
-    sclang ended may take to go before it is stopped."""
+    sclang ended may take to go before it is stopped; `progress`: a tag, whose lines the script
+    posts are printed as they come, without it (a long job's progress)."""
     assert jack.alive(), "jackd is not running"
     port = port or procs.free_udp_port()
     key, code_path = _script_files(code, name)
@@ -268,13 +269,22 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
     proc = None
     scsynth_pid = None
     known_children = set()
+    printed = 0  # how much of the log the progress lines were taken from
     with open(log_path, "w+") as log:
         try:
             proc = subprocess.Popen(command(script, include_paths),
                                     stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                     env=run_env, cwd=paths.work_dir())
             def on_poll():
+                nonlocal printed
                 known_children.update(procs.descendants(proc.pid))
+                if progress is not None:
+                    text = log_path.read_text(errors="replace")
+                    whole = text[printed:text.rfind("\n") + 1]  # lines sclang has ended
+                    printed += len(whole)
+                    for line in whole.splitlines():
+                        if line.startswith(progress):
+                            print(line.removeprefix(progress).strip(), flush=True)
                 if booted is not None and not booted.is_set() and "KF-SERVER-UP" in log_path.read_text(errors="replace"):
                     booted.set()
 

@@ -3,7 +3,13 @@ folder FrictionStudy.run made) written into the folder REPORT (report.md, PNG fi
 FrictionStudy.report runs it. The packages it needs are checked before anything is read: a missing
 one is named with the Debian packages that hold them, and the exit status is 3."""
 import importlib
+import os
 import sys
+
+# Before numpy is imported: no huge pages on its arrays, whose collapse by the kernel's khugepaged
+# holds a CPU for tens of ms where realtime threads wait (a report made while a session plays
+# beside it; scripts/env.sh says more).
+os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
 # The module each needs, and its Debian package.
 NEEDED = [("numpy", "python3-numpy"), ("pandas", "python3-pandas"), ("matplotlib", "python3-matplotlib"),

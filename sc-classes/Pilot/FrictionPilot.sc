@@ -34,14 +34,25 @@ FrictionPilot {
 		^Signal.fill(signalFrames, { |i| sin(2pi * i / cycleFrames) })
 	}
 
-	// Loads the pilot signal into a new Buffer on server (any server: sent as /b_setn).
+	// Loads the pilot signal into a new Buffer on server (any server: sent as /b_setn once the
+	// buffer is allocated, which FrictionSync waits for, bounded, where Buffer.sendCollection's
+	// server.sync would wait for ever on a lost answer). action: called with the buffer once all
+	// of it is sent (the server takes it in order, before anything sent after).
 	*loadSignal { |server, action|
+		var buffer;
 		server = server ? Server.default;
 		if(server.isKindOf(Server).not) {
 			Error("FrictionPilot.loadSignal: server must be a Server, got %".format(server)).throw
 		};
 		FrictionCheck.serverRunning(server, "FrictionPilot.loadSignal");
-		^Buffer.sendCollection(server, this.signal, 1, 0, action)
+		buffer = Buffer(server, signalFrames, 1);
+		forkIfNeeded {
+			server.listSendMsg(buffer.allocMsg);
+			FrictionSync.wait(server, where: "FrictionPilot.loadSignal");
+			this.loadSignalMsgs(buffer.bufnum).drop(1).do { |msg| server.listSendMsg(msg) };
+			action.value(buffer)
+		};
+		^buffer
 	}
 
 	// The OSC messages that put a signal (default: the pilot signal) into buffer bufnum, for a Score.
@@ -254,7 +265,7 @@ FrictionPilot {
 			var starting = synth;
 			buffer = buffer ?? { this.class.loadSignal(server) };
 			this.class.synthDef(defName, device, monitor: true).add;
-			server.sync;
+			FrictionSync.wait(server, where: "FrictionPilot.play");
 			if(synth === starting) {
 				server.sendMsg(*synth.newMsg(server.defaultGroup, [\bufnum, buffer.bufnum,
 					\samplesPerMm, samplesPerMm, \origin, origin, \friction, friction, \amp, amp, \out, out,

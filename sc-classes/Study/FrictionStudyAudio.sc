@@ -26,11 +26,11 @@ FrictionStudyAudio {
 		// The server's own recorder buffer size: 2^16 frames at 48 kHz, half of it a write.
 		buffer = Buffer.alloc(server, server.sampleRate.nextPowerOfTwo, 2);
 		this.class.def.send(server);
-		server.sync;
+		FrictionSync.wait(server, where: "FrictionStudyAudio");
 		buffer.write(path, "wav", "float", 0, 0, true);
-		server.sync;
+		FrictionSync.wait(server, where: "FrictionStudyAudio");
 		synth = Synth.tail(RootNode(server), \kfStudyAudio, [\bufnum, buffer, \in, in, \timeoutS, timeoutS]);
-		server.sync;
+		FrictionSync.wait(server, where: "FrictionStudyAudio");
 		if(timeoutS > 0) {
 			heartbeat = Routine { loop { (timeoutS / 4).wait; synth.set(\t_alive, 1) } }.play(SystemClock)
 		};
@@ -51,14 +51,14 @@ FrictionStudyAudio {
 		heartbeat = nil;
 		synth.free;
 		synth = nil;
-		server.sync;
+		FrictionSync.wait(server, where: "FrictionStudyAudio");
 		while { Main.elapsedTime - stableSince < 0.05 and: { Main.elapsedTime - t0 < 2 } } {
 			var now = File.fileSize(path);
 			if(now != size) { size = now; stableSince = Main.elapsedTime };
 			0.01.wait
 		};
 		buffer.close;
-		server.sync;
+		FrictionSync.wait(server, where: "FrictionStudyAudio");
 		buffer.free;
 		buffer = nil;
 	}

@@ -166,7 +166,7 @@ FrictionStudySession {
 				SynthDef(\frictionStudyButtons, {
 					SendReply.kr(FrictionButtons.kr(\device.kr(0)).sum > 0, '/kfStudyButton', 1)
 				}).add;
-				server.sync;
+				this.prSync;
 				this.prWatch;
 				if(windows) {
 					participantWindow = FrictionStudyParticipantWindow(this);
@@ -226,7 +226,7 @@ FrictionStudySession {
 		pilot = FrictionPilot(conditionDevice, s[\mapping], s[\friction], s[\origin], if(s[\audio]) { s[\amp] } { 0 },
 			participantOut);
 		pilot.play;
-		server.sync;
+		this.prSync;
 		listenSynth = Synth.after(pilot.synth, \frictionStudyListen, [\in, participantOut, \out, experimenterOut]);
 		buttonsSynth = Synth.tail(server, \frictionStudyButtons, [\device, conditionDevice.index]);
 		buttonsResponder = OSCFunc({ this.done(\button) }, '/kfStudyButton', server.addr,
@@ -253,7 +253,7 @@ FrictionStudySession {
 		// The frames the server sent before the end and sclang has not yet taken (a busy machine:
 		// beside two CPU hogs a stretch 0.26 s before the end was missing, four cells) come in
 		// before this sync's answer, so the map logged is the condition's up to its end.
-		server.sync;
+		this.prSync;
 		this.log(\coverage, coverage.fraction.round(0.001));
 		this.log(\coverageMap, coverage.mapString);
 		this.prStopAudio;
@@ -264,10 +264,10 @@ FrictionStudySession {
 		buttonsSynth.free;
 		buttonsSynth = nil;
 		pilot.free;
-		server.sync;
+		this.prSync;
 		conditionDevice.stopRecording;
 		if(simulated.notNil) { conditionDevice.close };
-		server.sync;
+		this.prSync;
 		if(ending == \repeat or: { ending == \abort }) { ^ending };
 		^this.prQuestions
 	}
@@ -307,6 +307,10 @@ FrictionStudySession {
 		this.log(\end, condition.name);
 		^\end
 	}
+
+	// Waits until the server has done what the session sent it (FrictionSync: asked again while
+	// no answer comes; after lostAfterS without one the session fails, as its watch would fail it).
+	prSync { FrictionSync.wait(server, lostAfterS, "FrictionStudySession " ++ participant) }
 
 	// Ends the condition's audio.wav, all of it.
 	prStopAudio { recorder !? { recorder.close; recorder = nil } }

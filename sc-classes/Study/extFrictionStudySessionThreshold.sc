@@ -59,10 +59,10 @@
 		this.prStopAudio;
 		listenSynth.free;
 		listenSynth = nil;  // freed once (prFreeAfterFailure)
-		server.sync;
+		this.prSync;
 		conditionDevice.stopRecording;
 		if(simulated.notNil) { conditionDevice.close };
-		server.sync;
+		this.prSync;
 		^this.prQuestions
 	}
 

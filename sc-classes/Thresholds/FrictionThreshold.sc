@@ -93,7 +93,7 @@ FrictionThreshold {
 		};
 		answered = Condition(false);
 		this.prStartAnswers(answers, device);
-		server.sync;
+		FrictionSync.wait(server, where: where);
 		server.bind { runSynth = Synth(def.name, [\out, out, \bufnum, runBuffer !? _.bufnum ? 0,
 			\intervalS, intervalS, \gapS, gapS]) };
 		startS = thisThread.seconds;

@@ -19,12 +19,24 @@ from kfharness.jack import performer_jack
 # audio.wav is its own pair's. The report follows, from sclang as a researcher makes it.
 SCRIPT = r"""
 var thresholds = if(@TRIALS@ > 0) { FrictionStudy.thresholdConditions(@TRIALS@, \keys, @INTERVAL@, @GAP@) };
-var study = FrictionStudy.pilot(600, thresholds), root = @ROOT@, t0 = Main.elapsedTime, sessions;
+var study = FrictionStudy.pilot(600, thresholds), root = @ROOT@, t0 = Main.elapsedTime, sessions, at, progress;
 sessions = @PARTICIPANTS@.collect { |i|
 	study.run("P" ++ (i + 1), root, s, i, seed: i + 1, simulated: FrictionStudySimParticipant(i + 1, @EXPLORE@),
 		windows: false, participantOut: 4 * i, experimenterOut: 4 * i + 2, deviceIndex: i)
 };
-while { sessions.any { |session| session.isOver.not } } { 0.1.wait };
+// A line as each participant comes to a condition, and at its session's end.
+at = nil ! sessions.size;
+progress = {
+	sessions.do { |session, i|
+		var now = if(session.isOver) { session.state } { session.position };
+		if(now != at[i]) {
+			at[i] = now;
+			"KF-STUDY-PROGRESS % s  %  %\n".postf((Main.elapsedTime - t0).round(1), session.participant,
+				if(session.isOver) { now } { "%/% %".format(now + 1, session.conditionCount, session.order[now].name) })
+		}
+	}
+};
+while { progress.value; sessions.any { |session| session.isOver.not } } { 0.1.wait };
 "KF-STUDY-SESSIONS % s\n".postf((Main.elapsedTime - t0).round(0.1));
 sessions.do { |session| "KF-STUDY-SESSION % %\n".postf(session.participant, session.state) };
 sessions.do { |session|
@@ -55,7 +67,7 @@ def run_study(out_dir, participants=5, explore_s=None, trials=40, interval_s=1.5
     jack = performer_jack()
     try:
         jack.start()
-        run = sclang.run_with_server(code, jack, timeout=timeout_s, name="study",
+        run = sclang.run_with_server(code, jack, timeout=timeout_s, name="study", progress="KF-STUDY-PROGRESS",
                                      server_options={"numOutputBusChannels": 4 * participants})
     finally:
         jack.stop()
