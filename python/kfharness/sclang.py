@@ -278,14 +278,16 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             def on_poll():
                 nonlocal printed
                 known_children.update(procs.descendants(proc.pid))
+                if progress is None and (booted is None or booted.is_set()):
+                    return
+                text = log_path.read_text(errors="replace")
                 if progress is not None:
-                    text = log_path.read_text(errors="replace")
                     whole = text[printed:text.rfind("\n") + 1]  # lines sclang has ended
                     printed += len(whole)
                     for line in whole.splitlines():
                         if line.startswith(progress):
                             print(line.removeprefix(progress).strip(), flush=True)
-                if booted is not None and not booted.is_set() and "KF-SERVER-UP" in log_path.read_text(errors="replace"):
+                if booted is not None and not booted.is_set() and "KF-SERVER-UP" in text:
                     booted.set()
 
             failed = wait_for_sclang(proc, log_path, timeout, on_poll)

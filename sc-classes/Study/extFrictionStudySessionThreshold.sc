@@ -34,13 +34,11 @@
 		experimenterWindow !? { experimenterWindow.refresh };
 		this.prStartRunning;
 		estimate = experiment.run(conditionDevice, how, { |trial|
-			var endT = Main.elapsedTime;
 			// Stored once the server has answered since the trial ended (a round trip: a few ms): a
-			// trial that ended on a lost server is never stored (prLost ends the session meanwhile).
-			server.sendMsg('/sync', watchId);
-			while { lastAnswerT <= endT and: { Main.elapsedTime - endT < lostAfterS } } { 0.005.wait };
-			// No answer (the watch gone with Cmd-., say): the trial is not stored, the session fails.
-			if(lastAnswerT <= endT) { Error("the server did not answer after trial %".format(trial[\trial])).throw };
+			// trial that ended on a lost server is never stored (prLost ends the session meanwhile;
+			// with no answer in lostAfterS, FrictionSync's Error fails it).
+			FrictionSync.wait(server, lostAfterS, "FrictionStudySession % after trial %".format(participant,
+				trial[\trial]));
 			// sclang stood still during the trial (the watch did not tick): its times are not the
 			// participant's; it is not stored, whichever of the two routines runs first after it.
 			this.prStoodStill !? { |reason| this.prLost(reason) };
