@@ -217,7 +217,7 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 	SystemClock.sched(%(timeout)f, { "KF-SCRIPT-TIMEOUT".postln; finish.(3); nil });
 	// On AppClock, like code evaluated in the IDE: GUI (plot, scope, Window) works from it.
 	Routine {
-		var ok = false, period;
+		var ok = false, period, waitedS = 0;
 		try {
 			// sclang sees the server up at its first status poll after scsynth is ready (0.22 s
 			// here): polled every 0.7 s (the default) the boot took 1.8 s, every 0.05 s 0.6 s
@@ -226,7 +226,15 @@ if(fn.isNil) { "KF-SCRIPT-SYNTAX-ERROR".postln; 1.exit } {
 			// answers "already registered" (all is well, it says).
 			period = s.aliveThreadPeriod;
 			s.aliveThreadPeriod = 0.05;
-			s.bootSync;
+			// Not bootSync: it waits for ever when scsynth ends while booting (its JACK client
+			// refused: "couldn't activate jack client"), this ends with it. The process starts
+			// within the first 5 s counted (this Routine's own waits: on a busy machine more).
+			s.boot;
+			while { s.serverRunning.not and: { s.pid.notNil or: { waitedS < 5 } } } {
+				0.05.wait;
+				waitedS = waitedS + 0.05;
+			};
+			if(s.serverRunning.not) { Error("scsynth ended while booting (its output above)").throw };
 			s.aliveThreadPeriod = period;
 			"KF-SCSYNTH-PID %%".format(s.pid).postln;
 			s.sync;
@@ -315,8 +323,8 @@ def run_with_server(code, jack, timeout=120, name="script", port=None, include_p
             # A server that did not quit (a signal, a crash, killed here) leaves its shared memory
             # behind, 8 MB a server; nothing uses it once the server is gone.
             pathlib.Path(f"/dev/shm/SuperColliderServer_{port}").unlink(missing_ok=True)
-    if "could not initialize audio" in output:
-        # The server's JACK client was refused (seen twice in fresh clones, under the sanitizers,
+    if "could not initialize audio" in output or "start audio failed" in output:
+        # The server's JACK client was refused, or not activated (seen three times in fresh clones,
         # cause unknown): what JACK itself said is the evidence.
         said = [line for line in jack.log(100000).splitlines() if "XRun" not in line][-30:]
         output += f"\nKF-HARNESS: jackd {jack.name}'s log, its xruns left out:\n" + "\n".join(said)

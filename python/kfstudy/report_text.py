@@ -11,9 +11,9 @@ CONDITIONS_HEADER = ["| # | condition | friction | audio | duration (s) | ended 
 def heading(study_name, count, root):
     return [f"# Study report: {study_name}", "",
             f"{count} sessions in `{root}`. Speeds come from the device recordings (differences "
-            f"over {session_folder.SPEED_REPORTS} reports); coverage is the map the experimenter saw, computed "
-            "again from the recording (`conditions.csv`'s coverage_cells_apart: the cells where the two "
-            "differ); \"in the fragment\" is the fragment's part on the surface.", ""]
+            f"over {session_folder.SPEED_REPORTS} reports); coverage is the map the experimenter saw, made "
+            "from the recording as it was written, and computed again from the whole recording "
+            "(`conditions.csv`'s coverage_cells_apart: the cells where the two differ); \"in the fragment\" is the fragment's part on the surface.", ""]
 
 
 def unreadable(folder, why):

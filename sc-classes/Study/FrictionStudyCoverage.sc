@@ -1,10 +1,10 @@
 // What of a condition has been explored: a map of the fragment on the surface (positionBins
 // parts of areaMm) against the speed range (speedBins parts of [slowMmPerS, fastMmPerS], on a log
 // scale: the paper's "from quite slow to fast"). A cell is covered once the puck has been seen in
-// it, or has passed through it between two positions seen (a frame every 10 ms misses parts of
-// 0.6 mm at mapping 1's speeds otherwise); the criterion is met when the fraction covered reaches
-// criterion. The report (python/kfstudy/session_folder.py, coverage) computes the same map from
-// the device recording.
+// it, or has passed through it between two positions seen in a row (samples 8 ms apart skip
+// parts of 0.6 mm at mapping 1's speeds otherwise); the criterion is met when the fraction covered
+// reaches criterion. A session adds the samples of its device recording (FrictionStudyTrack); the
+// report (python/kfstudy/session_folder.py, coverage) computes the same map from the same file.
 FrictionStudyCoverage {
 	var <areaMm, <slowMmPerS, <fastMmPerS, <positionBins, <speedBins, <criterion;
 	var <cells, <count = 0;

@@ -25,11 +25,11 @@ FrictionStudySession {
 	classvar <>clientTimeoutS = 2;
 	var <study, <participant, <folder, <server, <participantIndex, <seed, <device, <simulated, <windows;
 	var <participantOut, <experimenterOut, <deviceIndex;
-	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <monitor;
+	var <order, <position = 0, <state = \ready, <condition, <conditionDevice, <pilot, <coverage, <track, <monitor;
 	var <conditionDir, <attempt = 0, <question, <endedBy, <paused = false, <stats;
 	var <participantWindow, <experimenterWindow, <>onEnd;
 	var ending, answerValue, listenSynth, recorder, preparedT0, conditionT0, pausedS = 0, pauseT0;
-	var buttonsSynth, buttonsResponder, recentFrames, lastMiddleMm;
+	var buttonsSynth, buttonsResponder, startedAtS;
 	var routine, lastAnswerT, watchTickT, watchId, experiment, sessionTimeOffsetS = 0, deviceTimeoutBefore;
 
 	*initClass {
@@ -142,12 +142,15 @@ FrictionStudySession {
 	}
 
 	// A line in the condition's events.csv, with the time since its prepare line.
+	// The time logged (s from the condition's prepare line), as the file has it.
 	log { |event, detail = ""|
+		var timeS = this.prLogTime.asString;
 		this.class.checkEvent(event);
 		conditionDir !? {
 			FrictionStudyFiles.appendCsv(conditionDir +/+ "events.csv",
-				[this.prLogTime, event, detail, FrictionStudyFiles.now], eventsHeader)
-		}
+				[timeS, event, detail, FrictionStudyFiles.now], eventsHeader)
+		};
+		^timeS.asFloat
 	}
 
 	prLogTime { ^(Main.elapsedTime - (preparedT0 ? Main.elapsedTime)).round(0.001) }
@@ -204,7 +207,7 @@ FrictionStudySession {
 	}
 
 	prRunCondition {
-		var s = condition.settings;
+		var s = condition.settings, stoppedAtS;
 		preparedT0 = Main.elapsedTime;
 		conditionT0 = nil;
 		pausedS = 0;
@@ -220,7 +223,7 @@ FrictionStudySession {
 			FrictionDevice.sim(server, deviceIndex, simulated.handFor(condition), (handHeld: true), replace: true)
 		} { device };
 		conditionDevice.record(conditionDir +/+ "device.kfsession");
-		this.log(\recordDevice);
+		track = FrictionStudyTrack(conditionDir +/+ "device.kfsession", this.log(\recordDevice));
 		if(clientTimeoutS > 0) { conditionDevice.watchClient(clientTimeoutS) };
 		if(condition.isThreshold) { ^this.prRunThreshold };
 		pilot = FrictionPilot(conditionDevice, s[\mapping], s[\friction], s[\origin], if(s[\audio]) { s[\amp] } { 0 },
@@ -233,14 +236,13 @@ FrictionStudySession {
 			argTemplate: [buttonsSynth.nodeID]);
 		this.prRecordAudio;
 		stats = (speedSum: 0, speedCount: 0, maxForceN: 0, friction: s[\friction], audio: s[\audio]);
-		// 50 frames a second; the cells between two frames are covered too (FrictionStudyCoverage).
-		recentFrames = [];
-		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m, resumed| this.prFrame(m, resumed) });
+		monitor = FrictionViewMonitor.pilot(pilot, 50, 6, { |m| this.prFrame(m) });
 		participantWindow !? { participantWindow.showInstruction(condition.instruction) };
 		experimenterWindow !? { experimenterWindow.showCondition };
 		this.prStartRunning;
 		while { ending.isNil } {
 			0.05.wait;
+			track.read.coverNew(coverage, startedAtS);
 			if(paused.not) {
 				if(simulated.notNil and: { simulated.isDone(coverage, this.elapsedS, condition) }) {
 					this.done(\participant)
@@ -249,13 +251,11 @@ FrictionStudySession {
 			};
 		};
 		state = \stopping;
-		this.log(ending, endedBy ? "");
-		// The frames the server sent before the end and sclang has not yet taken (a busy machine:
-		// beside two CPU hogs a stretch 0.26 s before the end was missing, four cells) come in
-		// before this sync's answer, so the map logged is the condition's up to its end.
+		stoppedAtS = this.log(ending, endedBy ? "");
+		// The map logged is the recording's from the start to this line (the report's end of a
+		// condition that ended by done or maxTime), made once the recording is complete.
+		if(ending != \done and: { ending != \maxTime }) { stoppedAtS = inf };
 		this.prSync;
-		this.log(\coverage, coverage.fraction.round(0.001));
-		this.log(\coverageMap, coverage.mapString);
 		this.prStopAudio;
 		monitor.free;
 		listenSynth.free;
@@ -268,6 +268,9 @@ FrictionStudySession {
 		conditionDevice.stopRecording;
 		if(simulated.notNil) { conditionDevice.close };
 		this.prSync;
+		track.read.coverAll(coverage, startedAtS, stoppedAtS);
+		this.log(\coverage, coverage.fraction.round(0.001));
+		this.log(\coverageMap, coverage.mapString);
 		if(ending == \repeat or: { ending == \abort }) { ^ending };
 		^this.prQuestions
 	}
@@ -278,7 +281,7 @@ FrictionStudySession {
 		endedBy = nil;
 		conditionT0 = Main.elapsedTime;
 		state = \running;
-		this.log(\start, condition.name);
+		startedAtS = this.log(\start, condition.name);
 		// After the line: no report of the hand's movement can then come before it.
 		if(simulated.notNil) { conditionDevice.releaseHand };
 	}
@@ -324,32 +327,14 @@ FrictionStudySession {
 		coverage = study.coverageFor(condition);
 	}
 
-	prFrame { |m, resumed|
+	prFrame { |m|
 		var area = condition.areaMm;
-		if(resumed == true) { recentFrames = [] };
-		this.prCover(m.timeS, m.positionMm);
 		if(m.positionMm >= area[0] and: { m.positionMm < area[1] }) {
 			stats[\speedSum] = stats[\speedSum] + m.speedMmPerS.abs;
 			stats[\speedCount] = stats[\speedCount] + 1;
 		};
 		m.commandedForceN !? { |f| stats[\maxForceN] = max(stats[\maxForceN], f) };
 		experimenterWindow !? { experimenterWindow.frame };
-	}
-
-	// The coverage map as the report computes it from the recording (python/kfstudy/session_folder.py,
-	// track and coverage): the speed over two frames (40 ms, as over the report's SPEED_REPORTS of
-	// 8 ms) at the middle of its two ends, the columns between two such positions covered at it.
-	// The frame's own speed (one mouse report's) is not used: it jumps with the counts and at
-	// reversals.
-	prCover { |timeS, positionMm|
-		var first, middleMm, speedMmPerS;
-		recentFrames = recentFrames.add([timeS, positionMm]).keep(-3);
-		if(recentFrames.size < 3) { lastMiddleMm = nil; ^this };
-		first = recentFrames[0];
-		middleMm = (first[1] + positionMm) / 2;
-		speedMmPerS = (positionMm - first[1]) / max(timeS - first[0], 1e-6);
-		coverage.add(lastMiddleMm ? middleMm, middleMm, speedMmPerS);
-		lastMiddleMm = middleMm;
 	}
 
 	prStats {

@@ -96,35 +96,18 @@ def check_coverage_maps(sessions, table):
             live = c.live_cells()
             t, x, v = c.track()
             recording = session_folder.coverage(x, v, c.area_mm, s.coverage_settings)
-            differ = live != recording
-            where = (s.participant, c.name, np.argwhere(live & ~recording).tolist(), np.argwhere(recording & ~live).tolist(),
-                     late_reports(c))
+            where = (s.participant, c.name, np.argwhere(live & ~recording).tolist(), np.argwhere(recording & ~live).tolist())
             row = rows[(s.participant, c.name)]
-            assert int(row["coverage_cells_apart"]) == differ.sum(), where
-            assert float(row["coverage_live"]) == round(live.mean(), 3), where
-            # Both take a speed over 40 ms and cover the columns between samples, but sample
-            # differently (the view's frames at 50 a second from the rendered trajectory, the
-            # reports at 125 a second): a stretch crossed near a speed part's edge lands in the part
-            # beside it, and a reversal's slow parts, passed in one frame, may be seen by one only.
-            # Measured over 120 conditions (four runs of this job, two of them beside two CPU hogs):
-            # fractions at most 0.067 apart, at most 8 cells of the 60 (5 without the hogs). Before
-            # the live map took 40 ms speeds and the frames still queued at the end (server.sync),
-            # the fractions were once 0.15 and once 0.17 apart in full runs. The bounds: 0.15 for
-            # the fractions as before; twice the most cells seen. A map of other positions or
-            # speeds is further apart: speeds twice the recording's (a wrong unit) put 24 apart.
-            assert abs(float(row["coverage_live"]) - float(row["coverage_recording"])) < 0.15, where
-            assert differ.sum() <= 16, where
-
-
-def late_reports(condition):
-    """How late the device thread took the condition's reports, beyond the least it took any (ms):
-    the most, and how many were more than 12 ms late (1.5 report periods, as far as the rendered
-    trajectory carries a report's motion on). The live map is of the trajectory rendered as the
-    reports came, the recording's of the mouse's own times: where the machine held the device
-    thread back, the two differ (a fresh clone: 35 ms, every 33 ms, ARCHITECTURE.md)."""
-    r = condition.recording.reports
-    late_ms = 1000 * ((r[:, 0] - r[:, 1]) - (r[:, 0] - r[:, 1]).min())
-    return f"reports taken up to {late_ms.max():.0f} ms late, {(late_ms > 12).sum()} of {len(r)} over 12 ms"
+            # The session makes its map from the recording as the server writes it
+            # (FrictionStudyTrack), the same samples as the report's track: the two are the same
+            # map, whatever the machine did to the device thread. Before, the live map was of the
+            # trajectory rendered as the reports came, and a fresh clone whose kernel held the
+            # device thread back 30 to 37 ms at a time saw it 10 cells from the recording's.
+            assert (live == recording).all(), where
+            assert int(row["coverage_cells_apart"]) == 0, where
+            assert float(row["coverage_live"]) == round(live.mean(), 3) == round(float(row["coverage_recording"]), 3), where
+            # Explored, not empty: the simulated participants sweep the fragment at several speeds.
+            assert recording.any(axis=0).sum() >= 3 and recording.any(axis=1).sum() >= 5, where
 
 
 def check_bids(sessions):

@@ -264,3 +264,16 @@ def test_a_device_in_a_proxyspace_plays_the_puck_position(jack):
     """, jack, name="proxyspace"))
     assert values(run, "KF-PROXY ") == [["FrictionDevice", "true", "4"]]
     assert float(run.lines("KF-PROXY-X ")[0][0]) > 10
+
+
+def test_a_server_that_ends_while_booting_ends_the_run_with_jacks_word(jack):
+    # scsynth whose JACK client is refused ends while booting (a fresh clone's study job saw it:
+    # "couldn't activate jack client"); sclang's bootSync then waited until the script's time-out.
+    # Here the device names a JACK server that does not run (JACK_NO_START_SERVER keeps it so).
+    run = sclang.run_with_server('"KF-NOT-HERE".postln;', jack, timeout=120,
+                                 server_options={"device": '"kf-no-such-jack:x"'})
+    assert not run.ok
+    assert "scsynth ended while booting" in run.output, run.output[-3000:]
+    assert "KF-SCRIPT-TIMEOUT" not in run.output and "sclang timed out" not in run.output, run.output[-3000:]
+    assert "KF-NOT-HERE" not in run.output
+    assert f"jackd {jack.name}'s log" in run.output, run.output[-3000:]
