@@ -383,7 +383,7 @@ FrictionDevice {
 				node.onFree { if(busSynths[role] === node) { busSynths.removeAt(role) } };
 				forkIfNeeded {
 					SynthDef(defName, graph).add;
-					server.sync;
+					FrictionSync.wait(server, where: "FrictionDevice %'s % synth".format(index, role));
 					// Forgotten meanwhile (closed, quit, Cmd-.): not started.
 					if(busSynths[role] === node) {
 						server.sendMsg(*node.newMsg(RootNode(server), [\device, index, \bus, bus.index], addAction));

@@ -22,7 +22,7 @@ FrictionSignalPyramid {
 		};
 		fork {
 			try {
-				server.sync;
+				FrictionSync.wait(server, where: "FrictionSignalPyramid.fetch");
 				// A local server shares its buffers through a file; a remote one sends them.
 				if(server.isLocal) { buffer.loadToFloatArray(action: reduce) } {
 					buffer.getToFloatArray(action: reduce)
