@@ -134,8 +134,9 @@ def check_bids(sessions):
 def frame_rates():
     """Per friction-on condition, the force frames the devices applied per second (1000 when the
     server's audio keeps pace) and their watchdog trips, over all sessions: for the failure
-    message of a check that needs the force rendered (a fresh clone's run once had about 500 a
-    second and 4 to 9 trips per condition, with the mapping 2 parts far from the ends low)."""
+    message of a check that needs the force rendered (fresh clones' runs have had 430 to 900 a
+    second and 4 to 35 trips per condition, with the mapping 2 parts far from the ends low, while
+    Wine made its prefix beside them: ARCHITECTURE.md, "Tests and checks")."""
     rates = {}
     for f in sorted((OUT / "sessions").glob("*/*-on/device.kfsession")):
         s = readers.Session(f)
