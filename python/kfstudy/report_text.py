@@ -13,7 +13,8 @@ def heading(study_name, count, root):
             f"{count} sessions in `{root}`. Speeds come from the device recordings (differences "
             f"over {session_folder.SPEED_REPORTS} reports); coverage is the map the experimenter saw, made "
             "from the recording as it was written, and computed again from the whole recording "
-            "(`conditions.csv`'s coverage_cells_apart: the cells where the two differ); \"in the fragment\" is the fragment's part on the surface.", ""]
+            "(`conditions.csv`'s coverage_cells_apart: the cells where the two differ); \"in the "
+            "fragment\" is the fragment's part on the surface.", ""]
 
 
 def unreadable(folder, why):

@@ -141,8 +141,8 @@ FrictionStudySession {
 		^event
 	}
 
-	// A line in the condition's events.csv, with the time since its prepare line.
-	// The time logged (s from the condition's prepare line), as the file has it.
+	// A line in the condition's events.csv, with the time since its prepare line; returns that
+	// time (s) as the file has it.
 	log { |event, detail = ""|
 		var timeS = this.prLogTime.asString;
 		this.class.checkEvent(event);

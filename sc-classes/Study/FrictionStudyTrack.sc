@@ -24,14 +24,15 @@ FrictionStudyTrack {
 	// Reads the lines written since the last read; the samples [timeS, positionMm, speedMmPerS]
 	// they add are appended to samples.
 	read {
-		var file, text, end;
+		var file, length, text, end;
 		if(File.exists(path).not) { ^this };
 		file = File(path, "r");
 		if(file.isOpen.not) { ^this };
 		{
-			if(file.length > offset) {
+			length = file.length;
+			if(length > offset) {
 				file.seek(offset, 0);
-				text = String.newClear(file.length - offset);
+				text = String.newClear(length - offset);
 				file.read(text);
 			}
 		}.protect { file.close };
